@@ -1,0 +1,40 @@
+# twodisk_ros — every command a user or CI needs. Each target creates the venv it uses.
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+# DDS discovery stays on this machine; each target may override the domain id.
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+export ROS_DOMAIN_ID ?= 73
+export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
+export MPLBACKEND := Agg
+
+.PHONY: venv test demo figures bench clean
+
+venv: $(VENV)/.installed
+
+$(VENV)/.installed: requirements.txt
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
+	touch $@
+
+## Run the whole test suite (what CI runs).
+test: venv
+	$(PY) -m pytest
+
+## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot.
+demo: venv
+	mkdir -p out
+	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
+	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap
+	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png
+
+## The paper's figures, whole cycles, the height of G and the stability map (PNG).
+figures: venv
+	$(PY) -m twodisk_ros.figures --out docs/figures
+
+## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
+bench: venv
+	$(PY) benchmarks/run_all.py
+
+clean:
+	rm -rf $(VENV) out build install log .pytest_cache .hypothesis
