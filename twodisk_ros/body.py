@@ -1,0 +1,407 @@
+"""The two-disk body: its parameters and the closed forms of the paper, in the body frame.
+
+Body frame ``G e1 e2 e3`` (metres): G is the midpoint of the disk centres (the centre of
+mass of two equal laminae). Disk 1 lies in the plane x3 = 0 with centre ``-Δ e2``, disk 2 in
+the plane x1 = 0 with centre ``+Δ e2``; ``a`` is the semi-axis along the common axis e2,
+``b`` the other one. θ locates the contact point A on disk 1, ψ the contact point B on
+disk 2 (paper, section 2).
+
+Two ways to name a configuration are offered:
+
+* the paper's ``(theta, branch)``: ``branch = +1`` is the paper's half-cycle (B below the
+  plane of disk 1, sin ψ > 0), ``branch = -1`` its mirror image in that plane;
+* the regular cycle parameter ``u`` (``phase``, rad): the eccentric anomaly of A is
+  η = η_max sin u (tan θ = (b/a) tan η) and ``branch = sign(cos u)``. Every quantity below is a smooth, 2π-periodic function of u,
+  also through the turning points θ = ±θ_max where θ turns back (physics notes).
+
+Accuracy. The only near-singular quantity is ``σ√Q`` at the turning points, where Q → 0.
+It is computed from the exact factorisation Q = F1·F2 with F1 = (cos θ − cos θ_max)·L, so
+it keeps full relative precision as u → ±π/2 (no cancellation). All closed forms are
+analytic in u, so derivatives in u are taken by complex step (exact to rounding).
+Δ → 0 is singular (Q(0) = 4b²Δ(a + Δ) → 0): results stay finite for Δ/a ≥ 1e-6 but vary
+sharply near θ = 0 on a scale ~ 2(b/a)√(Δ/a) in θ.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+__all__ = ['TwoDiskBody', 'PhaseGeometry', 'complex_step']
+
+_COMPLEX_STEP = 1e-30
+
+
+def complex_step(function, u):
+    """Derivative of an analytic real function at real ``u`` by complex step (exact to rounding).
+
+    Parameters
+    ----------
+    function : callable
+        Accepts complex arrays and is analytic in its argument.
+    u : array_like
+        Points where the derivative is taken.
+    """
+    u = np.asarray(u, dtype=float)
+    return np.imag(function(u + 1j * _COMPLEX_STEP)) / _COMPLEX_STEP
+
+
+def _sinc(x):
+    """sin(x)/x, analytic (complex-step safe), exact at x = 0."""
+    x = np.asarray(x)
+    small = np.abs(x) < 1e-3
+    x_safe = np.where(small, 1.0, x)
+    x2 = x * x
+    series = 1.0 - x2 / 6.0 + x2 * x2 / 120.0 - x2 * x2 * x2 / 5040.0
+    return np.where(small, series, np.sin(x_safe) / x_safe)
+
+
+def _check_parameter(name, value, low, high, rule):
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a real number {rule}, got {value!r}') from None
+    if not (math.isfinite(value) and low < value < high):
+        raise ValueError(f'{name} must be finite and {rule}, got {value!r}')
+    return value
+
+
+@dataclass(frozen=True)
+class PhaseGeometry:
+    """Body-frame geometry at cycle phases ``u`` (arrays broadcast with ``u``).
+
+    Vectors have shape ``u.shape + (3,)`` and are in the body frame (metres or unit).
+    """
+
+    phase: np.ndarray           #: u (rad)
+    theta: np.ndarray           #: θ (rad), contact angle on disk 1
+    psi: np.ndarray             #: ψ (rad), contact angle on disk 2
+    branch: np.ndarray          #: +1 / −1 (sign of cos u; +1 at the turning points)
+    signed_sqrt_q: np.ndarray   #: σ√Q (m⁴)
+    contact_a: np.ndarray       #: r1 = GA (m)
+    contact_b: np.ndarray       #: r2 = GB (m)
+    ground_normal: np.ndarray   #: n, unit, the world's up direction seen in the body frame
+    tangent_a: np.ndarray       #: unit tangent of disk 1 at A (direction of increasing θ)
+    height: np.ndarray          #: z_G = −r1·n (m), the potential energy per unit M g
+    tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
+
+
+class TwoDiskBody:
+    """Two identical elliptic disks in perpendicular planes, joined along their axis ``a``.
+
+    Parameters
+    ----------
+    a : float
+        Semi-axis along the common axis e2 (m), finite and > 0.
+    b : float
+        The other semi-axis (m), finite and > 0 (b > a is allowed).
+    delta : float
+        Half the distance between the disk centres (m), 0 < delta < a.
+
+    Examples
+    --------
+    >>> oloid = TwoDiskBody(1.0, 1.0, 0.5)
+    >>> round(float(oloid.height(0.0)), 12)   # z_G at θ = 0 (m)
+    0.75
+    """
+
+    def __init__(self, a, b, delta):
+        a = _check_parameter('a', a, 0.0, math.inf, '> 0 (metres)')
+        b = _check_parameter('b', b, 0.0, math.inf, '> 0 (metres)')
+        delta = _check_parameter('delta', delta, 0.0, a, f'with 0 < delta < a = {a!r} (metres)')
+        self.a, self.b, self.delta = a, b, delta
+        # Paper, after eq. (2): the range of θ (and ψ).
+        self._cos_theta_max = -a * a / math.sqrt(a**4 + 4 * a * delta * b * b
+                                                  + 4 * delta * delta * b * b)
+        self.theta_max = math.acos(self._cos_theta_max)
+        self._sin_theta_max = math.sin(self.theta_max)
+        self._d_max = math.hypot(a * self._sin_theta_max, b * self._cos_theta_max)
+
+    def __repr__(self):
+        return f'TwoDiskBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
+
+    # -- named bodies ------------------------------------------------------------------------
+    @classmethod
+    def oloid(cls, radius=1.0):
+        """The Oloid: two circles of ``radius`` whose centres are one radius apart."""
+        return cls(radius, radius, radius / 2)
+
+    @classmethod
+    def two_circle_roller(cls, radius=1.0):
+        """The Two-Circle-Roller: centres √2 radius apart (centre of mass at constant height)."""
+        return cls(radius, radius, radius / math.sqrt(2))
+
+    # -- scalar properties -------------------------------------------------------------------
+    @property
+    def psi_max(self):
+        """Largest |ψ| (rad); equal to θ_max (paper, after eq. (2))."""
+        return self.theta_max
+
+    @property
+    def stability_margin(self):
+        """b² − 2a² + 2Δ² (m²): > 0 → θ = 0 family stable, < 0 → θ = ±π/2 stable, 0 neutral."""
+        return self.b**2 - 2 * self.a**2 + 2 * self.delta**2
+
+    @property
+    def size(self):
+        """A length scale of the body (m): the largest distance of a disk point from G."""
+        return self.a + self.delta if self.a >= self.b else math.hypot(self.b, self.delta)
+
+    # -- shared pieces of the closed forms ---------------------------------------------------
+    def _ellipse_terms(self, cos_t, sin_t):
+        a, b = self.a, self.b
+        d = np.sqrt(a * a * sin_t * sin_t + b * b * cos_t * cos_t)
+        return d
+
+    def _q_cofactor(self, cos_t, d):
+        """L·F2 where Q = (cos θ − cos θ_max)·L·F2 (exact factorisation, see module doc)."""
+        a, b, delta = self.a, self.b, self.delta
+        big_l = b * (2 * delta + a) - a * (a * a - b * b) * (self._cos_theta_max + cos_t) / (
+            d + self._d_max)
+        f2 = a * d + b * cos_t * (2 * delta - a)
+        return big_l * f2
+
+    def _geometry(self, theta, cos_t, sin_t, sq):
+        """Closed forms from θ and σ√Q (works for complex arguments)."""
+        a, b, delta = self.a, self.b, self.delta
+        d = self._ellipse_terms(cos_t, sin_t)
+        rho = a * b / d
+        zero = np.zeros_like(rho)
+        r1 = np.stack([rho * sin_t, -(delta + rho * cos_t), zero], axis=-1)
+        e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
+        r2 = np.stack([zero, delta - a * a * b * cos_t / e, -b * sq / e], axis=-1)
+        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        norm_n = np.sqrt(planar2 + sq * sq)
+        n = np.stack([-a * a * sin_t, b * b * cos_t, sq], axis=-1) / norm_n[..., None]
+        planar = np.sqrt(planar2)
+        t1 = np.stack([b * b * cos_t, a * a * sin_t, zero], axis=-1) / planar[..., None]
+        height = b * (a * d + delta * b * cos_t) / norm_n
+        return r1, r2, n, t1, height, planar, norm_n
+
+    # -- the paper's θ form ------------------------------------------------------------------
+    def _theta_array(self, theta):
+        theta = np.asarray(theta, dtype=float)
+        if np.any(~np.isfinite(theta)) or np.any(np.abs(theta) > self.theta_max * (1 + 1e-15)):
+            raise ValueError(f'theta must be finite with |theta| <= theta_max = '
+                             f'{self.theta_max!r} rad')
+        return np.clip(theta, -self.theta_max, self.theta_max)
+
+    @staticmethod
+    def _branch_array(branch):
+        branch = np.asarray(branch)
+        if not np.all((branch == 1) | (branch == -1)):
+            raise ValueError(f'branch must be +1 or -1, got {branch!r}')
+        return branch.astype(float)
+
+    def signed_sqrt_q(self, theta, branch=1):
+        """σ√Q(θ) (m⁴), Q = a⁴sin²θ + 4abΔ cosθ √(a²sin²θ + b²cos²θ) + 4b²Δ²cos²θ."""
+        theta = self._theta_array(theta)
+        branch = self._branch_array(branch)
+        abs_t = np.abs(theta)
+        # cos θ − cos θ_max without cancellation near the turning points
+        gap = 2 * np.sin((self.theta_max + abs_t) / 2) * np.sin((self.theta_max - abs_t) / 2)
+        cos_t = np.cos(theta)
+        d = self._ellipse_terms(cos_t, np.sin(theta))
+        return branch * np.sqrt(np.maximum(gap * self._q_cofactor(cos_t, d), 0.0))
+
+    def geometry(self, theta, branch=1):
+        """Body-frame geometry at contact angle θ on the given branch (paper, sections 2-4)."""
+        theta = self._theta_array(theta)
+        branch = np.broadcast_to(self._branch_array(branch), theta.shape)
+        sq = self.signed_sqrt_q(theta, branch)
+        u = self.phase_from_theta(theta, branch)
+        return self._phase_geometry_from(u, theta, np.cos(theta), np.sin(theta), sq, branch)
+
+    def contact_angle_psi(self, theta, branch=1):
+        """ψ(θ) (rad): cos ψ = −a² cos θ / √(Q + a⁴cos²θ), sign of sin ψ = branch."""
+        theta = self._theta_array(theta)
+        sq = self.signed_sqrt_q(theta, branch)
+        return np.arctan2(sq, -self.a**2 * np.cos(theta))
+
+    def contact_vector_a(self, theta):
+        """r1 = GA (m, body frame), paper section 2."""
+        return self.geometry(theta).contact_a
+
+    def contact_vector_b(self, theta, branch=1):
+        """r2 = GB (m, body frame), paper eq. (2)."""
+        return self.geometry(theta, branch).contact_b
+
+    def ground_normal(self, theta, branch=1):
+        """Unit normal n of the ground, pointing up, in the body frame (paper, section 3)."""
+        return self.geometry(theta, branch).ground_normal
+
+    def tilt(self, theta, branch=1):
+        """φ (rad): angle between the plane of disk 1 and the ground, cos φ = n·e3."""
+        return self.geometry(theta, branch).tilt
+
+    def disk_curvature(self, theta):
+        """k (1/m): curvature of the bounding ellipse of disk 1 at θ (paper, section 3)."""
+        theta = self._theta_array(theta)
+        a, b = self.a, self.b
+        s, c = np.sin(theta), np.cos(theta)
+        return a * b * (a * a * s * s + b * b * c * c) ** 1.5 / (
+            a**4 * s * s + b**4 * c * c) ** 1.5
+
+    def trace_curvature(self, theta, branch=1):
+        """K = k cos φ (1/m): signed curvature of the trace of A on the ground."""
+        return self.disk_curvature(theta) * np.cos(self.tilt(theta, branch))
+
+    def arc_length_rate(self, theta):
+        """ds/dθ (m/rad) along the boundary of disk 1, paper eq. (1)."""
+        theta = self._theta_array(theta)
+        a, b = self.a, self.b
+        s, c = np.sin(theta), np.cos(theta)
+        return a * b * np.sqrt(a**4 * s * s + b**4 * c * c) / (a * a * s * s + b * b * c * c) ** 1.5
+
+    def height(self, theta):
+        """z_G = V/(M g) (m), the same on both branches (paper, section 4)."""
+        theta = self._theta_array(theta)
+        return self._height_theta(theta)
+
+    def _height_theta(self, theta):
+        a, b, delta = self.a, self.b, self.delta
+        s, c = np.sin(theta), np.cos(theta)
+        d = np.sqrt(a * a * s * s + b * b * c * c)
+        norm2 = (2 * a**4 * s * s + b**4 * c * c + 4 * a * b * delta * c * d
+                 + 4 * b * b * delta * delta * c * c)
+        return b * (delta * b * c + a * d) / np.sqrt(norm2)
+
+    def height_derivative(self, theta):
+        """dz_G/dθ (m/rad), the paper's V′_θ / (M g)."""
+        theta = self._theta_array(theta)
+        a, b, delta = self.a, self.b, self.delta
+        s, c = np.sin(theta), np.cos(theta)
+        d = np.sqrt(a * a * s * s + b * b * c * c)
+        norm2 = (2 * a**4 * s * s + b**4 * c * c + 4 * a * b * delta * c * d
+                 + 4 * b * b * delta * delta * c * c)
+        return a**3 * b**3 * s * c * self.stability_margin / (d * norm2**1.5)
+
+    def height_second_derivative(self, theta):
+        """d²z_G/dθ² (m/rad²), by complex step of the paper's V′ (exact to rounding)."""
+        theta = self._theta_array(theta)
+        a, b, delta = self.a, self.b, self.delta
+
+        def first(t):
+            s, c = np.sin(t), np.cos(t)
+            d = np.sqrt(a * a * s * s + b * b * c * c)
+            norm2 = (2 * a**4 * s * s + b**4 * c * c + 4 * a * b * delta * c * d
+                     + 4 * b * b * delta * delta * c * c)
+            return a**3 * b**3 * s * c * self.stability_margin / (d * norm2**1.5)
+        return complex_step(first, theta)
+
+    # -- the regular cycle parameter u -------------------------------------------------------
+    # u sweeps the eccentric anomaly η of A on disk 1 sinusoidally: η = η_max sin u, with A at
+    # (b sin η, −a cos η) from the centre of disk 1, so tan θ = (b/a) tan η. Sharp features of
+    # thin ellipses (b/a → 0 or ∞) then have width ~min(a, b)/max(a, b) in u, not its square.
+    @property
+    def eta_max(self):
+        """η at the turning point θ = θ_max (rad)."""
+        return math.atan2(self.a * self._sin_theta_max, self.b * self._cos_theta_max)
+
+    def _phase_angles(self, u):
+        """(θ, cos θ, sin θ, cos θ − cos θ_max = cos²u · j, j) at phase u; analytic in u."""
+        a, b = self.a, self.b
+        eta_m, tm = self.eta_max, self.theta_max
+        w = np.sin(u)
+        sign_w = np.where(np.real(w) < 0, -1.0, 1.0)
+        abs_w = w * sign_w
+        abs_eta = eta_m * abs_w
+        e = np.sqrt(a * a * np.cos(abs_eta) ** 2 + b * b * np.sin(abs_eta) ** 2)
+        e_m = math.hypot(a * math.cos(eta_m), b * math.sin(eta_m))
+        cos_t = a * np.cos(abs_eta) / e
+        sin_abs = b * np.sin(abs_eta) / e
+        # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
+        v_over_c2 = eta_m / (1 + abs_w)
+        v = v_over_c2 * np.cos(u) ** 2
+        x = a * a * np.cos(abs_eta) * math.cos(eta_m) + b * b * np.sin(abs_eta) * math.sin(eta_m)
+        # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
+        denom = e * e_m + x
+        t = a * b * np.sin(v) / denom
+        abs_theta = tm - 2 * np.arctan(t)
+        j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
+             * a * b * v_over_c2 * _sinc(v) / denom)
+        return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
+
+    def phase_from_theta(self, theta, branch=1):
+        """The phase u ∈ [−π/2, 3π/2) of contact angle θ on a branch (inverse of θ(u))."""
+        theta = self._theta_array(theta)
+        branch = self._branch_array(branch)
+        eta = np.arctan2(self.a * np.sin(theta), self.b * np.cos(theta))
+        base = np.arcsin(np.clip(eta / self.eta_max, -1.0, 1.0))
+        return np.where(branch > 0, base, np.pi - base)
+
+    def phase_theta(self, u):
+        """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
+        return self._phase_angles(u)[0]
+
+    def phase_signed_sqrt_q(self, u):
+        """σ√Q as a smooth function of u: cos u · √(j L F2), with cos θ − cos θ_max = j cos²u.
+
+        Analytic in u (complex-step safe) and exact near the turning points u = ±π/2.
+        """
+        _, cos_t, sin_t, j = self._phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        return np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+
+    def _phase_vectors(self, u):
+        """(r1, r2, n, t1, height, planar, norm_n, theta, sq) at phase u (complex-safe)."""
+        theta, cos_t, sin_t, j = self._phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
+
+    def phase_geometry(self, u):
+        """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
+        u = np.asarray(u, dtype=float)
+        theta, cos_t, sin_t, j = self._phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        branch = np.where(np.cos(u) < 0, -1.0, 1.0)
+        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
+
+    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch):
+        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq)
+        psi = np.arctan2(sq, -self.a**2 * cos_t)
+        tilt = np.arctan2(planar, sq)
+        return PhaseGeometry(phase=u, theta=theta, psi=psi, branch=branch, signed_sqrt_q=sq,
+                             contact_a=r1, contact_b=r2, ground_normal=n, tangent_a=t1,
+                             height=height, tilt=tilt)
+
+    def phase_height(self, u):
+        """z_G(u) (m), analytic in u."""
+        return self._phase_vectors(u)[4]
+
+    def phase_rates(self, u):
+        """Rates per unit u̇ at phase u: returns (ds/du, dα/du) of the trace of A.
+
+        ds/du = (ds/dη)(dη/du) may be negative (A moves back along disk 1); dα/du = K ds/du
+        ≥ 0 (paper eqs. (3)-(6): K = k cos φ, by the chain rule dη/du = η_max cos u).
+        """
+        a, b = self.a, self.b
+        eta = self.eta_max * np.sin(u)
+        speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
+        ds_du = np.sqrt(speed2) * self.eta_max * np.cos(u)
+        k = a * b / speed2**1.5
+        _, cos_t, sin_t, j = self._phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        cos_phi = sq / np.sqrt(planar2 + sq * sq)
+        return ds_du, k * cos_phi * ds_du
+
+    def phase_angular_velocity(self, u):
+        """ω_u (rad per unit u, body frame, shape u.shape + (3,)): angular velocity per u̇.
+
+        With the contact frame (t1, n × t1, n) ↦ (c_α, c_α⊥, e_z) in the world,
+        ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
+        """
+        u = np.asarray(u, dtype=float)
+        uc = u + 1j * _COMPLEX_STEP
+        vec = self._phase_vectors(uc)
+        n, t1 = vec[2], vec[3]
+        m = np.cross(n, t1)
+        n_re, t1_re, m_re = n.real, t1.real, m.real
+        dn, dt1, dm = (x.imag / _COMPLEX_STEP for x in (n, t1, m))
+        frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
+        _, dalpha = self.phase_rates(u)
+        return dalpha[..., None] * n_re - frame_rate
