@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from importlib import metadata as _importlib_metadata
 from typing import Any, Mapping
 
+import yaml
 from mcap.exceptions import McapError
 from mcap.records import Channel, Header, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
@@ -115,11 +116,27 @@ def _reason(path, error, writing):
 # YAML as yaml-cpp's YAML::Dump emits it (block style, sequences indented under their key).
 
 _PLAIN = re.compile(r'[A-Za-z0-9_./][A-Za-z0-9_./ -]*')
-_RESERVED = {'true', 'false', 'yes', 'no', 'on', 'off', 'y', 'n', 'null', '~'}
+_ESCAPES = {'"': '\\"', '\\': '\\\\'}
+
+
+def _quoted(text):
+    """Return a double-quoted YAML scalar, escaping all but printable ASCII."""
+    out = []
+    for char in text:
+        code = ord(char)
+        if char in _ESCAPES:
+            out.append(_ESCAPES[char])
+        elif 0x20 <= code < 0x7f:
+            out.append(char)
+        elif code <= 0xffff:
+            out.append(f'\\u{code:04x}')
+        else:
+            out.append(f'\\U{code:08x}')
+    return '"' + ''.join(out) + '"'
 
 
 def _scalar(value):
-    """Format one YAML scalar."""
+    """Format one YAML scalar: plain where that reads back as the same string, else quoted."""
     if value is None:
         return '~'
     if isinstance(value, bool):
@@ -127,16 +144,9 @@ def _scalar(value):
     if isinstance(value, int):
         return str(value)
     text = str(value)
-    try:
-        float(text)
-        numeric = True
-    except ValueError:
-        numeric = False
-    if (_PLAIN.fullmatch(text) and not text.endswith(' ') and not numeric
-            and text.lower() not in _RESERVED):
+    if _PLAIN.fullmatch(text) and not text.endswith(' ') and yaml.safe_load(text) == text:
         return text
-    escaped = text.replace('\\', '\\\\').replace('"', '\\"').replace('\n', '\\n')
-    return '"' + escaped.replace('\t', '\\t').replace('\r', '\\r') + '"'
+    return _quoted(text)
 
 
 def _lines(value, indent):
