@@ -42,6 +42,8 @@ from twodisk_ros import _msgdefs  # noqa: E402
 from twodisk_ros import recording  # noqa: E402
 from twodisk_ros.recording import McapRecorder, RecordingError, read_recording  # noqa: E402
 
+pytestmark = pytest.mark.ros
+
 ROOT = Path(__file__).resolve().parents[1]
 T0 = 1_700_000_000 * 10**9
 
