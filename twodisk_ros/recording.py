@@ -675,7 +675,7 @@ def read_recording(path) -> Recording:
     Recording
         Messages decoded with ``mcap_ros2``, metadata records and channels.  A file without
         footer (writer killed) gives ``truncated=True`` and every message of its complete
-        chunks.
+        chunks.  The file is read into memory, which suits recordings of simulation runs.
 
     Raises
     ------
