@@ -1,0 +1,374 @@
+"""Rolling dynamics under gravity: one degree of freedom in the cycle phase u.
+
+With no slip at A and B the body turns about the line AB, so its motion is fixed by u(t)
+(physics notes). Kinetic and potential energy (SI units):
+
+    T = ½ m(u) u̇²,   m(u) = ω_uᵀ I_G ω_u + M |ω_u × r1|²,   V(u) = M g z_G(u),
+
+ω_u being the angular velocity per unit u̇ (body frame, rad) and I_G the inertia about G.
+Lagrange's equation: m ü + ½ m′ u̇² + V′ = 0; energy E = T + V is conserved.
+
+Two modes: ``dynamic`` (gravity only) and ``kinematic`` (constant angular speed |ω| = Ω, so
+u̇ = Ω / |ω_u(u)|). Two methods behind :func:`simulate`:
+
+``direct``
+    DOP853 (scipy ``solve_ivp``) with the geometry evaluated on the fly from the closed
+    forms; ``tolerance`` is its rtol (atol = tolerance × scale).
+``table``
+    Periodic tables of one cycle (m, V, |ω_u| with derivatives, spectral to rounding), then:
+    when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
+    t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
+    vectorised Newton (no time stepping, no drift); otherwise (oscillation about a stable
+    equilibrium) DOP853 on the tabulated right-hand side. ``tolerance`` is the ODE rtol.
+
+A body exactly at an equilibrium with u̇ = 0 stays there (the exact solution).
+"""
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .body import complex_step, TwoDiskBody
+from .cycle import RollingCycle, TWO_PI
+from .equilibria import equilibria, STABLE
+from .mass_models import MassProperties
+from .tables import HermiteTable, spectral_antiderivative
+
+__all__ = ['RollingDynamics', 'RollingMotion', 'simulate', 'METHODS', 'MODES']
+
+METHODS = ('direct', 'table')
+MODES = ('dynamic', 'kinematic')
+
+_FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u) in the direct method
+
+
+def _spectral_derivative(samples):
+    n = samples.shape[0]
+    k = np.fft.fftfreq(n, d=1.0 / n).reshape((n,) + (1,) * (samples.ndim - 1))
+    return np.real(np.fft.ifft(1j * k * np.fft.fft(samples, axis=0), axis=0))
+
+
+class RollingDynamics:
+    """The equation of motion of one body with one mass model.
+
+    Parameters
+    ----------
+    body : TwoDiskBody
+    mass_properties : MassProperties
+        Mass (kg) and inertia about G (kg m², body frame); the centre of mass must be G.
+    gravity : float
+        g (m/s²), finite and ≥ 0.
+    cycle : RollingCycle, optional
+        Reused if given (it holds the kinematic tables).
+    """
+
+    def __init__(self, body, mass_properties, gravity=9.81, cycle=None):
+        if not isinstance(body, TwoDiskBody):
+            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
+        if not isinstance(mass_properties, MassProperties):
+            raise TypeError('mass_properties must be a MassProperties')
+        gravity = float(gravity)
+        if not (math.isfinite(gravity) and gravity >= 0):
+            raise ValueError(f'gravity must be finite and >= 0 m/s^2, got {gravity!r}')
+        if np.max(np.abs(mass_properties.center_of_mass)) > 1e-9 * body.size:
+            raise ValueError('mass_properties.center_of_mass must be G (the origin)')
+        self.body = body
+        self.mass = mass_properties
+        self.gravity = gravity
+        self.cycle = cycle if cycle is not None else RollingCycle(body)
+        self._build_tables(4 * self.cycle.resolution)
+
+    # -- closed forms (the direct method) ---------------------------------------------------
+    def effective_mass(self, u):
+        """m(u) (kg m²/rad²): T = ½ m(u) u̇²."""
+        u = np.asarray(u, dtype=float)
+        omega = self.body.phase_angular_velocity(u)
+        r1 = self.body.phase_geometry(u).contact_a
+        v = np.cross(omega, r1)
+        inertia = self.mass.inertia
+        return (np.einsum('...i,ij,...j->...', omega, inertia, omega)
+                + self.mass.mass * np.sum(v * v, axis=-1))
+
+    def angular_speed_per_phase(self, u):
+        """|ω_u| (rad of body rotation per rad of u)."""
+        return np.linalg.norm(self.body.phase_angular_velocity(u), axis=-1)
+
+    def potential(self, u):
+        """V(u) = M g z_G(u) (J)."""
+        return self.mass.mass * self.gravity * self.body.phase_height(u)
+
+    def potential_slope(self, u):
+        """dV/du (J/rad), by complex step of the closed form."""
+        return self.mass.mass * self.gravity * complex_step(self.body.phase_height, u)
+
+    def effective_mass_slope(self, u):
+        """dm/du (kg m²/rad³): 5-point difference (step 1e-3 rad) of :meth:`effective_mass`."""
+        u = np.asarray(u, dtype=float)
+        h = _FD_STEP
+        m = [self.effective_mass(u + k * h) for k in (-2, -1, 1, 2)]
+        return (m[0] - 8 * m[1] + 8 * m[2] - m[3]) / (12 * h)
+
+    # -- tables (the table method) ----------------------------------------------------------
+    def _build_tables(self, n):
+        u = TWO_PI * np.arange(n) / n
+        m = self.effective_mass(u)
+        w = self.angular_speed_per_phase(u)
+        v = self.potential(u)
+        dv = self.potential_slope(u)
+        values = np.column_stack([m, v, w])
+        first = np.column_stack([_spectral_derivative(m), dv, _spectral_derivative(w)])
+        second = _spectral_derivative(first)
+        close = np.concatenate
+        self._table = HermiteTable(0.0, TWO_PI / n, close([values, values[:1]]),
+                                   close([first, first[:1]]), close([second, second[:1]]))
+        self._nodes = u
+        self.potential_range = (float(v.min()), float(v.max()))
+
+    def tabulated(self, u, derivative=0):
+        """(m, V, |ω_u|) at phase(s) u from the tables, shape u.shape + (3,)."""
+        u = np.asarray(u, dtype=float)
+        return self._table(np.mod(u, TWO_PI), derivative)
+
+    # -- derived quantities -----------------------------------------------------------------
+    def energy(self, u, u_dot):
+        """E = ½ m(u) u̇² + V(u) (J), from the tables."""
+        f = self.tabulated(u)
+        return 0.5 * f[..., 0] * np.asarray(u_dot) ** 2 + f[..., 1]
+
+    @property
+    def energy_scale(self):
+        """M g × body size (J), or M × size² (1/s)² when g = 0: the scale of relative drifts."""
+        g = self.gravity if self.gravity > 0 else 1.0
+        return self.mass.mass * g * self.body.size
+
+    def small_oscillation_periods(self):
+        """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
+        result = []
+        for eq in equilibria(self.body):
+            if eq.stability != STABLE or self.gravity == 0:
+                continue
+            stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+            m = float(self.effective_mass(eq.phase))
+            result.append((eq, TWO_PI * math.sqrt(m / stiffness)))
+        return result
+
+    def initial_phase_rate(self, u0, omega0):
+        """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0."""
+        return float(omega0) / float(self.angular_speed_per_phase(u0))
+
+
+@dataclass
+class RollingMotion:
+    """A simulated motion u(t), with dense output over ``[0, t_end]``.
+
+    Attributes
+    ----------
+    t : ndarray
+        Sample times (s).
+    phase, phase_rate : ndarray
+        u (rad) and u̇ (rad/s) at ``t``.
+    energy : ndarray
+        E (J) at ``t``, recomputed from (u, u̇) with the tables.
+    nfev : int
+        Right-hand-side evaluations (0 for the quadrature path).
+    """
+
+    dynamics: RollingDynamics
+    mode: str
+    method: str
+    t: np.ndarray
+    phase: np.ndarray
+    phase_rate: np.ndarray
+    energy: np.ndarray
+    nfev: int
+    solver: str
+    sol: object = field(repr=False)
+
+    @property
+    def energy_drift(self):
+        """max |E − E₀| over the samples, relative to :attr:`RollingDynamics.energy_scale`."""
+        return float(np.max(np.abs(self.energy - self.energy[0]))) / self.dynamics.energy_scale
+
+    def positions(self):
+        """World positions of G, A and B at the samples (m), each shape (len(t), 3)."""
+        return self.dynamics.cycle.positions(self.phase)
+
+    def states(self):
+        """Full :class:`RollingState` at the samples (pose, contacts, angles)."""
+        return self.dynamics.cycle.state(self.phase)
+
+
+class _Quadrature:
+    """u(t) for motion in one direction: t = s (G(u) − G(u₀)), G′ = 1/|u̇|, by Newton."""
+
+    def __init__(self, dynamics, u0, direction, inverse_speed, n):
+        u = TWO_PI * np.arange(n) / n
+        rate = inverse_speed(u)
+        mean, periodic = spectral_antiderivative(rate)
+        first = rate - mean
+        second = _spectral_derivative(rate)
+        self._mean = mean
+        self._table = HermiteTable(0.0, TWO_PI / n, np.append(periodic, 0.0),
+                                   np.append(first, first[0]), np.append(second, second[0]))
+        self._u0, self._s = float(u0), float(direction)
+        self._g0 = self._antiderivative(self._u0)
+        self.cycle_time = mean * TWO_PI
+
+    def _antiderivative(self, u):
+        cycles = np.floor(np.asarray(u) / TWO_PI)
+        rest = np.asarray(u) - TWO_PI * cycles
+        return self._mean * u + self._table(rest)
+
+    def _rate(self, u):
+        return self._table(np.mod(u, TWO_PI), derivative=1) + self._mean
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        s = self._s
+        u = self._u0 + s * t / self._mean
+        for _ in range(50):
+            residual = s * (self._antiderivative(u) - self._g0) - t
+            step = residual / self._rate(u)
+            u = u - s * step
+            if np.max(np.abs(step), initial=0.0) < 1e-15 * (1.0 + np.max(np.abs(u))):
+                break
+        return u, s / self._rate(u)
+
+
+def _check_choice(name, value, allowed):
+    if value not in allowed:
+        raise ValueError(f'{name} must be one of {", ".join(map(repr, allowed))}, got {value!r}')
+
+
+def simulate(dynamics, t_eval, *, mode='dynamic', theta0=0.0, branch=1, omega0=0.0,
+             method='table', tolerance=1e-10):
+    """Simulate the rolling body from an initial state and sample it at ``t_eval``.
+
+    Parameters
+    ----------
+    dynamics : RollingDynamics
+    t_eval : array_like
+        Sample times (s), increasing, starting at ≥ 0 (t = 0 is the initial state).
+    mode : {'dynamic', 'kinematic'}
+    theta0 : float
+        Initial θ (rad), |theta0| ≤ θ_max.
+    branch : {+1, -1}
+        +1: the paper's branch (B below the plane of disk 1), −1: its mirror.
+    omega0 : float
+        Signed angular speed of the body (rad/s); positive: θ increasing on branch +1.
+        In kinematic mode it is held constant.
+    method : {'direct', 'table'}
+    tolerance : float
+        Relative tolerance of the ODE solver (in (0, 1)).
+
+    Returns
+    -------
+    RollingMotion
+    """
+    _check_choice('mode', mode, MODES)
+    _check_choice('method', method, METHODS)
+    tolerance = float(tolerance)
+    if not (0 < tolerance < 1):
+        raise ValueError(f'tolerance must be in (0, 1), got {tolerance!r}')
+    t_eval = np.asarray(t_eval, dtype=float)
+    if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or np.any(np.diff(t_eval) < 0):
+        raise ValueError('t_eval must be a non-empty 1-d array of increasing times >= 0 s')
+    omega0 = float(omega0)
+    if not math.isfinite(omega0):
+        raise ValueError(f'omega0 must be finite (rad/s), got {omega0!r}')
+    body = dynamics.body
+    u0 = float(body.phase_from_theta(theta0, branch))
+    if mode == 'kinematic':
+        return _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance)
+    return _simulate_dynamic(dynamics, t_eval, u0, omega0, method, tolerance)
+
+
+def _motion(dynamics, mode, method, t, u, u_dot, nfev, solver, sol):
+    return RollingMotion(dynamics=dynamics, mode=mode, method=method, t=t, phase=u,
+                         phase_rate=u_dot, energy=dynamics.energy(u, u_dot), nfev=nfev,
+                         solver=solver, sol=sol)
+
+
+def _rest(dynamics, mode, method, t, u0):
+    u = np.full_like(t, u0)
+    zero = np.zeros_like(t)
+    return _motion(dynamics, mode, method, t, u, zero, 0, 'rest',
+                   lambda tt: (np.full_like(np.asarray(tt, float), u0), 0 * np.asarray(tt)))
+
+
+def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
+    if omega0 == 0:
+        return _rest(dynamics, 'kinematic', method, t_eval, u0)
+    speed = abs(omega0)
+    direction = math.copysign(1.0, omega0)
+    if method == 'table':
+        quad = _Quadrature(dynamics, u0, direction,
+                           lambda u: dynamics.tabulated(u)[..., 2] / speed,
+                           len(dynamics._nodes))
+        u, u_dot = quad(t_eval)
+        return _motion(dynamics, 'kinematic', method, t_eval, u, u_dot, 0, 'quadrature', quad)
+
+    def rhs(t, y):
+        return [direction * speed / float(dynamics.angular_speed_per_phase(y[0]))]
+    result = _solve(rhs, t_eval, [u0], tolerance, 1.0)
+    u = result.y[0]
+    u_dot = direction * speed / dynamics.angular_speed_per_phase(u)
+    return _motion(dynamics, 'kinematic', method, t_eval, u, u_dot, result.nfev, 'DOP853',
+                   result.sol)
+
+
+def _simulate_dynamic(dynamics, t_eval, u0, omega0, method, tolerance):
+    u_dot0 = dynamics.initial_phase_rate(u0, omega0)
+    slope = float(dynamics.potential_slope(u0))
+    if u_dot0 == 0 and abs(slope) <= 1e-14 * dynamics.energy_scale:
+        return _rest(dynamics, 'dynamic', method, t_eval, u0)
+    if method == 'table':
+        f0 = dynamics.tabulated(u0)
+        energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
+        v_max = dynamics.potential_range[1]
+        margin = energy - v_max
+        if u_dot0 != 0 and margin > 1e-6 * dynamics.energy_scale:
+            def inverse_speed(u):
+                f = dynamics.tabulated(u)
+                return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
+            quad = _Quadrature(dynamics, u0, math.copysign(1.0, u_dot0), inverse_speed,
+                               len(dynamics._nodes))
+            u, u_dot = quad(t_eval)
+            return _motion(dynamics, 'dynamic', method, t_eval, u, u_dot, 0, 'quadrature',
+                           quad)
+
+        def rhs(t, y):
+            f = dynamics.tabulated(y[0])
+            df = dynamics.tabulated(y[0], derivative=1)
+            return [y[1], -(df[1] + 0.5 * df[0] * y[1] ** 2) / f[0]]
+    else:
+        def rhs(t, y):
+            m = float(dynamics.effective_mass(y[0]))
+            dm = float(dynamics.effective_mass_slope(y[0]))
+            dv = float(dynamics.potential_slope(y[0]))
+            return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
+    rate_scale = max(abs(u_dot0), 1.0)
+    result = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
+    return _motion(dynamics, 'dynamic', method, t_eval, result.y[0], result.y[1], result.nfev,
+                   'DOP853', result.sol)
+
+
+def _solve(rhs, t_eval, y0, tolerance, scale):
+    span = (0.0, float(t_eval[-1]))
+    if span[1] == 0.0:
+        y = np.array(y0, dtype=float)[:, None] * np.ones((1, t_eval.size))
+        return _Trivial(y)
+    result = solve_ivp(rhs, span, y0, method='DOP853', t_eval=t_eval, rtol=tolerance,
+                       atol=tolerance * scale, dense_output=True)
+    if not result.success:
+        raise RuntimeError(f'integration failed: {result.message}')
+    return result
+
+
+@dataclass
+class _Trivial:
+    y: np.ndarray
+    nfev: int = 0
+    sol: object = None
