@@ -278,11 +278,76 @@ def simulate(dynamics, t_eval, *, mode='dynamic', theta0=0.0, branch=1, omega0=0
     omega0 = float(omega0)
     if not math.isfinite(omega0):
         raise ValueError(f'omega0 must be finite (rad/s), got {omega0!r}')
-    body = dynamics.body
-    u0 = float(body.phase_from_theta(theta0, branch))
+    u0 = float(dynamics.body.phase_from_theta(theta0, branch))
+    return simulate_phase(dynamics, t_eval, u0, dynamics.initial_phase_rate(u0, omega0),
+                          mode=mode, method=method, tolerance=tolerance)
+
+
+def simulate_phase(dynamics, t_eval, u0, u_dot0, *, mode='dynamic', method='table',
+                   tolerance=1e-10):
+    """As :func:`simulate`, from the phase u0 (rad) and phase rate u_dot0 (rad/s).
+
+    In kinematic mode the angular speed held is |u_dot0|·|ω_u(u0)|.
+    """
+    _check_choice('mode', mode, MODES)
+    _check_choice('method', method, METHODS)
+    t_eval = np.asarray(t_eval, dtype=float)
     if mode == 'kinematic':
-        return _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance)
-    return _simulate_dynamic(dynamics, t_eval, u0, omega0, method, tolerance)
+        omega = float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
+        return _simulate_kinematic(dynamics, t_eval, float(u0), omega, method, tolerance)
+    return _simulate_dynamic(dynamics, t_eval, float(u0), float(u_dot0), method, tolerance)
+
+
+class MotionStream:
+    """Samples of one motion at increasing times, for as long as asked (the node's source).
+
+    The quadrature path is evaluated in closed form at any time; the ODE paths are
+    integrated in chunks of ``chunk`` seconds, each continuing from the end of the last.
+    """
+
+    def __init__(self, dynamics, u0, u_dot0, *, mode='dynamic', method='table',
+                 tolerance=1e-10, chunk=10.0):
+        self.dynamics, self.mode, self.method, self.tolerance = dynamics, mode, method, tolerance
+        self._chunk = float(chunk)
+        self._start = 0.0
+        self._motion = simulate_phase(dynamics, [0.0, self._chunk], u0, u_dot0, mode=mode,
+                                      method=method, tolerance=tolerance)
+        self.initial_energy = float(self._motion.energy[0])
+        self._omega = abs(float(u_dot0) * float(dynamics.angular_speed_per_phase(u0)))
+
+    def _eval(self, t):
+        motion, tau = self._motion, np.asarray(t, dtype=float) - self._start
+        if motion.solver in ('quadrature', 'rest'):
+            return motion.sol(tau)
+        y = motion.sol(tau)
+        if self.mode == 'kinematic':
+            speed = self.dynamics.tabulated(y[0])[..., 2]
+            return y[0], np.sign(motion.phase_rate[0]) * self._omega / speed
+        return y[0], y[1]
+
+    def sample(self, t):
+        """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
+        t = np.asarray(t, dtype=float)
+        if self._motion.solver in ('quadrature', 'rest'):
+            return self._eval(t)
+        pieces = []
+        while True:
+            end = self._start + self._chunk
+            inside = t <= end
+            pieces.append(self._eval(t[inside]))
+            t = t[~inside]
+            if not t.size:
+                break
+            u_end, u_dot_end = self._eval_scalar(end)
+            self._start = end
+            self._motion = simulate_phase(self.dynamics, [0.0, self._chunk], u_end, u_dot_end,
+                                          mode=self.mode, method=self.method,
+                                          tolerance=self.tolerance)
+        return tuple(np.concatenate([p[i] for p in pieces]) for i in range(2))
+
+    def _eval_scalar(self, t):
+        u, u_dot = self._eval(np.array([t]))
+        return u[0], u_dot[0]
 
 
 def _motion(dynamics, mode, method, t, u, u_dot, nfev, solver, sol):
@@ -319,8 +384,7 @@ def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
                    result.sol)
 
 
-def _simulate_dynamic(dynamics, t_eval, u0, omega0, method, tolerance):
-    u_dot0 = dynamics.initial_phase_rate(u0, omega0)
+def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
     slope = float(dynamics.potential_slope(u0))
     if u_dot0 == 0 and abs(slope) <= 1e-14 * dynamics.energy_scale:
         return _rest(dynamics, 'dynamic', method, t_eval, u0)
