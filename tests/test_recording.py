@@ -188,6 +188,22 @@ def test_read_recording_gives_the_same_messages(tmp_path):
     assert rec.profile == 'ros2' and 'twodisk_ros' in rec.library
 
 
+def test_read_recording_decodes_only_the_selected_topics(tmp_path):
+    path = tmp_path / 'run.mcap'
+    written = write_samples(path, count=2)
+    rec = read_recording(path, decode=lambda topic: topic == '/pose')
+    assert [(m.topic, m.log_time_ns) for m in rec.messages] == [(t, s) for t, s, _ in written]
+    with open(path, 'rb') as stream:
+        raw = [message.data for _, _, message in make_reader(stream).iter_messages(
+            log_time_order=False)]
+    for (topic, _, msg), got, data in zip(written, rec.messages, raw):
+        if topic == '/pose':
+            assert_same(msg, got.msg, topic)
+        else:
+            assert got.msg == data
+    assert rec.topics['/trace'].message_count == 2
+
+
 @pytest.mark.parametrize('compression', ['zstd', 'lz4', 'none'])
 def test_compressions_round_trip(tmp_path, compression):
     path = tmp_path / f'{compression}.mcap'

@@ -586,7 +586,8 @@ class RecordedMessage:
         Publish time.
     msg : object
         The message decoded by ``mcap_ros2`` (attribute access like the ROS class), or the raw
-        bytes if the channel is not CDR with a ``ros2msg`` schema.
+        bytes if the channel is not CDR with a ``ros2msg`` schema or its topic was not selected
+        for decoding (``read_recording(..., decode=...)``).
     """
 
     topic: str
@@ -662,13 +663,17 @@ def _complete_prefix(stream, size):
     return position, False
 
 
-def read_recording(path) -> Recording:
+def read_recording(path, *, decode=None) -> Recording:
     """Read a recording written by :class:`McapRecorder` (or rosbag2), tolerating a cut file.
 
     Parameters
     ----------
     path : str or os.PathLike
         The ``.mcap`` file.
+    decode : callable, optional
+        ``decode(topic) -> bool``: which topics' messages to decode; the others keep their
+        raw CDR bytes as ``msg`` (decoding is the slow part of reading, e.g. long paths).
+        All topics are decoded if omitted.
 
     Returns
     -------
@@ -702,7 +707,7 @@ def read_recording(path) -> Recording:
         reader = StreamReader(io.BytesIO(data[len(_MAGIC):]), skip_magic=True,
                               validate_crcs=True)
     try:
-        _collect(_records(reader, complete), recording)
+        _collect(_records(reader, complete), recording, decode)
     except (McapError, ValueError, KeyError, IndexError, struct.error) as error:
         raise RecordingError(f'cannot read recording {path}: {_one_line(error)}') from None
     return recording
@@ -723,8 +728,8 @@ def _records(reader, complete):
         yield record
 
 
-def _collect(records, recording):
-    """Fill ``recording`` from a stream of MCAP records."""
+def _collect(records, recording, decode=None):
+    """Fill ``recording`` from a stream of MCAP records; ``decode(topic)`` selects topics."""
     schemas: dict[int, Schema] = {}
     channels: dict[int, Channel] = {}
     decoders = DecoderFactory()
@@ -733,8 +738,10 @@ def _collect(records, recording):
         if isinstance(record, Message):
             channel = channels[record.channel_id]
             schema = schemas.get(channel.schema_id)
-            decode = decoders.decoder_for(channel.message_encoding, schema)
-            msg = decode(record.data) if decode is not None else bytes(record.data)
+            decoder = None
+            if decode is None or decode(channel.topic):
+                decoder = decoders.decoder_for(channel.message_encoding, schema)
+            msg = decoder(record.data) if decoder is not None else bytes(record.data)
             recording.messages.append(RecordedMessage(
                 channel.topic, schema.name if schema else '', record.log_time,
                 record.publish_time, msg))
