@@ -371,6 +371,17 @@ class TwoDiskBody:
         """z_G(u) (m), analytic in u."""
         return self._phase_vectors(u)[4]
 
+    def phase_angle_rates(self, u):
+        """(dθ/du, dψ/du) at phase u, by complex step (ψ = 2 arctan(sin ψ / (1 + cos ψ)))."""
+        a = self.a
+
+        def psi(x):
+            _, cos_t, _, _ = self._phase_angles(x)
+            sq = self.phase_signed_sqrt_q(x)
+            norm = np.sqrt(sq * sq + a**4 * cos_t * cos_t)
+            return 2 * np.arctan(sq / (norm - a * a * cos_t))
+        return complex_step(self.phase_theta, u), complex_step(psi, u)
+
     def phase_rates(self, u):
         """Rates per unit u̇ at phase u: returns (ds/du, dα/du) of the trace of A.
 

@@ -143,16 +143,24 @@ class RollingDynamics:
         g = self.gravity if self.gravity > 0 else 1.0
         return self.mass.mass * g * self.body.size
 
-    def small_oscillation_periods(self):
-        """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
+    def equilibria_with_periods(self):
+        """[(Equilibrium, small-oscillation period in s or None)] for all eight equilibria.
+
+        T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u).
+        """
         result = []
         for eq in equilibria(self.body):
-            if eq.stability != STABLE or self.gravity == 0:
-                continue
-            stiffness = self.mass.mass * self.gravity * eq.phase_curvature
-            m = float(self.effective_mass(eq.phase))
-            result.append((eq, TWO_PI * math.sqrt(m / stiffness)))
+            period = None
+            if eq.stability == STABLE and self.gravity > 0:
+                stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
+            result.append((eq, period))
         return result
+
+    def small_oscillation_periods(self):
+        """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
+        return [(eq, period) for eq, period in self.equilibria_with_periods()
+                if period is not None]
 
     def initial_phase_rate(self, u0, omega0):
         """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0."""
