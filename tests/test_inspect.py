@@ -179,7 +179,7 @@ def test_clean_recording_passes_every_check(capsys, clean_file):
         assert f'PASS  {name} ' in out
     assert 'FAIL' not in out
     assert '/roller/pose' in out and 'geometry_msgs/msg/PoseStamped' in out
-    assert 'result: PASS' in out and 'duration: 3 s' in out
+    assert 'result: PASS' in out and 'duration: 3.000 s' in out
 
 
 def test_tolerances_are_tight_but_met(clean_file):

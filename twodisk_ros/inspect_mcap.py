@@ -120,6 +120,21 @@ FD_MARGIN = 2.0               # tolerance of an FD-limited check / FD error of a
 ROUNDOFF = 100 * np.finfo(float).eps
 SOLVER_FLOOR = 1e-9           # relative energy or speed drift always allowed to the solver
 
+#: What each check verifies, in words.
+TITLES = {
+    'inputs': 'topics and parameters present and valid',
+    'ground': 'contact points A and B on the ground (max |z|)',
+    'contact_points': 'A and B where the body puts them: G + R r1(u), G + R r2(u)',
+    'tangent_plane': 'the ground is the tangent plane: R n(u) is vertical',
+    'theta': 'recorded θ equals θ(u) of the recorded phase u',
+    'psi': 'recorded ψ equals ψ(θ, branch), branch = sign(cos u)',
+    'no_slip': 'no slip at A and B (velocities by central differences of poses)',
+    'energy': 'energy conserved (from the recorded poses alone)',
+    'angular_speed': 'kinematic mode: angular speed |ω| constant = |omega0|',
+    'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
+    'stamps': 'consistent stamps across messages and topics',
+}
+
 
 # --------------------------------------------------------------------------------------------
 # Results.
@@ -548,59 +563,67 @@ def _fmt(value):
     return 'n/a' if value is None or not math.isfinite(value) else f'{value:.3g}'
 
 
+def _check(name, value, tolerance, unit='', detail=()):
+    """A :class:`Check` titled from :data:`TITLES`; it passes if ``value <= tolerance``."""
+    passed = value is not None and tolerance is not None and bool(value <= tolerance)
+    return Check(name, TITLES[name], passed, _plain(value), _plain(tolerance), unit,
+                 list(detail))
+
+
+def _not_evaluated(name, reason, unit=''):
+    """A failed check that could not be evaluated."""
+    return _check(name, None, None, unit, [reason])
+
+
 def _check_inputs(problems, chosen, model):
     missing = [role for role in TOPIC_TYPES if role not in chosen]
     detail = [f'no {role} topic of type {TOPIC_TYPES[role]}' for role in missing]
     detail += problems
-    passed = not detail and model is not None
+    if model is None and not detail:
+        detail.append('no model')
     if not detail:
         body = model.body
-        detail = [f'body a = {body.a:g} m, b = {body.b:g} m, delta = {body.delta:g} m, '
-                  f'mass model {model.dynamics.mass.model}, mode {model.mode}; topics '
-                  + ', '.join(chosen[role] for role in TOPIC_TYPES)]
-    return Check('inputs', 'topics and parameters present and valid', passed,
-                 float(len(detail) if not passed else 0), 0.0, 'problems', detail)
+        return _check('inputs', 0, 0, 'problems', [
+            f'body a = {body.a:g} m, b = {body.b:g} m, delta = {body.delta:g} m, mass model '
+            f'{model.dynamics.mass.model}, mode {model.mode}; topics '
+            + ', '.join(chosen[role] for role in TOPIC_TYPES)])
+    return _check('inputs', len(detail), 0, 'problems', detail)
 
 
 def _check_ground(series, scale):
     points = [series[role].values['point'] for role in ('contact_a', 'contact_b')
               if role in series and len(series[role])]
     if not points:
-        return Check('ground', 'contact points on the ground', False, None, None, 'm',
-                     ['no contact points recorded'])
+        return _not_evaluated('ground', 'no contact points recorded', 'm')
     heights = np.abs(np.concatenate(points)[:, 2])
     tolerance = GROUND_TOLERANCE * scale
-    worst = float(np.max(heights))
-    return Check('ground', 'contact points A and B on the ground (max |z|)',
-                 worst <= tolerance, worst, tolerance, 'm',
-                 [f'{heights.size} points; {int(np.sum(heights > tolerance))} above the '
-                  f'tolerance (1e-9 × coordinate scale {scale:.3g} m)'])
+    return _check('ground', float(np.max(heights)), tolerance, 'm', [
+        f'{heights.size} points, {int(np.sum(heights > tolerance))} above the tolerance '
+        f'(1e-9 × coordinate scale {scale:.3g} m)'])
 
 
 def _check_contact_points(samples, geometry, scale):
     rotation = samples.rotation
-    predicted_a = samples.position_g + rotation.apply(geometry.contact_a)
-    predicted_b = samples.position_g + rotation.apply(geometry.contact_b)
-    error_a = np.linalg.norm(samples.contact_a - predicted_a, axis=1)
-    error_b = np.linalg.norm(samples.contact_b - predicted_b, axis=1)
+    error_a = np.linalg.norm(
+        samples.contact_a - samples.position_g - rotation.apply(geometry.contact_a), axis=1)
+    error_b = np.linalg.norm(
+        samples.contact_b - samples.position_g - rotation.apply(geometry.contact_b), axis=1)
     worst = np.maximum(error_a, error_b)
     k = int(np.argmax(worst))
     tolerance = CONTACT_TOLERANCE * scale
-    return Check('contact_points', 'A and B where the body puts them: G + R r1(u), G + R r2(u)',
-                 bool(worst[k] <= tolerance), float(worst[k]), tolerance, 'm',
-                 [f'max |A − (G + R r1)| = {_fmt(np.max(error_a))} m, '
-                  f'max |B − (G + R r2)| = {_fmt(np.max(error_b))} m (worst '
-                  f'{_where(samples, k)}); {int(np.sum(worst > tolerance))} of {worst.size} '
-                  f'samples off; tolerance 1e-8 × coordinate scale {scale:.3g} m'])
+    return _check('contact_points', float(worst[k]), tolerance, 'm', [
+        f'max |A − (G + R r1)| = {_fmt(np.max(error_a))} m, max |B − (G + R r2)| = '
+        f'{_fmt(np.max(error_b))} m, worst {_where(samples, k)}; '
+        f'{int(np.sum(worst > tolerance))} of {worst.size} samples off; '
+        f'tolerance 1e-8 × coordinate scale {scale:.3g} m'])
 
 
 def _check_tangent_plane(samples, geometry):
     up = samples.rotation.apply(geometry.ground_normal)
     angle = np.arctan2(np.hypot(up[:, 0], up[:, 1]), up[:, 2])
     k = int(np.argmax(angle))
-    return Check('tangent_plane', 'the ground is the tangent plane: R n(u) is vertical',
-                 bool(angle[k] <= ANGLE_TOLERANCE), float(angle[k]), ANGLE_TOLERANCE, 'rad',
-                 [f'largest angle between R n(u) and the up direction {_where(samples, k)}'])
+    return _check('tangent_plane', float(angle[k]), ANGLE_TOLERANCE, 'rad', [
+        f'largest angle between R n(u) and the up direction, {_where(samples, k)}'])
 
 
 def _wrap(angle):
@@ -610,9 +633,8 @@ def _wrap(angle):
 def _check_theta(samples, geometry):
     error = np.abs(_wrap(samples.angles[:, 0] - geometry.theta))
     k = int(np.argmax(error))
-    return Check('theta', 'recorded θ equals θ(u) of the recorded phase u',
-                 bool(error[k] <= ANGLE_TOLERANCE), float(error[k]), ANGLE_TOLERANCE, 'rad',
-                 [f'worst {_where(samples, k)}'])
+    return _check('theta', float(error[k]), ANGLE_TOLERANCE, 'rad',
+                  [f'worst {_where(samples, k)}'])
 
 
 def _check_psi(samples, body):
@@ -626,11 +648,13 @@ def _check_psi(samples, body):
         spread = np.maximum(spread, np.abs(_wrap(body.contact_angle_psi(moved, branch) - psi)))
     error = np.maximum(np.abs(_wrap(samples.angles[:, 1] - psi)) - spread, 0.0)
     k = int(np.argmax(error))
-    return Check('psi', 'recorded ψ equals ψ(θ, branch), branch = sign(cos u)',
-                 bool(error[k] <= PSI_TOLERANCE), float(error[k]), PSI_TOLERANCE, 'rad',
-                 [f'worst {_where(samples, k)} (branch {int(branch[k]):+d}); ψ compared with '
-                  f'ψ(θ ± {THETA_UNCERTAINTY:g} rad), up to {_fmt(np.max(spread))} rad apart '
-                  'near the turning points'])
+    return _check('psi', float(error[k]), PSI_TOLERANCE, 'rad', [
+        f'worst {_where(samples, k)} (branch {int(branch[k]):+d}); ψ compared with '
+        f'ψ(θ ± {THETA_UNCERTAINTY:g} rad, branch), up to {_fmt(np.max(spread))} rad apart '
+        'near the turning points'])
+
+
+_NO_DIFFERENCES = 'no sample with four regular intervals around it for central differences'
 
 
 def _slip(position_g, contact_a, contact_b, velocity, omega):
@@ -642,8 +666,7 @@ def _slip(position_g, contact_a, contact_b, velocity, omega):
 def _check_no_slip(samples, motion, scale):
     k = motion.index
     if k.size == 0:
-        return Check('no_slip', 'no slip at A and B', False, None, None, '',
-                     ['no sample with regular neighbours for central differences'])
+        return _not_evaluated('no_slip', _NO_DIFFERENCES)
     state = motion.model_state
     recorded = _slip(samples.position_g[k], samples.contact_a[k], samples.contact_b[k],
                      motion.velocity, motion.angular_velocity)
@@ -654,21 +677,19 @@ def _check_no_slip(samples, motion, scale):
     worst = int(np.argmax(recorded))
     omega_h = float(np.max(np.linalg.norm(motion.angular_velocity, axis=1))) * motion.step
     if speed > roundoff:
-        value, unit = float(recorded[worst]) / speed, ''
-        fd_error = float(np.max(expected)) / speed
-        tolerance = FD_MARGIN * fd_error + roundoff / speed
+        unit, norm = '', speed
         what = f'max |v_A|, |v_B| / max |v_G| (max |v_G| = {speed:.4g} m/s)'
     else:
-        value, unit = float(recorded[worst]), 'm/s'
-        fd_error = float(np.max(expected))
-        tolerance = FD_MARGIN * fd_error + roundoff
+        unit, norm = 'm/s', 1.0
         what = 'max |v_A|, |v_B| (the body is at rest)'
-    return Check('no_slip', 'no slip at A and B (velocities by central differences of poses)',
-                 value <= tolerance, value, tolerance, unit,
-                 [f'{what}, worst {_where(samples, k[worst])}, {k.size} samples',
-                  f'FD-limited: the model poses at the recorded phases (rolling without slip) '
-                  f'show {fd_error:.3g} at h = {motion.step:.4g} s ((ω h)⁴ = {omega_h**4:.3g}); '
-                  f'tolerance {FD_MARGIN:g} × that + round-off'])
+    fd_error = float(np.max(expected)) / norm
+    return _check('no_slip', float(recorded[worst]) / norm,
+                  FD_MARGIN * fd_error + roundoff / norm, unit, [
+                      f'{what}, worst {_where(samples, k[worst])}, {k.size} samples',
+                      f'FD-limited: the model poses at the recorded phases (rolling without '
+                      f'slip) show {fd_error:.3g} at h = {motion.step:.4g} s '
+                      f'((ω h)⁴ = {omega_h**4:.3g}); tolerance {FD_MARGIN:g} × that + '
+                      'round-off'])
 
 
 def _solver_allowance(model):
@@ -679,14 +700,12 @@ def _energies(samples, motion, model):
     """Energy from the recorded poses, from the model's poses and exact, at motion.index."""
     k = motion.index
     mass, gravity = model.dynamics.mass, model.dynamics.gravity
-    recorded_rotation = samples.rotation[k]
     recorded = (_kinetic_energy(mass, motion.velocity, motion.angular_velocity,
-                                recorded_rotation)
+                                samples.rotation[k])
                 + mass.mass * gravity * samples.position_g[k, 2])
     state = motion.model_state
-    model_rotation = Rotation.from_matrix(state.rotation[k])
     model_fd = (_kinetic_energy(mass, motion.model_velocity, motion.model_angular_velocity,
-                                model_rotation)
+                                Rotation.from_matrix(state.rotation[k]))
                 + mass.mass * gravity * state.position_g[k, 2])
     phase = np.unwrap(samples.angles[:, 2])[k]
     exact = model.dynamics.energy(phase, samples.rates[k, 2])
@@ -696,33 +715,29 @@ def _energies(samples, motion, model):
 def _check_energy(samples, motion, model):
     k = motion.index
     if k.size == 0:
-        return Check('energy', 'energy conserved', False, None, None, '',
-                     ['no sample with regular neighbours for central differences'])
+        return _not_evaluated('energy', _NO_DIFFERENCES)
     if not np.all(np.isfinite(samples.rates[k, 2])):
-        return Check('energy', 'energy conserved', False, None, None, '',
-                     ['rolling_state carries no phase rate: the FD error cannot be estimated'])
+        return _not_evaluated('energy', 'rolling_state carries no phase rate: the FD error '
+                                        'cannot be estimated')
     scale = model.dynamics.energy_scale
     recorded, model_fd, exact = _energies(samples, motion, model)
     drift = np.abs(recorded - recorded[0]) / scale
     worst = int(np.argmax(drift))
     fd_error = float(np.max(np.abs(model_fd - exact))) / scale
-    tolerance = 2 * FD_MARGIN * fd_error + _solver_allowance(model)
+    solver = _solver_allowance(model)
     model_drift = float(np.max(np.abs(exact - exact[0]))) / scale
-    return Check('energy', 'energy conserved (from the recorded poses alone)',
-                 bool(drift[worst] <= tolerance), float(drift[worst]), tolerance, '',
-                 [f'max |E − E0| / (M g L) with E0 = {recorded[0]:.8g} J, M g L = {scale:.4g} J;'
-                  f' worst {_where(samples, k[worst])}, {k.size} samples',
-                  f'FD-limited: largest FD error of E of the model poses at the recorded phases '
-                  f'{fd_error:.3g}; tolerance 2 × {FD_MARGIN:g} × that + '
-                  f'{_solver_allowance(model):.3g} (solver)',
-                  f'exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}'])
+    return _check('energy', float(drift[worst]), 2 * FD_MARGIN * fd_error + solver, '', [
+        f'max |E − E0| / (M g L), E0 = {recorded[0]:.8g} J, M g L = {scale:.4g} J; worst '
+        f'{_where(samples, k[worst])}, {k.size} samples',
+        f'FD-limited: the model poses at the recorded phases give E within {fd_error:.3g} of '
+        f'the exact E(u, u̇); tolerance 2 × {FD_MARGIN:g} × that + {solver:.3g} (solver)',
+        f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}'])
 
 
 def _check_angular_speed(samples, motion, model):
     k = motion.index
     if k.size == 0:
-        return Check('angular_speed', 'angular speed constant', False, None, None, '',
-                     ['no sample with regular neighbours for central differences'])
+        return _not_evaluated('angular_speed', _NO_DIFFERENCES)
     target = abs(model.omega0)
     speed = np.linalg.norm(motion.angular_velocity, axis=1)
     model_speed = np.linalg.norm(motion.model_angular_velocity, axis=1)
@@ -737,30 +752,28 @@ def _check_angular_speed(samples, motion, model):
         tolerance = FD_MARGIN * fd_error + ROUNDOFF / motion.step
         unit, what = 'rad/s', 'max |ω| (omega0 = 0)'
     worst = int(np.argmax(error))
-    return Check('angular_speed', 'kinematic mode: angular speed |ω| constant = |omega0|',
-                 bool(error[worst] <= tolerance), float(error[worst]), tolerance, unit,
-                 [f'{what}; worst {_where(samples, k[worst])}, {k.size} samples',
-                  f'FD-limited: the model poses at the recorded phases show {fd_error:.3g}; '
-                  f'tolerance {FD_MARGIN:g} × that + solver allowance'])
+    return _check('angular_speed', float(error[worst]), tolerance, unit, [
+        f'{what}; worst {_where(samples, k[worst])}, {k.size} samples',
+        f'FD-limited: the model poses at the recorded phases show {fd_error:.3g}; '
+        f'tolerance {FD_MARGIN:g} × that + solver allowance'])
 
 
 def _nominal_step_ns(series, model):
     """1/rate in ns from the recorded rate, else the median stamp interval; and its source."""
     if model is not None and model.rate:
         return 1e9 / model.rate, f'1/rate, rate = {model.rate:g} Hz'
-    intervals = np.concatenate([np.diff(series[role].stamp_ns) for role in SAMPLED
-                                if role in series and len(series[role]) > 1] or [[]])
-    if intervals.size == 0:
+    intervals = [np.diff(series[role].stamp_ns) for role in SAMPLED
+                 if role in series and len(series[role]) > 1]
+    if not intervals:
         return None, 'no intervals'
-    return float(np.median(intervals)), 'median interval (no valid rate parameter)'
+    return float(np.median(np.concatenate(intervals))), 'median interval (no valid rate)'
 
 
 def _check_timestamps(series, step_ns, source):
-    detail, worst = [], 0.0
     roles = [role for role in SAMPLED if role in series]
     if step_ns is None or not roles:
-        return Check('timestamps', 'stamps increasing, no gaps', False, None, STAMP_TOLERANCE,
-                     '', ['too few messages'])
+        return _check('timestamps', None, STAMP_TOLERANCE, '', ['too few messages'])
+    detail, worst = [], 0.0
     for role in roles:
         stamps = series[role].stamp_ns
         if stamps.size < 2:
@@ -774,15 +787,14 @@ def _check_timestamps(series, step_ns, source):
         line = f'{series[role].topic}: {stamps.size} stamps'
         if bad.size:
             first = int(bad[0])
-            line += (f', {bad.size} bad intervals, first {intervals[first] * 1e-9:.6g} s '
+            line += (f', {bad.size} bad intervals, the first {intervals[first] * 1e-9:.6g} s '
                      f'after t = {stamps[first] * 1e-9:.6g} s')
             if np.any(intervals <= 0):
                 line += f', {int(np.sum(intervals <= 0))} not increasing'
         detail.append(line)
     detail.append(f'nominal interval {step_ns * 1e-9:.6g} s ({source}); '
                   f'tolerance {STAMP_TOLERANCE:.0%} of it')
-    return Check('timestamps', 'stamps increasing with no gaps (pose, contacts, rolling_state)',
-                 worst <= STAMP_TOLERANCE, worst, STAMP_TOLERANCE, '', detail)
+    return _check('timestamps', worst, STAMP_TOLERANCE, '', detail)
 
 
 def _check_stamps(series, truncated):
@@ -797,10 +809,9 @@ def _check_stamps(series, truncated):
         mismatches += count
     if roles:
         sets = {role: np.unique(series[role].stamp_ns) for role in roles}
-        cut = min(stamps[-1] for stamps in sets.values()) if truncated else None
         union = np.unique(np.concatenate(list(sets.values())))
-        if cut is not None:
-            union = union[union <= cut]
+        if truncated:
+            union = union[union <= min(stamps[-1] for stamps in sets.values())]
         for role, stamps in sets.items():
             lacking = union.size - np.intersect1d(union, stamps).size
             if lacking:
@@ -808,20 +819,18 @@ def _check_stamps(series, truncated):
             mismatches += lacking
     if not detail:
         detail.append('pose, contacts and rolling_state share their stamps; header stamp = '
-                      'log time = publish time' + (' (tail cut by truncation ignored)'
-                                                   if truncated else ''))
-    return Check('stamps', 'consistent stamps across messages and topics', mismatches == 0,
-                 float(mismatches), 0.0, 'mismatches', detail)
+                      'log time = publish time'
+                      + (' (the tail cut by the truncation ignored)' if truncated else ''))
+    return _check('stamps', mismatches, 0, 'mismatches', detail)
 
 
-def _run(checks, name, title, function, *args):
+def _run(checks, name, function, *args):
     """Append ``function(*args)``; an error while evaluating it is a failed check."""
     try:
         checks.append(function(*args))
     except Exception as error:  # noqa: BLE001 - reported as a failed check, not a traceback
-        checks.append(Check(name, title, False, None, None, '',
-                            [f'cannot be evaluated: {type(error).__name__}: '
-                             f'{" ".join(str(error).split())}']))
+        checks.append(_not_evaluated(name, f'cannot be evaluated: {type(error).__name__}: '
+                                           f'{" ".join(str(error).split())}'))
 
 
 # --------------------------------------------------------------------------------------------
@@ -906,59 +915,57 @@ def inspect_recording(path):
     except ValueError as error:  # e.g. a zero quaternion
         problems.append(f'cannot use the poses: {" ".join(str(error).split())}')
     checks = []
-    _run(checks, 'inputs', 'topics and parameters', _check_inputs, problems, chosen, model)
-    _run(checks, 'ground', 'contact points on the ground', _check_ground, series,
-         _coordinate_scale(model, series))
+    scale = _coordinate_scale(model, series)
+    _run(checks, 'inputs', _check_inputs, problems, chosen, model)
+    _run(checks, 'ground', _check_ground, series, scale)
     step_ns, source = _nominal_step_ns(series, model)
-    motion = None
-    if model is not None and samples is not None:
-        geometry = model.body.phase_geometry(samples.angles[:, 2])
-        scale = _coordinate_scale(model, series)
-        _run(checks, 'contact_points', 'A and B where the body puts them',
-             _check_contact_points, samples, geometry, scale)
-        _run(checks, 'tangent_plane', 'the ground is the tangent plane', _check_tangent_plane,
-             samples, geometry)
-        _run(checks, 'theta', 'θ equals θ(u)', _check_theta, samples, geometry)
-        _run(checks, 'psi', 'ψ equals ψ(θ, branch)', _check_psi, samples, model.body)
-        reason = 'no stamp interval'
-        if step_ns is not None:
-            try:
-                motion = _motion(samples, model, step_ns * 1e-9)
-            except Exception as error:  # noqa: BLE001 - reported as failed checks
-                reason = f'{type(error).__name__}: {" ".join(str(error).split())}'
-        if motion is not None:
-            _run(checks, 'no_slip', 'no slip at A and B', _check_no_slip, samples, motion,
-                 scale)
-            if model.mode == 'kinematic':
-                _run(checks, 'angular_speed', 'angular speed constant', _check_angular_speed,
-                     samples, motion, model)
-            else:
-                _run(checks, 'energy', 'energy conserved', _check_energy, samples, motion,
-                     model)
-        else:
-            _not_evaluated(checks, ('no_slip', _speed_check(parameters)),
-                           f'no finite differences: {reason}')
-    else:
-        reason = ('no model (see inputs)' if model is None
-                  else 'no stamps shared by pose, contacts and rolling_state')
-        _not_evaluated(checks, ('contact_points', 'tangent_plane', 'theta', 'psi', 'no_slip',
-                                _speed_check(parameters)), reason)
-    _run(checks, 'timestamps', 'stamps increasing with no gaps', _check_timestamps, series,
-         step_ns, source)
-    _run(checks, 'stamps', 'consistent stamps', _check_stamps, series, recording.truncated)
+    motion = _physics_checks(checks, samples, model, step_ns, scale, parameters)
+    _run(checks, 'timestamps', _check_timestamps, series, step_ns, source)
+    _run(checks, 'stamps', _check_stamps, series, recording.truncated)
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
     summary['diagnostics'] = _diagnostics_summary(series)
     return Inspection(summary, checks, _plot_series(series, samples, motion, model, stamp0))
 
 
-def _speed_check(parameters):
-    return 'angular_speed' if parameters.get('mode') == 'kinematic' else 'energy'
+def _physics_checks(checks, samples, model, step_ns, scale, parameters):
+    """Append the checks that need the model; return the finite differences (or None)."""
+    speed_check = 'angular_speed' if parameters.get('mode') == 'kinematic' else 'energy'
+    if model is None or samples is None:
+        reason = ('no model (see inputs)' if model is None
+                  else 'no stamps shared by pose, contacts and rolling_state')
+        _not_evaluated_all(checks, ('contact_points', 'tangent_plane', 'theta', 'psi',
+                                    'no_slip', speed_check), reason)
+        return None
+    try:
+        geometry = model.body.phase_geometry(samples.angles[:, 2])
+    except (ValueError, FloatingPointError) as error:
+        geometry, reason = None, f'phases unusable: {" ".join(str(error).split())}'
+    if geometry is None:
+        _not_evaluated_all(checks, ('contact_points', 'tangent_plane', 'theta'), reason)
+    else:
+        _run(checks, 'contact_points', _check_contact_points, samples, geometry, scale)
+        _run(checks, 'tangent_plane', _check_tangent_plane, samples, geometry)
+        _run(checks, 'theta', _check_theta, samples, geometry)
+    _run(checks, 'psi', _check_psi, samples, model.body)
+    motion, reason = None, 'no stamp interval'
+    if step_ns is not None:
+        try:
+            motion = _motion(samples, model, step_ns * 1e-9)
+        except Exception as error:  # noqa: BLE001 - reported as failed checks
+            reason = f'{type(error).__name__}: {" ".join(str(error).split())}'
+    if motion is None:
+        _not_evaluated_all(checks, ('no_slip', speed_check), f'no finite differences: {reason}')
+        return None
+    _run(checks, 'no_slip', _check_no_slip, samples, motion, scale)
+    if model.mode == 'kinematic':
+        _run(checks, 'angular_speed', _check_angular_speed, samples, motion, model)
+    else:
+        _run(checks, 'energy', _check_energy, samples, motion, model)
+    return motion
 
 
-def _not_evaluated(checks, names, reason):
-    for name in names:
-        checks.append(Check(name, 'physics check', False, None, None, '',
-                            [f'not evaluated: {reason}']))
+def _not_evaluated_all(checks, names, reason):
+    checks.extend(_not_evaluated(name, f'not evaluated: {reason}') for name in names)
 
 
 def _coordinate_scale(model, series):
@@ -1002,6 +1009,7 @@ def _plot_series(series, samples, motion, model, stamp0):
         out['t_fd'] = samples.t[k]
         out['kinetic_fd'] = kinetic
         out['potential_fd'] = mass.mass * gravity * samples.position_g[k, 2]
+        out['energy_scale'] = np.array(model.dynamics.energy_scale)
         if np.all(np.isfinite(samples.rates[:, 2])):
             phase = np.unwrap(samples.angles[:, 2])
             out['t_model'] = samples.t
@@ -1107,12 +1115,13 @@ def plot_inspection(inspection, path):
     from matplotlib.figure import Figure
 
     data = inspection.series
-    figure = Figure(figsize=(13, 7), layout='constrained')
+    figure = Figure(figsize=(14, 8), layout='constrained')
     FigureCanvasAgg(figure)
-    grid = figure.add_gridspec(2, 2, width_ratios=(1.35, 1.0))
+    grid = figure.add_gridspec(3, 2, width_ratios=(1.3, 1.0))
     ground = figure.add_subplot(grid[:, 0])
     height = figure.add_subplot(grid[0, 1])
     energy = figure.add_subplot(grid[1, 1], sharex=height)
+    drift = figure.add_subplot(grid[2, 1], sharex=height)
     for role, label, style in (('contact_a', 'trace of A', dict(color='tab:red', lw=1.0)),
                                ('contact_b', 'trace of B', dict(color='tab:blue', lw=1.0)),
                                ('pose', 'path of G (projection)',
@@ -1123,31 +1132,40 @@ def plot_inspection(inspection, path):
     ground.set_aspect('equal', adjustable='datalim')
     ground.set_xlabel('X (m)')
     ground.set_ylabel('Y (m)')
-    ground.set_title('on the ground (start: dots)')
-    ground.grid(True, lw=0.3)
-    if ground.lines:
-        ground.legend(loc='best', fontsize='small')
+    ground.set_title('on the ground (dots: start)')
     if 'pose' in data:
         height.plot(data['t_pose'], data['pose'][:, 2], color='k', lw=1.0)
-    height.set_ylabel('height of G, z_G (m)')
-    height.grid(True, lw=0.3)
+    height.set_ylabel('z_G (m)')
+    height.set_title('height of G')
+    scale = float(data['energy_scale']) if 'energy_scale' in data else None
     if 't_fd' in data:
         total = data['kinetic_fd'] + data['potential_fd']
         energy.plot(data['t_fd'], total, color='k', lw=1.2, label='E from poses (FD)')
         energy.plot(data['t_fd'], data['kinetic_fd'], color='tab:orange', lw=0.8, label='T')
         energy.plot(data['t_fd'], data['potential_fd'], color='tab:green', lw=0.8,
                     label='V = M g z_G')
+        drift.plot(data['t_fd'], (total - total[0]) / scale, color='k', lw=1.0,
+                   label='from poses (FD)')
     if 't_model' in data:
-        energy.plot(data['t_model'], data['energy_model'], color='tab:purple', lw=0.8,
-                    ls=':', label='E(u, u̇) exact')
+        exact = data['energy_model']
+        energy.plot(data['t_model'], exact, color='tab:purple', lw=0.8, ls=':',
+                    label='E(u, u̇) of rolling_state')
+        drift.plot(data['t_model'], (exact - exact[0]) / scale, color='tab:purple', lw=0.8,
+                   ls=':', label='E(u, u̇) of rolling_state')
     if 't_diagnostics' in data:
-        energy.plot(data['t_diagnostics'], data['energy_diagnostics'], 's', ms=3,
-                    color='tab:red', label='diagnostics energy')
-    energy.set_xlabel('t (s)')
+        recorded = data['energy_diagnostics']
+        energy.plot(data['t_diagnostics'], recorded, 's', ms=3, color='tab:red',
+                    label='diagnostics')
+        if scale:
+            drift.plot(data['t_diagnostics'], (recorded - recorded[0]) / scale, 's', ms=3,
+                       color='tab:red', label='diagnostics')
     energy.set_ylabel('energy (J)')
-    energy.grid(True, lw=0.3)
-    if energy.lines:
-        energy.legend(loc='best', fontsize='small')
+    drift.set_ylabel('(E − E₀) / (M g L)')
+    drift.set_xlabel('t (s)')
+    for axes in (ground, height, energy, drift):
+        axes.grid(True, lw=0.3)
+        if len(axes.lines) > 1:
+            axes.legend(loc='best', fontsize='small')
     summary = inspection.summary
     params = summary['parameters']
     title = os.path.basename(summary['file'])
