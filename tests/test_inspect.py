@@ -21,6 +21,7 @@ from builtin_interfaces.msg import Time  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue  # noqa: E402
 from geometry_msgs.msg import Point, PointStamped, Pose, PoseStamped, Quaternion  # noqa: E402
 from nav_msgs.msg import Path as PathMsg  # noqa: E402
+from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
@@ -42,7 +43,6 @@ OLOID = {
     'realtime': 'False', 'method': 'table', 'tolerance': '1e-10', 'frame_id': 'world',
     'path_length': '200', 'record': 'run.mcap', 'version': '0.1.0',
 }
-SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 
 
 # ------------------------------------------------------------------------------------------
@@ -217,6 +217,8 @@ def test_plot_writes_a_png(capsys, clean_file, tmp_path):
     assert status == 0
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and png.stat().st_size > 20_000
     assert f'plot: {png}' in out
+    status, _, err = run_main(capsys, clean_file, '--plot', tmp_path / 'no' / 'such.png')
+    assert status == 2 and len(err.splitlines()) == 1 and 'cannot write plot' in err
 
 
 def test_kinematic_recording_checks_angular_speed(tmp_path):
@@ -226,6 +228,40 @@ def test_kinematic_recording_checks_angular_speed(tmp_path):
     assert 'energy' not in checks
     assert all(check.passed for check in checks.values()), checks
     assert checks['angular_speed'].tolerance < 1e-3
+
+
+def spin(t):
+    """A rotation vector that turns and changes axis (rad)."""
+    return np.stack([0.3 * t, 0.5 * t**2 - t, 2.0 * np.sin(t)], axis=-1)
+
+
+def test_finite_differences_are_fourth_order():
+    def errors(step):
+        t = np.arange(0.0, 1.0, step)
+        t = t + 1e-3 * step * np.sin(7 * t)   # stamps within 1 % of the step, not uniform
+        position = np.stack([np.sin(3 * t), t**3, np.cos(t)], axis=1)
+        index, velocity, omega = inspect_mcap.finite_differences(
+            t, position, Rotation.from_rotvec(spin(t)), step)
+        assert index[0] == 2 and index[-1] == t.size - 3
+        exact_v = np.stack([3 * np.cos(3 * t), 3 * t**2, -np.sin(t)], axis=1)[index]
+        tau = 1e-6   # reference ω: rotation vector of R(t + τ) R(t − τ)ᵀ over 2τ
+        turn = Rotation.from_rotvec(spin(t + tau)) * Rotation.from_rotvec(spin(t - tau)).inv()
+        exact_w = turn.as_rotvec()[index] / (2 * tau)
+        return np.max(np.abs(velocity - exact_v)), np.max(np.abs(omega - exact_w))
+    coarse, fine = errors(0.02), errors(0.01)
+    assert coarse[0] / fine[0] > 12 and coarse[1] / fine[1] > 12   # 2⁴ = 16
+    assert fine[0] < 1e-6 and fine[1] < 1e-6
+
+
+def test_recording_without_parameters_fails_inputs(capsys, tmp_path, oloid_run):
+    path = write_run(tmp_path / 'bare.mcap', oloid_run, {'rate': '100.0'})
+    status, out, err = run_main(capsys, path)
+    assert status == 1 and err == ''
+    checks = checks_of(path)
+    assert not checks['inputs'].passed and checks['inputs'].value >= 5
+    assert any('parameter a is missing' in line for line in checks['inputs'].detail)
+    assert checks['ground'].passed and checks['timestamps'].passed
+    assert checks['no_slip'].value is None and not checks['no_slip'].passed
 
 
 # ------------------------------------------------------------------------------------------

@@ -63,8 +63,8 @@ scale, so that round-off far from the origin is allowed for):
 A truncated file (writer killed, no footer) is checked on the part that was recovered; the
 report says how many messages and bytes that is.
 
-Exit status: 0 when every check passes, 1 when one fails, 2 when the file cannot be read (one
-line on stderr).
+Exit status: 0 when every check passes, 1 when one fails, 2 when the file cannot be read or the
+plot cannot be written (one line on stderr).
 """
 
 import argparse
@@ -1188,7 +1188,8 @@ def _parser():
         prog=PROG,
         description='Summarise a roller MCAP recording and check it offline against the '
                     'physics (contacts, no slip, energy, timestamps).',
-        epilog='Exit status: 0 every check passes, 1 a check fails, 2 the file cannot be read.')
+        epilog='Exit status: 0 every check passes, 1 a check fails, 2 the file cannot be read '
+               '(or the plot cannot be written).')
     parser.add_argument('file', help='the .mcap recording')
     parser.add_argument('--json', action='store_true',
                         help='print one JSON document (summary and checks) instead of text')
@@ -1197,8 +1198,19 @@ def _parser():
     return parser
 
 
+def _print(text):
+    """Print to stdout; a reader that went away (``| head``) is not an error."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+
+
 def main(argv=None):
-    """Run ``twodisk-inspect``; return the exit status (0 pass, 1 a check fails, 2 unreadable).
+    """Run ``twodisk-inspect``; return the exit status.
+
+    0 when every check passes, 1 when a check fails, 2 when the file cannot be read or the
+    plot cannot be written (one line on stderr, no traceback).
 
     Parameters
     ----------
@@ -1216,9 +1228,9 @@ def main(argv=None):
         print(f'{PROG}: {error}', file=sys.stderr)
         return 2
     if args.json:
-        print(json.dumps(inspection.as_dict(), indent=2, allow_nan=False, ensure_ascii=False))
+        _print(json.dumps(inspection.as_dict(), indent=2, allow_nan=False, ensure_ascii=False))
     else:
-        print(format_report(inspection))
+        _print(format_report(inspection))
     if args.plot:
         try:
             plot_inspection(inspection, args.plot)
@@ -1227,7 +1239,7 @@ def main(argv=None):
                   file=sys.stderr)
             return 2
         if not args.json:
-            print(f'plot: {args.plot}')
+            _print(f'plot: {args.plot}')
     return 0 if inspection.passed else 1
 
 
