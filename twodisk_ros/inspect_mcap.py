@@ -16,8 +16,9 @@ The checks (L is the body size, :attr:`TwoDiskBody.size`; X = max(L, max |G|) th
 scale, so that round-off far from the origin is allowed for):
 
 ``inputs``
-    the topics above have the expected types and the parameters define a body, a mass model
-    and a mode (tolerance 0 problems).
+    pose, contacts and rolling state are recorded with the expected types and the parameters
+    define a body, a mass model and a mode (tolerance 0 problems; the diagnostics, only
+    reported and plotted, may be missing).
 ``ground``
     A and B on the ground: max |z| ≤ 1e-9 X.
 ``contact_points``
@@ -105,7 +106,8 @@ TOPIC_TYPES = {
     'rolling_state': 'sensor_msgs/msg/JointState',
     'diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
 }
-#: Topics published together at every step, at ``rate`` Hz.
+#: Topics published together at every step, at ``rate`` Hz; all are required (the
+#: diagnostics are only reported and plotted).
 SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 METADATA_NAME = 'twodisk_ros'
 JOINT_NAMES = ('theta', 'psi', 'phase')
@@ -293,12 +295,19 @@ def _joint_values(msg):
     return {'position': position, 'velocity': rate}
 
 
+def _number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
 def _diagnostic_values(msg):
     found = {}
     for status in msg.status:
         for pair in status.values:
             if pair.key in ('energy', 'energy_drift') and pair.key not in found:
-                found[pair.key] = float(pair.value)
+                found[pair.key] = _number(pair.value)
     return {'energy': found.get('energy', math.nan),
             'energy_drift': found.get('energy_drift', math.nan)}
 
@@ -576,7 +585,7 @@ def _not_evaluated(name, reason, unit=''):
 
 
 def _check_inputs(problems, chosen, model):
-    missing = [role for role in TOPIC_TYPES if role not in chosen]
+    missing = [role for role in SAMPLED if role not in chosen]
     detail = [f'no {role} topic of type {TOPIC_TYPES[role]}' for role in missing]
     detail += problems
     if model is None and not detail:
@@ -586,7 +595,7 @@ def _check_inputs(problems, chosen, model):
         return _check('inputs', 0, 0, 'problems', [
             f'body a = {body.a:g} m, b = {body.b:g} m, delta = {body.delta:g} m, mass model '
             f'{model.dynamics.mass.model}, mode {model.mode}; topics '
-            + ', '.join(chosen[role] for role in TOPIC_TYPES)])
+            + ', '.join(chosen[role] for role in TOPIC_TYPES if role in chosen)])
     return _check('inputs', len(detail), 0, 'problems', detail)
 
 
@@ -1076,6 +1085,8 @@ def format_report(inspection):
         lines.append(f'diagnostics: {d["count"]} messages, energy {_value(d["energy_first"], "J")}'
                      f' → {_value(d["energy_last"], "J")}, max recorded energy_drift '
                      f'{_value(d["max_energy_drift"], "")}')
+    else:
+        lines.append('diagnostics: none recorded')
     lines.append(f'samples: {s["samples"]} stamps shared by pose, contacts and rolling_state'
                  + (f' ({s["mode"]} mode)' if s['mode'] else ''))
     lines.append('checks:')
