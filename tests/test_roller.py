@@ -271,6 +271,22 @@ def test_parameter_changes():
         harness.close()
 
 
+def test_read_only_parameters_are_rejected_at_run_time():
+    harness = Harness([Parameter('rate', value=RATE)])
+    try:
+        assert harness.spin(3.0, until=lambda: len(harness.got['pose']) >= 3)
+        for parameter in (Parameter('rate', value=10.0), Parameter('duration', value=1.0),
+                          Parameter('realtime', value=False), Parameter('record', value='x')):
+            (result,) = harness.node.set_parameters([parameter])
+            assert result.successful is False, parameter.name
+            assert harness.node.get_parameter(parameter.name).value != parameter.value
+        (result,) = harness.node.set_parameters([Parameter('path_length', value=0)])
+        assert result.successful is False   # out of its integer range
+        assert harness.node.settings.rate == RATE and harness.node._pending is None
+    finally:
+        harness.close()
+
+
 # -- subprocess ------------------------------------------------------------------------------
 
 def node_env():
