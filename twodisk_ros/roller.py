@@ -8,6 +8,7 @@ Run: ``ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml``.
 """
 
 from collections import deque
+import signal
 import sys
 
 import numpy as np
@@ -16,6 +17,7 @@ from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.serialization import serialize_message
+from rclpy.signals import SignalHandlerOptions
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 
@@ -255,9 +257,17 @@ class Roller(Node):
             self._recorder.close()
 
 
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
 def main(args=None):
-    """Entry point of ``ros2 run twodisk_ros roller``; exit 2 on invalid start-up values."""
-    rclpy.init(args=args)
+    """Entry point of ``ros2 run twodisk_ros roller``; exit 2 on invalid start-up values.
+
+    SIGINT and SIGTERM both end the node cleanly (recording finished) with exit code 0.
+    """
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.SIGINT)
+    signal.signal(signal.SIGTERM, _interrupt)
     node = None
     try:
         try:
