@@ -120,7 +120,8 @@ def _arc(a, b, limit):
     """Arc of the boundary between polar angles ±limit from the paper's eq. (1) (m)."""
     def rate(t):
         s, c = math.sin(t), math.cos(t)
-        return a * b * math.sqrt(a**4 * s * s + b**4 * c * c) / (a * a * s * s + b * b * c * c)**1.5
+        polar2 = a * a * s * s + b * b * c * c
+        return a * b * math.sqrt(a**4 * s * s + b**4 * c * c) / polar2**1.5
     # the integrand peaks sharply for thin shapes: split at the axes
     points = sorted({0.0, math.pi / 2, -math.pi / 2, limit, -limit})
     points = [p for p in points if -limit <= p <= limit]

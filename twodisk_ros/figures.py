@@ -1,0 +1,272 @@
+"""Figures of the paper and of the notes, as PNG files (matplotlib, Agg).
+
+Run ``python -m twodisk_ros.figures --out DIR`` (``make figures`` writes ``docs/figures``):
+
+* ``figure3.png``, ``figure4.png``, ``oloid_traces.png``: traces of the contact points A and B
+  on the ground over three whole cycles (world frame, m), as in the paper's Figures 3 and 4;
+* ``height.png``: the height of G over one cycle for the oloid, the Figure 3 body and the
+  Two-Circle-Roller, with the eight equilibria per cycle;
+* ``stability_map.png``: which family of equilibria is stable, over b/a and Δ/a.
+
+Plotting lives only here; the physics core never imports matplotlib.
+"""
+
+import argparse
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402  (after selecting the backend)
+import numpy as np  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+
+from .body import TwoDiskBody  # noqa: E402
+from .cycle import RollingCycle  # noqa: E402
+from .equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
+
+__all__ = ['FIGURE3', 'FIGURE4', 'plot_traces', 'plot_height', 'plot_stability_map',
+           'write_figures', 'main']
+
+#: The paper's bodies (a, b, Δ) in m.
+FIGURE3 = (2.0, 1.0, 1.0)
+FIGURE4 = (math.sqrt(1.5), 1.0, 1.0)
+
+COLOR_A, COLOR_B, COLOR_RULING = '#1f5fa8', '#c8501e', '0.72'
+DPI = 150
+TWO_PI = 2.0 * math.pi
+
+plt.rcParams.update({
+    'font.size': 9, 'axes.titlesize': 10, 'axes.labelsize': 9, 'legend.fontsize': 8,
+    'xtick.direction': 'in', 'ytick.direction': 'in', 'axes.grid': True,
+    'grid.color': '0.9', 'grid.linewidth': 0.6, 'savefig.dpi': DPI,
+})
+
+
+def _describe(body):
+    return f'a = {body.a:.4g} m, b = {body.b:.4g} m, Δ = {body.delta:.4g} m'
+
+
+def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, name=None):
+    """Traces of A and B on the ground over whole cycles (world frame, m).
+
+    Parameters
+    ----------
+    body : TwoDiskBody
+    cycles : int
+        Number of whole cycles, from phase u = 0 (A at the origin, θ = 0).
+    ax : matplotlib.axes.Axes
+    samples_per_cycle : int
+        Points per cycle along each trace.
+    rulings_per_cycle : int
+        Contact lines AB drawn per cycle (thin grey), the rulings of the body's hull.
+    name : str, optional
+        Prefix of the title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``; the traces are the lines with gid ``'trace A'`` and ``'trace B'``.
+    """
+    cycle = RollingCycle(body)
+    u = np.linspace(0.0, TWO_PI * cycles, samples_per_cycle * cycles + 1)
+    _, a_world, b_world = cycle.positions(u)
+    u_rule = np.arange(rulings_per_cycle * cycles + 1) * TWO_PI / rulings_per_cycle
+    _, a_rule, b_rule = cycle.positions(u_rule)
+    for k, (pa, pb) in enumerate(zip(a_rule, b_rule)):
+        ax.plot([pa[0], pb[0]], [pa[1], pb[1]], color=COLOR_RULING, lw=0.6, zorder=1,
+                label='contact line AB' if k == 0 else None)
+    ax.plot(a_world[:, 0], a_world[:, 1], color=COLOR_A, lw=1.4, zorder=3, gid='trace A',
+            label='trace of A (disk 1)')
+    ax.plot(b_world[:, 0], b_world[:, 1], color=COLOR_B, lw=1.4, zorder=3, gid='trace B',
+            label='trace of B (disk 2)')
+    # cusps: A turns back at the turning points (u = π/2 + kπ), B where θ = 0 (u = kπ)
+    cusp_u = np.arange(2 * cycles + 1) * math.pi
+    _, _, b_cusp = cycle.positions(cusp_u)
+    _, a_cusp, _ = cycle.positions(cusp_u[:-1] + math.pi / 2)
+    ax.plot(a_cusp[:, 0], a_cusp[:, 1], 'v', color=COLOR_A, ms=4, zorder=4, label='cusps')
+    ax.plot(b_cusp[:, 0], b_cusp[:, 1], '^', color=COLOR_B, ms=4, zorder=4)
+    ax.set_aspect('equal', adjustable='box')
+    ax.set_xlabel('X (m)')
+    ax.set_ylabel('Y (m)')
+    prefix = f'{name}: ' if name else ''
+    ax.set_title(f'{prefix}{_describe(body)}; {cycles} cycles, '
+                 f'{cycle.displacement.shift.real:.4f} m per cycle')
+    ax.legend(loc='upper center', bbox_to_anchor=(0.5, 0.0), borderaxespad=3.6, ncol=4,
+              frameon=False)
+    return ax
+
+
+_FAMILY_MARKERS = {'theta=0': 'o', 'theta=+pi/2': 's', 'theta=-pi/2': 's', 'turning': '^'}
+_FAMILY_LABELS = {'o': 'θ = 0', 's': 'θ = ±π/2', '^': 'turning point θ = ±θ_max'}
+
+
+def _marker(name):
+    for key, marker in _FAMILY_MARKERS.items():
+        if name.startswith(key):
+            return marker
+    return 'o'
+
+
+_EQ_THETA = ['0', 'π/2', 'θ_max', 'π/2', '0', '−π/2', '−θ_max', '−π/2']
+
+
+def plot_height(bodies, ax, samples=1441, annotate=0):
+    """Height of G (m) over one cycle, x = phase u (rad), with the equilibria marked.
+
+    Stable equilibria are filled, unstable ones open, neutral ones crossed; the marker shape
+    gives the family (θ = 0, θ = ±π/2, turning point).
+
+    Parameters
+    ----------
+    bodies : sequence of (label, TwoDiskBody)
+    ax : matplotlib.axes.Axes
+    samples : int
+        Phases over [0, 2π].
+    annotate : int or None
+        Index of the body whose equilibria are labelled with their θ on the top axis.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``; each curve has gid ``'height <label>'``.
+    """
+    u = np.linspace(0.0, TWO_PI, samples)
+    colors = plt.rcParams['axes.prop_cycle'].by_key()['color']
+    for k, (label, body) in enumerate(bodies):
+        color = colors[k % len(colors)]
+        ax.plot(u, body.phase_height(u), color=color, lw=1.4, gid=f'height {label}',
+                label=label)
+        for eq in equilibria(body):
+            marker = _marker(eq.name)
+            if eq.stability == NEUTRAL:
+                ax.plot(eq.phase, eq.height, marker='x', color=color, ms=5, mew=1.0,
+                        zorder=3)
+                continue
+            face = color if eq.stability == STABLE else 'white'
+            ax.plot(eq.phase, eq.height, marker=marker, mfc=face, mec=color, ms=6, mew=1.2,
+                    ls='none', zorder=4)
+    ax.set_xlim(0.0, TWO_PI)
+    ax.margins(y=0.1)
+    ax.set_xticks(np.arange(5) * math.pi / 2)
+    ax.set_xticklabels(['0', 'π/2', 'π', '3π/2', '2π'])
+    ax.set_xlabel('cycle phase u (rad)')
+    ax.set_ylabel('height of G, z_G (m)')
+    if annotate is not None:
+        label, body = bodies[annotate]
+        top = ax.secondary_xaxis('top')
+        top.set_xticks([eq.phase for eq in equilibria(body)])
+        top.set_xticklabels(_EQ_THETA, fontsize=7)
+        top.set_xlabel(f'θ at the equilibria ({label})', fontsize=8)
+        top.tick_params(direction='in')
+    ax.set_title('Height of the centre of mass over one cycle', pad=8)
+    curves = ax.legend(loc='upper left', bbox_to_anchor=(1.01, 1.0), frameon=False,
+                       title='body')
+    ax.add_artist(curves)
+    keys = [Line2D([], [], marker=m, color='0.3', ls='none', mfc='0.3', label=text)
+            for m, text in _FAMILY_LABELS.items()]
+    keys += [Line2D([], [], marker='o', color='0.3', ls='none', mfc='0.3', label='stable'),
+             Line2D([], [], marker='o', color='0.3', ls='none', mfc='white', label='unstable'),
+             Line2D([], [], marker='x', color='0.3', ls='none', label='neutral')]
+    ax.legend(handles=keys, loc='lower left', bbox_to_anchor=(1.01, 0.0), frameon=False,
+              title='equilibria')
+    return ax
+
+
+_NAMED_BODIES = [('Oloid', (1.0, 1.0, 0.5)), ('TCR', (1.0, 1.0, 1.0 / math.sqrt(2.0))),
+                 ('Fig. 3', FIGURE3), ('Fig. 4', FIGURE4)]
+
+
+def plot_stability_map(ax, b_range=(0.05, 3.0), resolution=400):
+    """Which equilibria are stable over b/a and Δ/a (from :func:`stability_map`).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    b_range : (float, float)
+        Range of b/a.
+    resolution : int
+        Grid points per axis.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``; the neutral curve has gid ``'neutral curve'``.
+    """
+    b = np.linspace(b_range[0], b_range[1], resolution)
+    d = np.linspace(0.0, 1.0, resolution + 1)[1:-1]
+    grid = stability_map(b[None, :], d[:, None])
+    cmap = ListedColormap(['#f3d9c4', '#ffffff', '#cfe0f1'])
+    ax.pcolormesh(b, d, grid, cmap=cmap, vmin=-1.5, vmax=1.5, shading='auto',
+                  rasterized=True)
+    b_line = np.linspace(b_range[0], math.sqrt(2.0), 400)
+    ax.plot(b_line, np.sqrt(np.clip(1.0 - b_line**2 / 2, 0.0, None)), color='k', lw=1.4,
+            gid='neutral curve', label='neutral: Δ = √(a² − b²/2), z_G constant')
+    offsets = {'TCR': (7, 3), 'Fig. 4': (7, 3), 'Oloid': (7, -11), 'Fig. 3': (-8, -13)}
+    for label, (a_, b_, d_) in _NAMED_BODIES:
+        x, y = b_ / a_, d_ / a_
+        ax.plot(x, y, 'o', mfc='k', mec='white', ms=6, zorder=4)
+        dx, dy = offsets[label]
+        ax.annotate(f'{label} ({x:.3g}, {y:.3g})', (x, y), xytext=(dx, dy),
+                    textcoords='offset points', fontsize=8, ha='left' if dx > 0 else 'center')
+    ax.text(0.62, 0.2, 'b² − 2a² + 2Δ² < 0\nθ = ±π/2 stable\nθ = 0, turning points unstable',
+            ha='center', va='center', fontsize=8)
+    ax.text(2.25, 0.6, 'b² − 2a² + 2Δ² > 0\nθ = 0, turning points stable\nθ = ±π/2 unstable',
+            ha='center', va='center', fontsize=8)
+    ax.set_xlim(*b_range)
+    ax.set_ylim(0.0, 1.0)
+    ax.set_xlabel('b / a')
+    ax.set_ylabel('Δ / a')
+    ax.set_title('Stable family of equilibria')
+    ax.legend(loc='lower right', frameon=True, framealpha=0.9)
+    ax.grid(False)
+    return ax
+
+
+def _save(fig, path):
+    fig.savefig(path, dpi=DPI, bbox_inches='tight')
+    plt.close(fig)
+    return path
+
+
+def write_figures(out_dir):
+    """Write all figures as PNG into ``out_dir`` (created if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for filename, title, shape in [('figure3.png', 'Paper, Figure 3', FIGURE3),
+                                   ('figure4.png', 'Paper, Figure 4', FIGURE4),
+                                   ('oloid_traces.png', 'Oloid', (1.0, 1.0, 0.5))]:
+        fig, ax = plt.subplots(figsize=(8.0, 3.6))
+        plot_traces(TwoDiskBody(*shape), 3, ax, name=title)
+        written.append(_save(fig, out / filename))
+    fig, ax = plt.subplots(figsize=(7.5, 3.6))
+    plot_height([('Oloid', TwoDiskBody.oloid()), ('Fig. 3 body', TwoDiskBody(*FIGURE3)),
+                 ('Two-Circle-Roller', TwoDiskBody.two_circle_roller())], ax, annotate=1)
+    written.append(_save(fig, out / 'height.png'))
+    fig, ax = plt.subplots(figsize=(6.0, 4.2))
+    plot_stability_map(ax)
+    written.append(_save(fig, out / 'stability_map.png'))
+    return written
+
+
+def main(argv=None):
+    """Command line: ``python -m twodisk_ros.figures --out DIR``."""
+    parser = argparse.ArgumentParser(description='Write the figures (PNG) of twodisk_ros.')
+    parser.add_argument('--out', default='docs/figures', help='output directory')
+    args = parser.parse_args(argv)
+    for path in write_figures(args.out):
+        print(path)
+    return 0
+
+
+if __name__ == '__main__':
+    raise SystemExit(main())
