@@ -54,8 +54,9 @@ def work_precision_figure(results, reference_errors, path):
                 legend.setdefault(label, line)
                 for r, x, y in zip(pts, xs, ys):
                     if y >= top:
-                        ax.annotate(f'{method}, {KIND_LABELS[kind]}: diverged '
-                                    f'(error {r.error:.0e} × size)', (x, y),
+                        what = (f'error {r.error:.0e} × size' if math.isfinite(r.error)
+                                else 'NaN samples')
+                        ax.annotate(f'{method}, {KIND_LABELS[kind]}: diverged ({what})', (x, y),
                                     textcoords='offset points', xytext=(8, -14 - 12 * diverged),
                                     fontsize=7, color=color,
                                     arrowprops=dict(arrowstyle='-', color=color, lw=0.5))

@@ -143,13 +143,15 @@ def write_report(path, ctx):
     oloid1 = [x for x in t1 if x[0].body == 'oloid']
     head = oloid1[0][0] if oloid1 else t1[0][0]
     w(f'1. {_status(ok1)} — poses of G, A, B at ≥ 1e6 samples/s with error ≤ 1e-10 of the '
-      f'size (`RollingCycle.positions` on 1e6 phases over 3 cycles, u ∈ [−2π, 4π], vs the '
+      f'size (`RollingCycle.positions` on {head.samples:.0e} phases over 3 cycles, u ∈ '
+      f'[−2π, 4π], in one call, vs the '
       f'independent reference trace): oloid **{head.rate / 1e6:.2f} M samples/s**, error '
       f'**{_e(head.error)}**. All bodies:')
     for r, ok in t1:
-        w(f'   - {BODIES[r.body][3]}: {r.rate / 1e6:.2f} M/s ({_ms(r.wall)} ms per 1e6), '
-          f'error {_e(r.error)} (reference error {_e(r.reference_error)}) — '
-          f'{"PASS" if ok else "MISS"}')
+        w(f'   - {BODIES[r.body][3]}: {r.rate / 1e6:.2f} M/s ({_ms(r.wall)} ms per '
+          f'{r.samples:.0e} samples, best of 5), error {_e(r.error)} (reference error '
+          f'{_e(r.reference_error)}) — {"PASS" if ok else "MISS"}; diagnostic: the same phases '
+          f'in calls of {r.chunk:.0e}: {r.rate_chunked / 1e6:.2f} M/s')
     if not ok1:
         w('   - Why missed: ' + ctx['target1_why'])
     hours = ctx['hours']
@@ -167,7 +169,11 @@ def write_report(path, ctx):
           f'positions {h.wall_positions:.2f} s), {what} **{_e(h.drift)}**{pkg}; after '
           f'{h.cycles} cycles (independent cycle time {h.cycle_time:.12f} s) phase error '
           f'{_e(h.phase_error)} rad and pose error {_e(h.position_error)} of the size at '
-          f't = k·T (reference error {_e(h.reference_error)}) — {"PASS" if ok else "MISS"}')
+          f't = k·T (reference error {_e(h.reference_error)}; one ulp of 2π in the turn per '
+          f'cycle alone moves the last pose by {_e(h.conditioning)}, so pose errors of that '
+          f'size after {h.cycles} cycles are rounding) — {"PASS" if ok else "MISS"}; '
+          f'diagnostic: the same hour in chunks of {h.chunk:.0e} samples takes '
+          f'{h.wall_chunked:.2f} s')
     if not ok2:
         w('   - Why missed: ' + ctx['target2_why'])
     ratios = ctx['ratios']

@@ -28,6 +28,8 @@ class PositionsThroughput:
     error: float            #: max position error of G, A, B / size, vs the reference
     reference_error: float  #: estimated error of that reference / size
     phase_span: tuple       #: (u_lo, u_hi) (rad)
+    chunk: int = 0          #: diagnostic: the same phases in calls of this many samples …
+    rate_chunked: float = 0.0   #: … reach this many samples per second
 
     def as_dict(self):
         return asdict(self)
@@ -38,7 +40,13 @@ def positions_throughput(built, n=10**6, span=(-TWO_PI, 2 * TWO_PI)):
     cycle = built.dynamics.cycle
     u = np.linspace(span[0], span[1], n)
     cycle.positions(u[:1000])                       # warm up
-    _, wall = _timed(lambda: cycle.positions(u), min_time=1.0, max_repeats=5)
+    _, wall = _timed(lambda: cycle.positions(u), min_time=math.inf, max_repeats=5)
+    chunk = min(n, 100_000)
+
+    def chunked():
+        for i in range(0, n, chunk):
+            cycle.positions(u[i:i + chunk])
+    _, wall_chunked = _timed(chunked, min_time=math.inf, max_repeats=3)
     pos = cycle.positions(u)
     rb = built.ref_body
     trace = ReferenceTrace(rb, span[0], span[1], REFERENCE_RTOL)
@@ -51,7 +59,8 @@ def positions_throughput(built, n=10**6, span=(-TWO_PI, 2 * TWO_PI)):
     size = built.body.size
     err = position_error(pos, ref, size)
     ref_err = position_error(tuple(x[::50] for x in ref), ref_check, size)
-    return PositionsThroughput(built.name, n, wall, n / wall, err, ref_err, span)
+    return PositionsThroughput(built.name, n, wall, n / wall, err, ref_err, span, chunk,
+                               n / wall_chunked)
 
 
 # ------------------------------------------------------------------ target 2
@@ -71,6 +80,9 @@ class HourRun:
     reference_error: float   #: estimated error of the reference poses at the last cycle / size
                              #: (piecewise-Chebyshev cycle map, 128 vs 64 panels)
     finite: bool
+    conditioning: float = 0.0    #: pose change at the last cycle from one ulp(2π) of turn / size
+    chunk: int = 0               #: diagnostic: the same hour simulated in chunks of samples …
+    wall_chunked: float = 0.0    #: … takes this long (simulate + positions)
 
     @property
     def wall(self):
@@ -131,7 +143,7 @@ def _composed(p0, spin, shift, cycles):
     return out
 
 
-def hour_run(built, sc, duration=3600.0, rate=1000.0, subsample=100):
+def hour_run(built, sc, duration=3600.0, rate=1000.0, subsample=100, chunk=100_000):
     """simulate(..., t_eval=np.arange(0, duration, 1/rate), method='table') + positions."""
     assert sc.phase0 == 0.0, 'the cycle check below assumes the run starts at u = 0'
     dyn = built.dynamics
@@ -195,9 +207,21 @@ def hour_run(built, sc, duration=3600.0, rate=1000.0, subsample=100):
         d = np.hypot(np.abs(p[:, 0] + 1j * p[:, 1] - ref[:, j]), p[:, 2] - heights[j])
         worst = max(worst, float(np.max(d)) if np.all(np.isfinite(d)) else math.inf)
     ref_err = float(np.max(np.abs(ref[-1] - ref2))) / size
+    ulp = math.ulp(TWO_PI)
+    ref3 = _composed(p0c[None, :], spin * complex(math.cos(ulp), math.sin(ulp)), shift,
+                     cycles)[-1, 0]
+    conditioning = float(np.max(np.abs(ref[-1] - ref3))) / size
+    # diagnostic: the same work in chunks of `chunk` samples (simulate accepts any t_eval ≥ 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', RuntimeWarning)
+        tc = time.perf_counter()
+        for i in range(0, t.size, chunk):
+            part = simulate(dyn, t[i:i + chunk], **kwargs)
+            part.positions()
+        wall_chunked = time.perf_counter() - tc
     return HourRun(built.name, sc.kind, t.size, t1 - t0, t2 - t1, drift, drift_pkg, cycle_time,
                    cycles, phase_err if math.isfinite(phase_err) else math.inf, worst / size,
-                   ref_err, finite)
+                   ref_err, finite, conditioning, chunk, wall_chunked)
 
 
 # ------------------------------------------------------------------ target 3
