@@ -12,8 +12,12 @@ Nothing here compares the module with its own output. The references are:
 * closed forms of the physics notes (z_G at θ = 0 and θ = π/2, the constant height of the
   Two-Circle-Roller), the small-oscillation period T = 2π √(m / M g z_G″), the scaling law
   T ∝ √(L / g), the rolling constraint (ω ∥ AB);
-* a second method: ``direct`` against ``table``, and the trace of A against an independent
-  DOP853 integration of the paper's eqs. (4)-(6) (``integrate_contact_trace``).
+* a second method: ``direct`` against ``table``, ``MotionStream``'s restarted chunks against
+  one integration over the whole span, and the trace of A against an independent DOP853
+  integration of the paper's eqs. (4)-(6) (``integrate_contact_trace``).
+
+Known bugs are marked ``xfail(strict=True)`` with the input, the expected and the actual
+result in the reason.
 
 Units: SI (m, kg, s, rad). Relative drifts are relative to M g × body size.
 """
