@@ -16,7 +16,7 @@ Nothing here compares the module with its own output. The references are:
   one integration over the whole span, and the trace of A against an independent DOP853
   integration of the paper's eqs. (4)-(6) (``integrate_contact_trace``).
 
-Known bugs are marked ``xfail(strict=True)`` with the input, the expected and the actual
+Known bugs, if any, are marked ``xfail(strict=True)`` with the input, the expected and the
 result in the reason.
 
 Units: SI (m, kg, s, rad). Relative drifts are relative to M g × body size.
@@ -317,16 +317,8 @@ UNSTABLE_POINTS = [
     pytest.param(FAT, math.pi / 2, 1, id='fat-halfpi'),
     pytest.param(FAT, -math.pi / 2, -1, id='fat-halfpi-mirror'),
     pytest.param(LONG, 0.0, 1, id='long-theta0'),
-    pytest.param(LONG, 0.0, -1, id='long-theta0-mirror', marks=pytest.mark.xfail(
-        strict=True, reason='BUG dynamics._simulate_dynamic: the rest test |V\'(u0)| <= '
-        '1e-14 M g size is below the roundoff of the complex-step slope at u0 = pi (2.7e-14 '
-        'M g size for (a,b,delta)=(3,0.5,0.02), theta0=0, branch=-1; exactly 0 at u0 = 0): '
-        'the body leaves the unstable equilibrium (G moves 4e-10 m in 3 s, 9e-9 m in 6 s, '
-        '4e-4 m in 10 s)')),
-    pytest.param(THIN, 'max', 1, id='thin-turning+', marks=pytest.mark.xfail(
-        strict=True, reason='BUG body.phase_from_theta(theta_max) = pi/2 - 1.49e-8 for '
-        '(a,b,delta)=(1,0.2,0.9) (arcsin of eta/eta_max rounded below 1): the body is not '
-        'at the turning-point equilibrium and rolls away (G moves 4e-6 m in 3 s, 0.1 m in 7 s)')),
+    pytest.param(LONG, 0.0, -1, id='long-theta0-mirror'),
+    pytest.param(THIN, 'max', 1, id='thin-turning+'),
 ]
 
 
@@ -541,13 +533,6 @@ def test_zero_gravity_keeps_kinetic_energy():
     assert np.all(rest.phase == rest.phase[0])
 
 
-@pytest.mark.xfail(strict=True, reason='BUG RollingDynamics.energy_scale with gravity=0 is '
-                   'M*size (kg m), its docstring says M*size**2')
-def test_energy_scale_without_gravity_matches_docstring():
-    body, _, _, dyn = model(OLOID, gravity=0.0)
-    assert_allclose(dyn.energy_scale, MASS * body.size**2, rtol=1e-15)
-
-
 # ----------------------------------------------------------------------------- input errors
 
 BAD_INPUTS = [
@@ -586,36 +571,19 @@ def test_input_errors(kwargs, name, allowed):
     _one_line_error(kwargs, name, allowed)
 
 
-def _bug(reason):
-    return pytest.mark.xfail(strict=True, reason='BUG ' + reason)
-
-
-_NAN_T = ('t_eval with NaN is accepted: [0, nan, 1] gives NaN phases (table) or, with '
-          'direct, a RollingMotion whose phase has 1 sample for 3 times')
-_INF_T = ('t_eval with inf is accepted: [0, inf] gives a NaN phase (table); with direct the '
-          'solver integrates towards t = inf and never returns (not run here)')
-_NOT_NUMBER = ('a non-numeric value raises ValueError("could not convert string to float: '
-               '...") without naming the parameter or what is allowed')
-
-
 @pytest.mark.filterwarnings('ignore::RuntimeWarning')
 @pytest.mark.parametrize('kwargs, name, allowed', [
     pytest.param(dict(t_eval=[0.0, math.nan, 1.0], method='direct'), 't_eval', 'finite',
-                 id='nan-direct', marks=_bug(_NAN_T)),
-    pytest.param(dict(t_eval=[0.0, math.nan, 1.0]), 't_eval', 'finite', id='nan-table',
-                 marks=_bug(_NAN_T)),
-    pytest.param(dict(t_eval=[0.0, math.inf]), 't_eval', 'finite', id='inf-table',
-                 marks=_bug(_INF_T)),
-    pytest.param(dict(tolerance='abc'), 'tolerance', '(0, 1)', id='tolerance-str',
-                 marks=_bug(_NOT_NUMBER)),
-    pytest.param(dict(omega0='fast'), 'omega0', 'finite', id='omega0-str',
-                 marks=_bug(_NOT_NUMBER)),
-    pytest.param(dict(theta0=3.0), 'theta0', 'theta_max', id='theta0-range',
-                 marks=_bug('theta0 = 3 > theta_max is reported as "theta must be finite '
-                            'with |theta| <= theta_max ..." (names the body\'s parameter, '
-                            'not simulate\'s theta0)')),
+                 id='nan-direct'),
+    pytest.param(dict(t_eval=[0.0, math.nan, 1.0]), 't_eval', 'finite', id='nan-table'),
+    pytest.param(dict(t_eval=[0.0, math.inf]), 't_eval', 'finite', id='inf-table'),
+    pytest.param(dict(t_eval=[0.0, 1.0, 1.0]), 't_eval', 'strictly increasing',
+                 id='repeated-time'),
+    pytest.param(dict(tolerance='abc'), 'tolerance', '(0, 1)', id='tolerance-str'),
+    pytest.param(dict(omega0='fast'), 'omega0', 'finite', id='omega0-str'),
+    pytest.param(dict(theta0=3.0), 'theta0', 'theta_max', id='theta0-range'),
 ])
-def test_input_errors_not_caught(kwargs, name, allowed):
+def test_input_errors_non_finite_and_non_numeric(kwargs, name, allowed):
     _one_line_error(kwargs, name, allowed)
 
 

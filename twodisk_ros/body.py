@@ -323,11 +323,20 @@ class TwoDiskBody:
         return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
 
     def phase_from_theta(self, theta, branch=1):
-        """The phase u ∈ [−π/2, 3π/2) of contact angle θ on a branch (inverse of θ(u))."""
+        """The phase u ∈ [−π/2, 3π/2) of contact angle θ on a branch (inverse of θ(u)).
+
+        Exact at the turning points: with v = η_max − |η| (computed as one angle) and
+        1 − sin|u| = v/η_max, |u| = π/2 − 2 arcsin √(v / 2η_max).
+        """
         theta = self._theta_array(theta)
         branch = self._branch_array(branch)
-        eta = np.arctan2(self.a * np.sin(theta), self.b * np.cos(theta))
-        base = np.arcsin(np.clip(eta / self.eta_max, -1.0, 1.0))
+        a, b, tm = self.a, self.b, self.theta_max
+        abs_t = np.abs(theta)
+        # tan(η_max − |η|) = a b sin(θ_max − |θ|) / (b² cos θ_max cos θ + a² sin θ_max sin θ)
+        v = np.arctan2(a * b * np.sin(tm - abs_t), b * b * math.cos(tm) * np.cos(abs_t)
+                       + a * a * math.sin(tm) * np.sin(abs_t))
+        base = np.pi / 2 - 2 * np.arcsin(np.sqrt(np.clip(v / (2 * self.eta_max), 0.0, 0.5)))
+        base = np.where(theta < 0, -base, base)
         return np.where(branch > 0, base, np.pi - base)
 
     def phase_theta(self, u):

@@ -139,7 +139,7 @@ class RollingDynamics:
 
     @property
     def energy_scale(self):
-        """M g × body size (J), or M × size² (1/s)² when g = 0: the scale of relative drifts."""
+        """M g L (J), L = body size: the scale of relative energy drifts (g → 1 m/s² if g = 0)."""
         g = self.gravity if self.gravity > 0 else 1.0
         return self.mass.mass * g * self.body.size
 
@@ -161,6 +161,15 @@ class RollingDynamics:
         """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
         return [(eq, period) for eq, period in self.equilibria_with_periods()
                 if period is not None]
+
+    def is_equilibrium(self, u):
+        """True if phase u (rad) is one of the equilibria (within 1e-9 rad), or V′(u) vanishes
+        there to rounding (z_G constant: the neutral case)."""
+        phases = np.array([eq.phase for eq, _ in self.equilibria_with_periods()])
+        gap = np.abs(np.remainder(u - phases + math.pi, TWO_PI) - math.pi)
+        if np.min(gap) <= 1e-9:
+            return True
+        return abs(float(self.potential_slope(u))) <= 1e-13 * self.energy_scale
 
     def initial_phase_rate(self, u0, omega0):
         """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0."""
@@ -245,6 +254,17 @@ class _Quadrature:
         return u, s / self._rate(u)
 
 
+def _real(name, value, rule, allowed):
+    """``value`` as a float if ``allowed(value)``, else ValueError naming ``name`` and ``rule``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a number {rule}, got {value!r}') from None
+    if not allowed(number):
+        raise ValueError(f'{name} must be {rule}, got {value!r}')
+    return number
+
+
 def _check_choice(name, value, allowed):
     if value not in allowed:
         raise ValueError(f'{name} must be one of {", ".join(map(repr, allowed))}, got {value!r}')
@@ -277,15 +297,19 @@ def simulate(dynamics, t_eval, *, mode='dynamic', theta0=0.0, branch=1, omega0=0
     """
     _check_choice('mode', mode, MODES)
     _check_choice('method', method, METHODS)
-    tolerance = float(tolerance)
-    if not (0 < tolerance < 1):
-        raise ValueError(f'tolerance must be in (0, 1), got {tolerance!r}')
-    t_eval = np.asarray(t_eval, dtype=float)
-    if t_eval.ndim != 1 or t_eval.size == 0 or t_eval[0] < 0 or np.any(np.diff(t_eval) < 0):
-        raise ValueError('t_eval must be a non-empty 1-d array of increasing times >= 0 s')
-    omega0 = float(omega0)
-    if not math.isfinite(omega0):
-        raise ValueError(f'omega0 must be finite (rad/s), got {omega0!r}')
+    tolerance = _real('tolerance', tolerance, 'in (0, 1)', lambda x: 0 < x < 1)
+    omega0 = _real('omega0', omega0, 'finite (rad/s)', math.isfinite)
+    theta_max = dynamics.body.theta_max
+    theta0 = _real('theta0', theta0, f'finite with |theta0| <= theta_max = {theta_max!r} rad',
+                   lambda x: math.isfinite(x) and abs(x) <= theta_max)
+    try:
+        t_eval = np.asarray(t_eval, dtype=float)
+    except (TypeError, ValueError):
+        t_eval = np.array([np.nan])
+    if (t_eval.ndim != 1 or t_eval.size == 0 or not np.all(np.isfinite(t_eval))
+            or t_eval[0] < 0 or np.any(np.diff(t_eval) <= 0)):
+        raise ValueError('t_eval must be a non-empty 1-d array of finite, strictly increasing '
+                         'times >= 0 s')
     u0 = float(dynamics.body.phase_from_theta(theta0, branch))
     return simulate_phase(dynamics, t_eval, u0, dynamics.initial_phase_rate(u0, omega0),
                           mode=mode, method=method, tolerance=tolerance)
@@ -393,8 +417,7 @@ def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
 
 
 def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
-    slope = float(dynamics.potential_slope(u0))
-    if u_dot0 == 0 and abs(slope) <= 1e-14 * dynamics.energy_scale:
+    if u_dot0 == 0 and dynamics.is_equilibrium(u0):
         return _rest(dynamics, 'dynamic', method, t_eval, u0)
     if method == 'table':
         f0 = dynamics.tabulated(u0)
