@@ -287,6 +287,31 @@ def test_read_only_parameters_are_rejected_at_run_time():
         harness.close()
 
 
+def test_work_is_skipped_for_topics_nobody_wants(monkeypatch):
+    """No subscriber and no recording: no message is built; one subscriber: only its topic."""
+    built = []
+    monkeypatch.setattr(Roller, '_publish',
+                        lambda self, topic, message, time_ns: built.append(topic))
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=IN_PROCESS_DOMAIN + 10)
+    node = Roller(context=ctx, parameter_overrides=[Parameter('rate', value=RATE)])
+    executor = SingleThreadedExecutor(context=ctx)
+    executor.add_node(node)
+    try:
+        spin_until(executor, lambda: node._tick >= 25, 5.0)
+        assert node._tick >= 25 and built == []
+        listener = rclpy.create_node('pose_only', context=ctx)
+        listener.create_subscription(PoseStamped, 'pose', lambda m: None, 10)
+        executor.add_node(listener)
+        assert spin_until(executor, lambda: len(built) >= 10, 5.0)
+        assert set(built) == {'pose'}
+    finally:
+        executor.shutdown()
+        node.close()
+        node.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
 # -- subprocess ------------------------------------------------------------------------------
 
 def node_env():
