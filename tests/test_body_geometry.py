@@ -346,9 +346,11 @@ def test_phase_form_matches_theta_form(drawn):
         assert_allclose(geo.ground_normal, [e[3] for e in expected], rtol=0, atol=ANGLE_ATOL)
         assert_allclose(geo.height, [e[4] for e in expected], rtol=0, atol=LENGTH_RTOL * scale)
         assert_allclose(body.phase_height(u), geo.height, rtol=0, atol=LENGTH_RTOL * scale)
-    # turning points: θ = ±θ_max, ψ = 0; periodic in u
+    # turning points: θ = ±θ_max, ψ = 0, and back; periodic in u
     turning = body.phase_geometry(np.array([math.pi / 2, -math.pi / 2]))
     assert_allclose(turning.theta, [ref.theta_max, -ref.theta_max], rtol=0, atol=ANGLE_ATOL)
+    assert_allclose(body.phase_from_theta(np.array([1.0, -1.0]) * body.theta_max),
+                    [math.pi / 2, -math.pi / 2], rtol=0, atol=1e-12)
     u = np.linspace(-math.pi, math.pi, 17)
     a0, a1 = body.phase_geometry(u), body.phase_geometry(u + 2 * math.pi)
     assert_allclose(a1.ground_normal, a0.ground_normal, rtol=0, atol=1e-13)
