@@ -46,15 +46,13 @@ CURVATURE_RTOL = 1e-6
 #: eps·size/h for V′ and eps·size/h² for V″ (matters where V is constant, e.g. the TCR).
 SLOPE_NOISE, CURVATURE_NOISE = 1e-12, 1e-10
 #: Extreme shapes (b/a ∈ {0.01, 100}, Δ/a ∈ {1e-3, 1 − 1e-6}), |η| ≤ (1 − 1e-5) η_max: unit
-#: vectors and ψ agree to ≤ 2.5e-9, lengths to ≤ 7e-11 relative. Both are limited by the
-#: code's θ_max (see test_theta_max_full_precision, xfail): with θ_max = atan2(...) the same
-#: comparison gives ≤ 3e-12 and ≤ 2e-13. ψ is ill-conditioned in θ near a turning point
-#: (ψ ~ √(θ_max − θ)), hence the 1 − 1e-5.
-EXTREME_ANGLE_ATOL = 1e-8
-EXTREME_LENGTH_RTOL = 1e-9
-#: V(θ_max) = V(0) at the extreme shapes: measured ≤ 1.6e-10 relative, limited by θ_max, which
-#: the code takes as acos(≈ −1) (see test_theta_max_full_precision, xfail).
-EXTREME_HEIGHT_RTOL = 1e-9
+#: vectors and ψ agree to ≤ 3e-12, lengths to ≤ 2e-13 relative (θ_max = atan2(...), see
+#: test_theta_max_full_precision; with acos it was 2.5e-9 and 7e-11). ψ is ill-conditioned in
+#: θ near a turning point (ψ ~ √(θ_max − θ)), hence the 1 − 1e-5.
+EXTREME_ANGLE_ATOL = 1e-10
+EXTREME_LENGTH_RTOL = 1e-11
+#: V(θ_max) = V(0) at the extreme shapes, relative (was 1.6e-10 with θ_max from acos).
+EXTREME_HEIGHT_RTOL = 1e-12
 
 SQRT2 = math.sqrt(2.0)
 
@@ -309,11 +307,6 @@ def test_theta_max_matches_q_root_named():
         assert_allclose(TwoDiskBody(*shape).theta_max, expected, rtol=0, atol=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    'body.theta_max = acos(-a²/√(...)) loses precision when cos θ_max → −1 (thin disks, small '
-    'Δ): error ≈ eps/sin θ_max, e.g. 5.0e-14 rad for (1, 0.01, 1e-3); the well-conditioned '
-    'form atan2(2b√(Δ(a+Δ)), −a²) is exact to rounding. Effect: V(θ_max) − V(0) = 1.5e-10 '
-    'relative and θ(u=0) = −1.3e-13 instead of 0 for that body.'))
 def test_theta_max_full_precision():
     for a, b, delta in [(1.0, 0.01, 1e-3), (1.0, 0.05, 0.01), (1.0, 0.01, 1e-5)]:
         body = TwoDiskBody(a, b, delta)
@@ -433,11 +426,6 @@ def test_extreme_shapes(shape):
 
 
 # -- the body's size --------------------------------------------------------------------------
-@pytest.mark.xfail(strict=True, reason=(
-    'TwoDiskBody.size is documented as "the largest distance of a disk point from G" but '
-    'returns hypot(b, Δ) when b > a; e.g. (a, b, Δ) = (1, 1.5, 0.9): size = 1.749, the '
-    'largest distance is √(b² + Δ² + a²Δ²/(b² − a²)) = 1.926, and (1, 1.01, 0.5): size = 1.128, '
-    'largest distance a + Δ = 1.5.'))
 def test_size_is_largest_distance():
     for shape in [(1.0, 1.5, 0.9), (1.0, 1.01, 0.5), (2.0, 1.0, 1.0), (1.0, 20.0, 0.5)]:
         a, b, delta = shape
@@ -470,9 +458,6 @@ def test_invalid_parameters(name, args):
     assert '> 0' in message or '<' in message
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "TwoDiskBody accepts numeric strings: TwoDiskBody('1.0', 1.0, 0.5) builds a body "
-    '(float() converts the string) where the issue asks for ValueError on strings.'))
 def test_numeric_strings_are_rejected():
     with pytest.raises(ValueError, match='^a '):
         TwoDiskBody('1.0', 1.0, 0.5)

@@ -236,10 +236,9 @@ def test_whole_cycles_extremes(shape):
     a, b, delta = shape
     cycle = _cycle(shape)
     # heights at the equilibria, exactly at the turning points too: V(0) = V(θ_max), b/√2.
-    # 1e-9: the code's θ_max is off by up to 5e-14 rad here (test_body_geometry, xfail).
     v0 = b * (a + delta) / math.sqrt(b * b + 4 * a * delta + 4 * delta * delta)
     u = np.array([-math.pi / 2, 0.0, math.pi / 2, math.pi, 1.5 * math.pi])
-    assert_allclose(cycle.state(u).position_g[:, 2], v0, rtol=1e-9)
+    assert_allclose(cycle.state(u).position_g[:, 2], v0, rtol=1e-12)
     u_half_pi = math.asin(math.pi / 2 / cycle.body.eta_max)
     assert_allclose(cycle.state(np.array([u_half_pi, math.pi - u_half_pi])).position_g[:, 2],
                     b / SQRT2, rtol=1e-12)

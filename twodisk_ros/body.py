@@ -57,6 +57,8 @@ def _sinc(x):
 
 
 def _check_parameter(name, value, low, high, rule):
+    if isinstance(value, (str, bytes)):
+        raise ValueError(f'{name} must be a real number {rule}, got {value!r}')
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -110,10 +112,11 @@ class TwoDiskBody:
         b = _check_parameter('b', b, 0.0, math.inf, '> 0 (metres)')
         delta = _check_parameter('delta', delta, 0.0, a, f'with 0 < delta < a = {a!r} (metres)')
         self.a, self.b, self.delta = a, b, delta
-        # Paper, after eq. (2): the range of θ (and ψ).
-        self._cos_theta_max = -a * a / math.sqrt(a**4 + 4 * a * delta * b * b
-                                                  + 4 * delta * delta * b * b)
-        self.theta_max = math.acos(self._cos_theta_max)
+        # Paper, after eq. (2): the range of θ (and ψ), cos θ_max = −a²/√(a⁴ + 4aΔb² + 4Δ²b²),
+        # written as atan2 (acos of ≈ −1 would lose digits for thin disks and small Δ).
+        root = math.sqrt(a**4 + 4 * a * delta * b * b + 4 * delta * delta * b * b)
+        self._cos_theta_max = -a * a / root
+        self.theta_max = math.atan2(2 * b * math.sqrt(delta * (a + delta)), -a * a)
         self._sin_theta_max = math.sin(self.theta_max)
         self._d_max = math.hypot(a * self._sin_theta_max, b * self._cos_theta_max)
 
@@ -144,8 +147,14 @@ class TwoDiskBody:
 
     @property
     def size(self):
-        """A length scale of the body (m): the largest distance of a disk point from G."""
-        return self.a + self.delta if self.a >= self.b else math.hypot(self.b, self.delta)
+        """A length scale of the body (m): the largest distance of a disk point from G.
+
+        |G − P|² = (a² − b²)c² + 2aΔc + b² + Δ² over c = cos s ∈ [−1, 1] for P on a disk.
+        """
+        a, b, d = self.a, self.b, self.delta
+        if a >= b or a * d >= b * b - a * a:
+            return a + d
+        return math.sqrt(b * b + d * d + (a * d) ** 2 / (b * b - a * a))
 
     # -- shared pieces of the closed forms ---------------------------------------------------
     def _ellipse_terms(self, cos_t, sin_t):
@@ -317,7 +326,11 @@ class TwoDiskBody:
         # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
         denom = e * e_m + x
         t = a * b * np.sin(v) / denom
-        abs_theta = tm - 2 * np.arctan(t)
+        # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
+        # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
+        near_axis = np.real(abs_eta) < 1.0
+        tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
+        abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
         j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
              * a * b * v_over_c2 * _sinc(v) / denom)
         return sign_w * abs_theta, cos_t, sign_w * sin_abs, j

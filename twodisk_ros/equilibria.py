@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from .body import complex_step
+from .tables import spectral_tail
 
 __all__ = ['Equilibrium', 'equilibria', 'stability_map', 'STABLE', 'UNSTABLE', 'NEUTRAL']
 
@@ -37,13 +38,24 @@ class Equilibrium:
     stability: str            #: 'stable', 'unstable' or 'neutral'
 
 
-def _height_phase_curvature(body, u, step=2e-3):
-    """d²z_G/du² at u: 5-point difference of the complex-step derivative (error ~ step⁴)."""
-    def slope(x):
-        return complex_step(body.phase_height, x)
-    offsets = np.array([-2, -1, 1, 2]) * step
-    values = slope(u + offsets)
-    return float((values[0] - 8 * values[1] + 8 * values[2] - values[3]) / (12 * step))
+def _height_phase_curvatures(body, phases):
+    """d²z_G/du² at the given phases: spectral derivative of the complex-step dz_G/du.
+
+    z_G is smooth and 2π-periodic in u; the grid is doubled until the upper half of the
+    spectrum of dz_G/du is below 1e-13 of its peak (or dz_G/du vanishes: the neutral case).
+    """
+    n = 256
+    while True:
+        u = 2 * math.pi * np.arange(n) / n
+        slope = complex_step(body.phase_height, u)
+        flat = np.max(np.abs(slope)) <= 1e-12 * body.size
+        if flat or spectral_tail(slope) < 1e-13 or n >= 2**17:
+            break
+        n *= 2
+    coeffs = np.fft.fft(slope) / n
+    k = np.fft.fftfreq(n, d=1.0 / n)
+    coeffs[n // 2] = 0.0
+    return [float(np.real(np.sum(1j * k * coeffs * np.exp(1j * k * p)))) for p in phases]
 
 
 def _psi_rate(body, u):
@@ -83,10 +95,10 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE):
         ('theta=-pi/2', 2 * math.pi - u_half_pi),
     ]
     found = []
-    for label, u in entries:
+    phase_curvatures = _height_phase_curvatures(body, [u for _, u in entries])
+    for (label, u), phase_curv in zip(entries, phase_curvatures):
         geo = body.phase_geometry(u)
         branch = 1 if math.cos(u) >= -1e-12 else -1
-        phase_curv = _height_phase_curvature(body, u)
         if label.startswith('turning'):
             coordinate = 'psi'
             curvature = phase_curv / _psi_rate(body, u) ** 2
