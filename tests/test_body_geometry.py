@@ -27,6 +27,7 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
+from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0
 from twodisk_ros.body import TwoDiskBody
 
 # -- tolerances (all measured with the reference below; the margin is ~100x) ----------------
@@ -184,22 +185,6 @@ class Reference:
         return np.array(thetas)
 
 
-def _paper_v0(a, b, delta):
-    """z_G at θ = 0 (m), physics notes: b(a + Δ)/√(b² + 4aΔ + 4Δ²)."""
-    return b * (a + delta) / math.sqrt(b * b + 4 * a * delta + 4 * delta * delta)
-
-
-def _paper_v2_0(a, b, delta):
-    """d²z_G/dθ² at θ = 0 (m/rad²), paper section 4 with M g = 1."""
-    return a**3 * (b * b - 2 * a * a + 2 * delta**2) / (
-        b * (b * b + 4 * a * delta + 4 * delta**2) ** 1.5)
-
-
-def _paper_v2_half_pi(a, b, delta):
-    """d²z_G/dθ² at θ = π/2 (m/rad²), paper section 4 with M g = 1."""
-    return -SQRT2 * b**3 * (b * b - 2 * a * a + 2 * delta**2) / (4 * a**4)
-
-
 def _compare_geometry(body, ref, thetas, angle_atol, length_rtol):
     for branch in (1, -1):
         expected = [ref.contact(t, branch) for t in thetas]
@@ -254,8 +239,8 @@ def _check_derivatives(shape):
     # the paper's V″(0) and V″(π/2) (section 4, M g = 1) against the differences
     v2_0, v2_90 = ref.height_derivatives(0.0)[1], ref.height_derivatives(math.pi / 2)[1]
     scale = max(abs(v2_0), abs(v2_90)) + curvature_floor / CURVATURE_RTOL
-    assert_allclose(_paper_v2_0(*shape), v2_0, rtol=0, atol=CURVATURE_RTOL * scale)
-    assert_allclose(_paper_v2_half_pi(*shape), v2_90, rtol=0, atol=CURVATURE_RTOL * scale)
+    assert_allclose(curvature_at_theta0(*shape), v2_0, rtol=0, atol=CURVATURE_RTOL * scale)
+    assert_allclose(curvature_at_half_pi(*shape), v2_90, rtol=0, atol=CURVATURE_RTOL * scale)
     assert_allclose(body.height_second_derivative(0.0), v2_0, rtol=0, atol=CURVATURE_RTOL * scale)
 
 
@@ -277,7 +262,7 @@ def test_heights_at_the_equilibria(drawn):
     shape = _shape(drawn)
     a, b, delta = shape
     body, ref = TwoDiskBody(*shape), Reference(*shape)
-    v0 = _paper_v0(*shape)
+    v0 = height_at_theta0(*shape)
     tol = LENGTH_RTOL * ref.size
     assert_allclose(ref.height(0.0), v0, rtol=0, atol=tol)
     assert_allclose(ref.height(math.pi / 2), b / SQRT2, rtol=0, atol=tol)
@@ -293,7 +278,7 @@ def test_heights_at_the_equilibria(drawn):
     assert_allclose(geo.psi[[0, 2]], 0.0, atol=ANGLE_ATOL)
     assert_allclose(geo.ground_normal[[0, 2], 2], 0.0, atol=ANGLE_ATOL)
     # V′ vanishes there; cos(π/2) is 6e-17 in floating point, so |V′| ≲ |V″|·1e-16
-    v2 = abs(_paper_v2_0(*shape)) + abs(_paper_v2_half_pi(*shape))
+    v2 = abs(curvature_at_theta0(*shape)) + abs(curvature_at_half_pi(*shape))
     assert_allclose(body.height_derivative(np.array([0.0, math.pi / 2])), 0.0,
                     atol=1e-15 * (v2 + ref.size))
 
@@ -416,7 +401,7 @@ def test_extreme_shapes(shape):
     for field in ('theta', 'psi', 'contact_a', 'contact_b', 'ground_normal', 'height', 'tilt'):
         assert np.all(np.isfinite(getattr(geo, field))), field
     assert_allclose(np.linalg.norm(geo.ground_normal, axis=-1), 1.0, rtol=1e-15)
-    v0 = _paper_v0(*shape)
+    v0 = height_at_theta0(*shape)
     assert_allclose(geo.height[:4], v0, rtol=EXTREME_HEIGHT_RTOL)
     assert_allclose(body.height(math.pi / 2), b / SQRT2, rtol=1e-14)
     assert_allclose(geo.theta[[0, 2]], [-ref.theta_max, ref.theta_max], rtol=0,

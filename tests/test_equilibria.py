@@ -18,6 +18,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
+from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0
 from twodisk_ros.body import TwoDiskBody
 from twodisk_ros.cycle import RollingCycle
 from twodisk_ros.equilibria import NEUTRAL, STABLE, UNSTABLE, equilibria, stability_map
@@ -25,15 +26,14 @@ from twodisk_ros.equilibria import NEUTRAL, STABLE, UNSTABLE, equilibria, stabil
 SQRT2 = math.sqrt(2.0)
 
 # -- tolerances ----------------------------------------------------------------------------
-#: Heights at the equilibria against the closed forms, relative: measured ≤ 2e-15 (≤ 1.5e-12 at
-#: the turning points, where the code's θ_max limits, see test_body_geometry).
+#: Heights at the equilibria against the closed forms, relative: measured ≤ 2e-15.
 HEIGHT_RTOL = 1e-10
 #: θ-family curvature against the paper's V″(0), V″(π/2): the code differentiates its V′ by
 #: complex step, measured ≤ 1e-15 relative.
 THETA_CURVATURE_RTOL = 1e-12
-#: Turning-point curvature (coordinate ψ) against V″(0): the code takes a 5-point difference
-#: (step 2e-3 in u) divided by (dψ/du)²; measured ≤ 6.5e-8 relative over b/a ∈ [0.05, 20],
-#: Δ/a ∈ [0.01, 0.99] (300 shapes; worst for b/a → 0.05, Δ/a → 0.01, where z_G(u) is sharp).
+#: Turning-point curvature (coordinate ψ) against V″(0) (disk-swap symmetry): the code divides
+#: its spectral d²z_G/du² by (dψ/du)²; measured ≤ 6.5e-8 relative with the earlier 5-point
+#: difference over b/a ∈ [0.05, 20], Δ/a ∈ [0.01, 0.99] (300 shapes).
 TURNING_CURVATURE_RTOL = 1e-6
 #: d²z_G/du² (``phase_curvature``), relative. Reference: V″(θ*)·(dθ/du)² at θ* = 0, ±π/2
 #: (exact: V′ = 0 there; dθ/du from the phase's definition), and 5-point differences of the
@@ -101,21 +101,6 @@ class PolarReference:
         return (-f[0] + 16 * f[1] - 30 * f[2] + 16 * f[3] - f[4]) / (12 * h * h)
 
 
-def _v0(a, b, delta):
-    return b * (a + delta) / math.sqrt(b * b + 4 * a * delta + 4 * delta * delta)
-
-
-def _v2_0(a, b, delta):
-    """Paper: V″(0) with M g = 1 (m/rad²)."""
-    return a**3 * (b * b - 2 * a * a + 2 * delta**2) / (
-        b * (b * b + 4 * a * delta + 4 * delta**2) ** 1.5)
-
-
-def _v2_half_pi(a, b, delta):
-    """Paper: V″(π/2) with M g = 1 (m/rad²)."""
-    return -SQRT2 * b**3 * (b * b - 2 * a * a + 2 * delta**2) / (4 * a**4)
-
-
 def _check_equilibria(shape):
     a, b, delta = shape
     body, ref = TwoDiskBody(*shape), PolarReference(*shape)
@@ -132,12 +117,12 @@ def _check_equilibria(shape):
     assert [e.branch for e in found] == [1, 1, 1, -1, -1, -1, -1, 1]
     assert_allclose([found[i].psi for i in (2, 6)], 0.0, atol=1e-9)
     # heights: V(0) at θ = 0 and at the turning points, b/√2 at θ = ±π/2
-    v0 = _v0(*shape)
+    v0 = height_at_theta0(*shape)
     expected_height = [v0, b / SQRT2, v0, b / SQRT2] * 2
     assert_allclose([e.height for e in found], expected_height, rtol=HEIGHT_RTOL)
     assert_allclose([ref.phase_height(u) for u in phases], expected_height, rtol=HEIGHT_RTOL)
     # curvature in the named coordinate
-    v2 = [_v2_0(*shape), _v2_half_pi(*shape)]
+    v2 = [curvature_at_theta0(*shape), curvature_at_half_pi(*shape)]
     for e, family in zip(found, [0, 1, None, 1, 0, 1, None, 1]):
         if family is None:
             # disk swap: the turning point in ψ is the θ = 0 equilibrium of the other disk
@@ -193,14 +178,14 @@ def test_equilibria_extremes(shape):
         for name in ('phase', 'theta', 'psi', 'height', 'curvature', 'phase_curvature'):
             assert math.isfinite(getattr(e, name)), (e.name, name)
     a, b, delta = shape
-    assert_allclose([e.height for e in found], [_v0(*shape), b / SQRT2] * 4, rtol=1e-9)
+    assert_allclose([e.height for e in found], [height_at_theta0(*shape), b / SQRT2] * 4, rtol=1e-9)
     margin = b * b - 2 * a * a + 2 * delta * delta
     zero_family = STABLE if margin > 0 else UNSTABLE
     assert found[0].stability == found[2].stability == zero_family
     assert found[1].stability != zero_family
-    assert_allclose(found[0].curvature, _v2_0(*shape), rtol=1e-12)
-    assert_allclose(found[1].curvature, _v2_half_pi(*shape), rtol=1e-12)
-    assert_allclose(found[2].curvature, _v2_0(*shape), rtol=1e-3)
+    assert_allclose(found[0].curvature, curvature_at_theta0(*shape), rtol=1e-12)
+    assert_allclose(found[1].curvature, curvature_at_half_pi(*shape), rtol=1e-12)
+    assert_allclose(found[2].curvature, curvature_at_theta0(*shape), rtol=1e-3)
 
 
 # -- the neutral case -------------------------------------------------------------------------
