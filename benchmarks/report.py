@@ -105,7 +105,9 @@ def write_report(path, ctx):
     w('## The reference\n')
     w('`benchmarks/reference.py` shares no code with `twodisk_ros`: the contact geometry '
       'is re-derived from the supporting-plane conditions (A on disk 1 by its eccentric '
-      'anomaly η = η_max sin s, B and the ground normal solved in closed form), the angular '
+      'anomaly η = η_max sin s, B and the ground normal solved in closed form; s is defined '
+      'like the package\'s phase u, so phase errors compare directly, while poses are '
+      'compared in the world frame), the angular '
       'velocity from the two no-slip contacts (ω ∥ AB, magnitude from n\' = −ω × n), the '
       'laminae inertia from the plate formulas and the parallel-axis theorem, and all '
       'derivatives (n\', n\'\', m\', V\') by truncated Taylor arithmetic (exact to rounding, '
@@ -165,8 +167,10 @@ def write_report(path, ctx):
         what = 'energy drift' if h.kind == 'rolling' else '|ω| drift'
         pkg = (f', package\'s own `energy_drift` {_e(h.drift_package)}'
                if h.kind == 'rolling' else '')
+        reps = ', '.join(f'{x:.2f}' for x in (h.walls or []))
         w(f'   - {KIND_TEXT[h.kind]}: **{h.wall:.2f} s** (simulate {h.wall_simulate:.2f} s + '
-          f'positions {h.wall_positions:.2f} s), {what} **{_e(h.drift)}**{pkg}; after '
+          f'positions {h.wall_positions:.2f} s; best of {reps} s), {what} '
+          f'**{_e(h.drift)}**{pkg}; after '
           f'{h.cycles} cycles (independent cycle time {h.cycle_time:.12f} s) phase error '
           f'{_e(h.phase_error)} rad and pose error {_e(h.position_error)} of the size at '
           f't = k·T (reference error {_e(h.reference_error)}; one ulp of 2π in the turn per '
@@ -228,7 +232,7 @@ def write_report(path, ctx):
             continue
         w(f'### {BODIES[name][3]}\n')
         w('| state | method | tol | solver | nfev | nfev per sim. s | wall/s (ms) | '
-          'simulate + positions (ms) | error / size | energy or ω drift | phase error (rad) after N |')
+          'whole run: simulate + positions (ms) | error / size | energy or ω drift | phase error (rad) after N |')
         w('|---|---|---|---|---|---|---|---|---|---|---|')
         for r in rows:
             bad = (f' ({r.bad_samples} of {r.samples} samples wrong by > 1e-3)'
