@@ -1,6 +1,6 @@
 """Work-precision runs: each method and tolerance against the independent reference."""
 
-from dataclasses import dataclass, field, asdict
+from dataclasses import dataclass, asdict
 import math
 import time
 import warnings
