@@ -41,7 +41,7 @@ __all__ = ['RollingDynamics', 'RollingMotion', 'simulate', 'METHODS', 'MODES']
 METHODS = ('direct', 'table')
 MODES = ('dynamic', 'kinematic')
 
-_FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u) in the direct method
+_FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u), times the feature width
 
 
 def _spectral_derivative(samples):
@@ -78,6 +78,8 @@ class RollingDynamics:
         self.mass = mass_properties
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
+        self._feature_width = min(1.0, body.b / body.a, body.a / body.b,
+                                  2 * math.sqrt(body.delta / body.a))
         self._build_tables(4 * self.cycle.resolution)
 
     # -- closed forms (the direct method) ---------------------------------------------------
@@ -104,9 +106,13 @@ class RollingDynamics:
         return self.mass.mass * self.gravity * complex_step(self.body.phase_height, u)
 
     def effective_mass_slope(self, u):
-        """dm/du (kg m²/rad³): 5-point difference (step 1e-3 rad) of :meth:`effective_mass`."""
+        """dm/du (kg m²/rad³): 5-point difference of :meth:`effective_mass`.
+
+        The step is 1e-3 rad times the width of the sharpest feature of the body's functions
+        of u, min(1, b/a, a/b, 2√(Δ/a)) (body module docstring).
+        """
         u = np.asarray(u, dtype=float)
-        h = _FD_STEP
+        h = _FD_STEP * self._feature_width
         m = [self.effective_mass(u + k * h) for k in (-2, -1, 1, 2)]
         return (m[0] - 8 * m[1] + 8 * m[2] - m[3]) / (12 * h)
 
@@ -218,20 +224,30 @@ class RollingMotion:
 
 
 class _Quadrature:
-    """u(t) for motion in one direction: t = s (G(u) − G(u₀)), G′ = 1/|u̇|, by Newton."""
+    """u(t) for motion in one direction, from t(u) = ∫ du / |u̇| tabulated over one cycle.
+
+    With x = s (u − u₀) ≥ 0 the distance travelled in u, τ(x) = s (G(u₀ + s x) − G(u₀)),
+    G′ = 1/|u̇|, is increasing and τ(x + 2π) = τ(x) + T. Each time is reduced to one cycle,
+    bracketed between two table nodes, and solved there by safeguarded Newton.
+    """
 
     def __init__(self, dynamics, u0, direction, inverse_speed, n):
         u = TWO_PI * np.arange(n) / n
         rate = inverse_speed(u)
+        if not np.all(np.isfinite(rate)) or np.any(rate <= 0):
+            raise RuntimeError('the motion does not advance monotonically in u over a cycle')
         mean, periodic = spectral_antiderivative(rate)
-        first = rate - mean
         second = _spectral_derivative(rate)
         self._mean = mean
         self._table = HermiteTable(0.0, TWO_PI / n, np.append(periodic, 0.0),
-                                   np.append(first, first[0]), np.append(second, second[0]))
+                                   np.append(rate - mean, rate[0] - mean),
+                                   np.append(second, second[0]))
         self._u0, self._s = float(u0), float(direction)
         self._g0 = self._antiderivative(self._u0)
         self.cycle_time = mean * TWO_PI
+        self._x_nodes = TWO_PI * np.arange(n + 1) / n
+        self._tau_nodes = self._tau(self._x_nodes)
+        self._tau_nodes[0], self._tau_nodes[-1] = 0.0, self.cycle_time
 
     def _antiderivative(self, u):
         cycles = np.floor(np.asarray(u) / TWO_PI)
@@ -241,17 +257,43 @@ class _Quadrature:
     def _rate(self, u):
         return self._table(np.mod(u, TWO_PI), derivative=1) + self._mean
 
+    def _tau(self, x):
+        return self._s * (self._antiderivative(self._u0 + self._s * x) - self._g0)
+
+    BLOCK = 65536   # samples solved at once (keeps the temporaries in cache)
+
     def __call__(self, t):
+        """(u, u̇) at times t ≥ 0 (s)."""
         t = np.asarray(t, dtype=float)
-        s = self._s
-        u = self._u0 + s * t / self._mean
-        for _ in range(50):
-            residual = s * (self._antiderivative(u) - self._g0) - t
-            step = residual / self._rate(u)
-            u = u - s * step
-            if np.max(np.abs(step), initial=0.0) < 1e-15 * (1.0 + np.max(np.abs(u))):
+        if t.size <= self.BLOCK:
+            return self._solve(t)
+        flat = t.ravel()
+        u, u_dot = np.empty_like(flat), np.empty_like(flat)
+        for start in range(0, flat.size, self.BLOCK):
+            part = slice(start, start + self.BLOCK)
+            u[part], u_dot[part] = self._solve(flat[part])
+        return u.reshape(t.shape), u_dot.reshape(t.shape)
+
+    def _solve(self, t):
+        period = self.cycle_time
+        cycles = np.floor(t / period)
+        rest = np.clip(t - cycles * period, 0.0, period)
+        nodes, taus = self._x_nodes, self._tau_nodes
+        j = np.clip(np.searchsorted(taus, rest, side='right') - 1, 0, len(nodes) - 2)
+        low, high = nodes[j], nodes[j + 1]
+        x = low + (rest - taus[j]) * (high - low) / (taus[j + 1] - taus[j])
+        for _ in range(30):
+            step = (self._tau(x) - rest) / self._rate(self._u0 + self._s * x)
+            x_new = np.clip(x - step, low, high)
+            done = np.max(np.abs(x_new - x), initial=0.0) <= 1e-13
+            x = x_new
+            if done:
                 break
-        return u, s / self._rate(u)
+        residual = np.max(np.abs(self._tau(x) - rest), initial=0.0)
+        if residual > 1e-10 * period:
+            raise RuntimeError(f'inverting t(u) failed: residual {residual:.3g} s')
+        u = self._u0 + self._s * (x + TWO_PI * cycles)
+        return u, self._s / self._rate(u)
 
 
 def _real(name, value, rule, allowed):
