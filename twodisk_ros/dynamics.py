@@ -18,8 +18,10 @@ u̇ = Ω / |ω_u(u)|). Two methods behind :func:`simulate`:
     Periodic tables of one cycle (m, V, |ω_u| with derivatives, spectral to rounding), then:
     when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
     t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
-    vectorised Newton (no time stepping, no drift); otherwise (oscillation about a stable
-    equilibrium) DOP853 on the tabulated right-hand side. ``tolerance`` is the ODE rtol.
+    bracketed Newton (no time stepping, no drift); when it oscillates in a well (E < max V),
+    the same in the angle φ of V(u(φ)) = V* + (E − V*) sin²φ (see ``_Libration``). Only
+    within 1e-6 M g L of the separatrix E = max V is DOP853 run on the tabulated right-hand
+    side, with ``tolerance`` as its rtol.
 
 A body exactly at an equilibrium with u̇ = 0 stays there (the exact solution).
 """
@@ -40,6 +42,8 @@ __all__ = ['RollingDynamics', 'RollingMotion', 'simulate', 'METHODS', 'MODES']
 
 METHODS = ('direct', 'table')
 MODES = ('dynamic', 'kinematic')
+#: solvers whose motion is known at any time without stepping (RollingMotion.solver)
+CLOSED_FORM_SOLVERS = ('quadrature', 'libration', 'rest')
 
 _FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u), times the feature width
 
@@ -167,6 +171,29 @@ class RollingDynamics:
         """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
         return [(eq, period) for eq, period in self.equilibria_with_periods()
                 if period is not None]
+
+    def well(self, u):
+        """(u*, u_low, u_high): the minimum of V in the well holding phase u, between maxima."""
+        found = sorted((eq.phase, eq.stability) for eq, _ in self.equilibria_with_periods())
+        maxima = np.array([p for p, kind in found if kind != STABLE])
+        minima = np.array([p for p, kind in found if kind == STABLE])
+        if len(maxima) == 0 or len(minima) == 0:
+            raise RuntimeError('V has no wells (neutral body): no oscillation')
+        base = TWO_PI * math.floor(u / TWO_PI)
+        edges = np.concatenate([maxima - TWO_PI, maxima, maxima + TWO_PI]) + base
+        i = np.searchsorted(edges, u, side='right')
+        low, high = edges[i - 1], edges[i]
+        centres = np.concatenate([minima - TWO_PI, minima, minima + TWO_PI]) + base
+        inside = centres[(centres > low) & (centres < high)]
+        return float(inside[0]), float(low), float(high)
+
+    def potential_curvature(self, u):
+        """d²V/du² (J/rad²) at an equilibrium phase u (spectral, as in the equilibria)."""
+        for eq in equilibria(self.body):
+            gap = abs(math.remainder(u - eq.phase, TWO_PI))
+            if gap < 1e-9:
+                return self.mass.mass * self.gravity * eq.phase_curvature
+        raise ValueError(f'u = {u!r} rad is not an equilibrium phase')
 
     def is_equilibrium(self, u):
         """True if phase u (rad) is one of the equilibria (within 1e-9 rad), or V′(u) vanishes
@@ -296,6 +323,78 @@ class _Quadrature:
         return u, self._s / self._rate(u)
 
 
+class _Libration:
+    """Oscillation in a well of V, in closed form from tables (no time stepping).
+
+    The angle φ is defined by V(u(φ)) = V* + (E − V*) sin²φ with sign(u − u*) = sign(sin φ),
+    u* the minimum of the well; then u̇ = √(2(E − V*)/m) cos φ and
+    dt/dφ = √(2 m (E − V*)) sin φ / V′(u), smooth, positive and 2π-periodic
+    (√(m/V″) at φ = 0, π). φ(t) comes from :class:`_Quadrature`, u(φ) from a table.
+    """
+
+    _GAUSS = np.polynomial.legendre.leggauss(20)
+
+    def __init__(self, dynamics, u0, u_dot0, n):
+        self._dynamics = dynamics
+        u_min, u_low, u_high = dynamics.well(u0)
+        self._u_min = u_min
+        f_min, f0 = dynamics.tabulated(u_min), dynamics.tabulated(u0)
+        rise0 = float(self._rise(np.array(u0)))
+        depth = 0.5 * f0[0] * u_dot0**2 + rise0          # E − V*, without cancellation
+        stiffness = dynamics.potential_curvature(u_min)
+        phi = TWO_PI * np.arange(n) / n
+        sin_phi, cos_phi = np.sin(phi), np.cos(phi)
+        u = self._solve_rise(depth * sin_phi**2, np.where(sin_phi >= 0, u_min, u_low),
+                             np.where(sin_phi >= 0, u_high, u_min))
+        centre = np.isclose(np.abs(sin_phi), 0.0, atol=1e-12)
+        u = np.where(centre, u_min, u)
+        f = dynamics.tabulated(u)
+        slope = dynamics.tabulated(u, derivative=1)[..., 1]
+        safe = np.where(centre, 1.0, slope)
+        amplitude = math.sqrt(2 * depth / stiffness)
+        du_dphi = np.where(centre, amplitude * cos_phi, 2 * depth * sin_phi * cos_phi / safe)
+        dt_dphi = np.where(centre, math.sqrt(f_min[0] / stiffness),
+                           np.sqrt(2 * f[..., 0] * depth) * sin_phi / safe)
+        d2u_dphi2 = _spectral_derivative(du_dphi)
+        self._u = HermiteTable(0.0, TWO_PI / n, np.append(u, u[0]),
+                               np.append(du_dphi, du_dphi[0]), np.append(d2u_dphi2, d2u_dphi2[0]))
+        sin0 = math.copysign(math.sqrt(min(1.0, max(0.0, rise0 / depth))), u0 - u_min)
+        cos0 = u_dot0 / math.sqrt(2 * depth / f0[0])
+        self._phase = _Quadrature(dynamics, math.atan2(sin0, cos0), 1.0, lambda x: dt_dphi, n)
+        self.period = self._phase.cycle_time
+
+    def _rise(self, u):
+        """V(u) − V(u*) (J) as ∫ V′ from u* (20-point Gauss): no cancellation near u*."""
+        nodes, weights = self._GAUSS
+        half = 0.5 * (np.asarray(u) - self._u_min)
+        points = self._u_min + half[..., None] * (1 + nodes)
+        slopes = self._dynamics.tabulated(points, derivative=1)[..., 1]
+        return half * np.sum(weights * slopes, axis=-1)
+
+    def _solve_rise(self, level, low, high):
+        """u in [low, high] with V(u) − V* = level, V monotone there (bisection, Newton)."""
+        dynamics, v_star = self._dynamics, float(self._dynamics.tabulated(self._u_min)[1])
+        low, high = np.array(low, float), np.array(high, float)
+        rising = high > self._u_min + 1e-15      # right side of the well: V increases
+        for _ in range(50):
+            mid = 0.5 * (low + high)
+            above = (dynamics.tabulated(mid)[..., 1] - v_star > level) == rising
+            low, high = np.where(above, low, mid), np.where(above, mid, high)
+        u = 0.5 * (low + high)
+        for _ in range(3):                          # polish with the accurate rise
+            slope = dynamics.tabulated(u, derivative=1)[..., 1]
+            step = (self._rise(u) - level) / np.where(slope == 0, 1.0, slope)
+            u = np.clip(u - np.where(slope == 0, 0.0, step), np.minimum(low, high) - 1e-9,
+                        np.maximum(low, high) + 1e-9)
+        return u
+
+    def __call__(self, t):
+        """(u, u̇) at times t ≥ 0 (s)."""
+        phi, phi_dot = self._phase(t)
+        rest = np.mod(phi, TWO_PI)
+        return self._u(rest), self._u(rest, derivative=1) * phi_dot
+
+
 def _real(name, value, rule, allowed):
     """``value`` as a float if ``allowed(value)``, else ValueError naming ``name`` and ``rule``."""
     try:
@@ -391,7 +490,7 @@ class MotionStream:
 
     def _eval(self, t):
         motion, tau = self._motion, np.asarray(t, dtype=float) - self._start
-        if motion.solver in ('quadrature', 'rest'):
+        if motion.solver in CLOSED_FORM_SOLVERS:
             return motion.sol(tau)
         y = motion.sol(tau)
         if self.mode == 'kinematic':
@@ -402,7 +501,7 @@ class MotionStream:
     def sample(self, t):
         """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
         t = np.asarray(t, dtype=float)
-        if self._motion.solver in ('quadrature', 'rest'):
+        if self._motion.solver in CLOSED_FORM_SOLVERS:
             return self._eval(t)
         pieces = []
         while True:
@@ -466,15 +565,20 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
         energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
         v_max = dynamics.potential_range[1]
         margin = energy - v_max
+        n = len(dynamics._nodes)
         if u_dot0 != 0 and margin > 1e-6 * dynamics.energy_scale:
             def inverse_speed(u):
                 f = dynamics.tabulated(u)
                 return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
-            quad = _Quadrature(dynamics, u0, math.copysign(1.0, u_dot0), inverse_speed,
-                               len(dynamics._nodes))
+            quad = _Quadrature(dynamics, u0, math.copysign(1.0, u_dot0), inverse_speed, n)
             u, u_dot = quad(t_eval)
             return _motion(dynamics, 'dynamic', method, t_eval, u, u_dot, 0, 'quadrature',
                            quad)
+        if margin < -1e-6 * dynamics.energy_scale:
+            libration = _Libration(dynamics, u0, u_dot0, n)
+            u, u_dot = libration(t_eval)
+            return _motion(dynamics, 'dynamic', method, t_eval, u, u_dot, 0, 'libration',
+                           libration)
 
         def rhs(t, y):
             f = dynamics.tabulated(y[0])
