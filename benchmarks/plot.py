@@ -40,7 +40,7 @@ def work_precision_figure(results, reference_errors, path):
                 if not pts:
                     continue
                 color = KIND_COLORS[kind]
-                quad = pts[0].solver == 'quadrature'
+                quad = pts[0].solver in ('quadrature', 'libration')
                 if quad:       # tolerance-independent: one point
                     pts = [min(pts, key=lambda r: r.wall_per_second)]
                 xs = [r.wall_per_second for r in pts]
@@ -49,7 +49,7 @@ def work_precision_figure(results, reference_errors, path):
                 style = dict(METHOD_STYLE[method])
                 label = f'{method}, {KIND_LABELS[kind]}'
                 if quad:
-                    label += ' [quadrature]'
+                    label += f' [{pts[0].solver}]'
                 (line,) = ax.plot(xs, ys, color=color, markersize=7, label=label, **style)
                 legend.setdefault(label, line)
                 for r, x, y in zip(pts, xs, ys):

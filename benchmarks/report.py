@@ -75,9 +75,10 @@ def write_report(path, ctx):
       'every run is sampled at 1 kHz (`t_eval`) and the poses of G, A and B are computed '
       'with `RollingMotion.positions()`.')
     w('- Methods: `simulate(..., method=\'direct\')` (DOP853 on the closed forms) and '
-      '`method=\'table\'` (quadrature t(u) for one-way motion — rolling over, kinematic — '
-      'with `nfev` 0 and no tolerance dependence; DOP853 on the tabulated right-hand side '
-      'when oscillating), tolerances ' + ', '.join(f'{t:.0e}' for t in ctx['tolerances']) + '.')
+      '`method=\'table\'` (closed form from tables: t(u) for one-way motion — rolling over, '
+      'kinematic — and t(φ) in the angle of the well when oscillating; `nfev` 0 and no '
+      'tolerance dependence; DOP853 on the tabulated right-hand side only next to the '
+      'separatrix), tolerances ' + ', '.join(f'{t:.0e}' for t in ctx['tolerances']) + '.')
     w('- **error** = max over the samples and over G, A, B of |x − x_ref| / `body.size`. '
       '**energy drift** (dynamic) = max |E(u, u̇) − E₀| / (M g size), with E evaluated by the '
       'reference\'s independent formulas at the method\'s (u, u̇); in kinematic mode energy is '
@@ -181,8 +182,9 @@ def write_report(path, ctx):
     if not ok2:
         w('   - Why missed: ' + ctx['target2_why'])
     ratios = ctx['ratios']
-    quad = [r for r in ratios if r.table_solver == 'quadrature']
-    ode = [r for r in ratios if r.table_solver != 'quadrature']
+    closed = ('quadrature', 'libration')
+    quad = [r for r in ratios if r.table_solver in closed]
+    ode = [r for r in ratios if r.table_solver not in closed]
 
     def passed(r):
         return r.relation in ('=', '>=') and r.ratio >= TARGET_RATIO
@@ -192,7 +194,7 @@ def write_report(path, ctx):
       'interpolated log-log to the table\'s error — when direct never gets that accurate the '
       'ratio against its most accurate run is a lower bound, ≥, and a log-log extrapolation '
       'of its last two points is noted):')
-    w(f'   - quadrature path (rolling over, kinematic): {sum(map(passed, quad))} of {len(quad)} '
+    w(f'   - closed-form paths (rolling over, kinematic, oscillating): {sum(map(passed, quad))} of {len(quad)} '
       'scenarios reach 100×: ' + ', '.join(
           f'{r.body} / {r.kind} ' + (_ratio_text(r)) for r in quad))
     if ode:
@@ -207,7 +209,8 @@ def write_report(path, ctx):
     w('| scenario | table tol | table error | table wall/s (ms) | direct wall/s at that error (ms) | ratio | note |')
     w('|---|---|---|---|---|---|---|')
     for r in ratios:
-        tol = 'any (quadrature)' if r.table_solver == 'quadrature' else f'{r.table_tolerance:.0e}'
+        tol = (f'any ({r.table_solver})' if r.table_solver in closed
+               else f'{r.table_tolerance:.0e}')
         ratio = _ratio_text(r)
         direct = (_ms(r.direct_wall_per_second) if math.isfinite(r.direct_wall_per_second)
                   else 'n/a')
@@ -215,12 +218,27 @@ def write_report(path, ctx):
           f'{_ms(r.table_wall_per_second)} | {direct} | {ratio} | {r.note} |')
     w('')
 
+    # --- recording
+    rec = ctx['recording']
+    w('## Recording to MCAP (batch run of the node)\n')
+    w(f'`roller` with `config/oloid.yaml`, `realtime:=false`, `rate:={rec.rate_hz:g}`, '
+      f'`duration:={rec.duration:g}` and `record:=FILE`, run as a process '
+      '(`benchmarks/recording_rate.py`, best of two): every topic is written '
+      '(pose, contacts, rolling_state at the rate; paths at 2 Hz with up to 1000 poses; '
+      'markers at 10 Hz; diagnostics at 1 Hz).\n')
+    w('| messages | file (MB) | wall, whole process (s) | start-up (s) | '
+      'messages per second (start-up excluded) |')
+    w('|---|---|---|---|---|')
+    w(f'| {rec.messages} | {rec.file_bytes / 1e6:.1f} | {rec.wall:.2f} | {rec.startup:.2f} | '
+      f'{rec.per_second:.0f} |')
+    w('')
+
     # --- figure
     w('## Work-precision plot\n')
     w('![work-precision](figures/work_precision.png)\n')
     w('One panel per body; x: wall time per simulated second (simulate + positions), y: max '
       'position error of G, A, B relative to the body size; circles: direct, squares: table '
-      '(the quadrature path is one point, independent of the tolerance); labels: log10 of '
+      '(the closed-form paths are one point, independent of the tolerance); labels: log10 of '
       'the tolerance; colours: the three states; dotted: the reference\'s own estimated '
       'error. Runs whose error exceeds the body size are drawn at the top edge (▲).\n')
 

@@ -14,6 +14,7 @@ from work_precision import (REFERENCE_CHECK_RTOL, REFERENCE_RTOL, position_error
                             _timed)
 
 from twodisk_ros import simulate
+from twodisk_ros.dynamics import CLOSED_FORM_SOLVERS
 
 TWO_PI = 2 * math.pi
 
@@ -292,7 +293,7 @@ def speed_ratios(results):
     for body, kind in seen:
         direct = [r for r in results if (r.body, r.kind, r.method) == (body, kind, 'direct')]
         table = [r for r in results if (r.body, r.kind, r.method) == (body, kind, 'table')]
-        if table and table[0].solver == 'quadrature':
+        if table and table[0].solver in CLOSED_FORM_SOLVERS:
             table = [min(table, key=lambda r: r.wall_per_second)]   # tolerance-independent
         for tr in table:
             if not (math.isfinite(tr.error) and tr.error < 1.0):

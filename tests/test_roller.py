@@ -454,3 +454,36 @@ def test_subprocess_batch_recording(tmp_path):
     for m in poses:
         q = m.msg.pose.orientation
         assert math.isclose(math.hypot(q.x, q.y, q.z, q.w), 1.0, abs_tol=1e-12)
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+def test_signal_finishes_the_recording(tmp_path, sig):
+    """A realtime run stopped by a signal exits 0 and leaves a complete MCAP file."""
+    target = tmp_path / 'stopped.mcap'
+    process = start_roller('-p', 'rate:=200.0', '-p', f'record:={target}')
+    try:
+        deadline = time.monotonic() + 20.0
+        while time.monotonic() < deadline and (
+                not target.exists() or target.stat().st_size < 300_000):
+            time.sleep(0.1)                  # until a few chunks have been written
+        assert target.exists(), 'no recording started'
+    finally:
+        code, stderr = stop(process, sig)
+    assert code == 0, stderr
+    recording = read_recording(target, decode=lambda topic: False)
+    assert not recording.truncated           # summary and footer written
+    counts = {topic: info.message_count for topic, info in recording.topics.items()}
+    per_sample = [counts[t] for t in ('/pose', '/contact_a', '/contact_b', '/rolling_state')]
+    assert min(per_sample) > 0 and max(per_sample) - min(per_sample) <= 1   # a sample may be cut
+    assert 'twodisk_ros' in recording.metadata and 'rosbag2' in recording.metadata
+
+
+def test_unwritable_record_path_exits_2(tmp_path):
+    missing = tmp_path / 'no' / 'such' / 'dir' / 'x.mcap'
+    result = subprocess.run(roller_command('-p', f'record:={missing}'), cwd=REPO,
+                            env=node_env(), capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(missing.parent) in lines[0]
+    assert 'Traceback' not in result.stderr
+    assert not missing.exists()
