@@ -11,15 +11,28 @@ Two ways to name a configuration are offered:
 * the paper's ``(theta, branch)``: ``branch = +1`` is the paper's half-cycle (B below the
   plane of disk 1, sin ψ > 0), ``branch = -1`` its mirror image in that plane;
 * the regular cycle parameter ``u`` (``phase``, rad): the eccentric anomaly of A is
-  η = η_max sin u (tan θ = (b/a) tan η) and ``branch = sign(cos u)``. Every quantity below is a smooth, 2π-periodic function of u,
-  also through the turning points θ = ±θ_max where θ turns back (physics notes).
+  η = η_max sin u (tan θ = (b/a) tan η) and ``branch = sign(cos u)``. Every quantity below
+  is a smooth, 2π-periodic function of u, also through the turning points θ = ±θ_max where
+  θ turns back (physics notes). The physics notes suggest θ = θ_max sin u; sweeping η
+  instead keeps the sharp features of thin disks (b/a → 0 or ∞) at width ~min(a,b)/max(a,b)
+  in u rather than its square, so far fewer table nodes are needed.
 
-Accuracy. The only near-singular quantity is ``σ√Q`` at the turning points, where Q → 0.
-It is computed from the exact factorisation Q = F1·F2 with F1 = (cos θ − cos θ_max)·L, so
-it keeps full relative precision as u → ±π/2 (no cancellation). All closed forms are
-analytic in u, so derivatives in u are taken by complex step (exact to rounding).
-Δ → 0 is singular (Q(0) = 4b²Δ(a + Δ) → 0): results stay finite for Δ/a ≥ 1e-6 but vary
-sharply near θ = 0 on a scale ~ 2(b/a)√(Δ/a) in θ.
+Accuracy (measured by the tests against independent constructions).
+
+* ``σ√Q`` is computed from the exact factorisation Q = F1·F2 with
+  F1 = (cos θ − cos θ_max)·L, so it keeps full relative precision as u → ±π/2; θ_max is
+  taken as atan2(2b√(Δ(a+Δ)), −a²) (full precision for thin disks). All closed forms are
+  analytic in u, so derivatives in u are taken by complex step (exact to rounding).
+* b/a ∈ [0.05, 20], Δ/a ∈ [0.01, 0.99]: ψ, n agree with the triple-product construction to
+  ≤ 3e-13 rad, lengths to ≤ 2e-14 of the size; no slip at A and B holds to the finite-
+  difference limit (~1e-10 of |ω|·size).
+* Extremes b/a ∈ {0.01, 100}, Δ/a ∈ {1e-3, 1 − 1e-6}: finite everywhere, also exactly at
+  the turning points; unit vectors and ψ to ≤ 3e-12, lengths to ≤ 2e-13 of the size.
+  ψ(θ) itself is ill-conditioned near the turning points (ψ ~ √(θ_max − θ)): use the
+  phase u there, in which everything is regular.
+* Δ → 0 is singular (Q(0) = 4b²Δ(a + Δ) → 0; at Δ = 0 both contacts meet on the axis):
+  the functions of u vary on a scale ~2√(Δ/a) near θ = 0, so cycle tables need more nodes
+  (4096 at Δ/a = 1e-3, resolved automatically); below Δ/a ≈ 1e-6 expect degraded accuracy.
 """
 
 from dataclasses import dataclass
