@@ -36,7 +36,7 @@ from .body import complex_step, TwoDiskBody
 from .cycle import RollingCycle, TWO_PI
 from .equilibria import equilibria, STABLE
 from .mass_models import MassProperties
-from .tables import HermiteTable, spectral_antiderivative
+from .tables import HermiteTable, spectral_antiderivative, spectral_tail
 
 __all__ = ['RollingDynamics', 'RollingMotion', 'simulate', 'METHODS', 'MODES']
 
@@ -46,6 +46,16 @@ MODES = ('dynamic', 'kinematic')
 CLOSED_FORM_SOLVERS = ('quadrature', 'libration', 'rest')
 
 _FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u), times the feature width
+
+
+def _upsample(samples, factor):
+    """Samples of a periodic function on a grid ``factor`` times finer (zero-padded FFT)."""
+    n = samples.shape[0]
+    coeffs = np.fft.rfft(samples)
+    padded = np.zeros(n * factor // 2 + 1, dtype=complex)
+    padded[:n // 2] = coeffs[:n // 2]
+    padded[n // 2] = 0.5 * coeffs[n // 2]    # split the Nyquist term symmetrically
+    return np.fft.irfft(padded, n * factor) * factor
 
 
 def _spectral_derivative(samples):
@@ -85,6 +95,7 @@ class RollingDynamics:
         self._feature_width = min(1.0, body.b / body.a, body.a / body.b,
                                   2 * math.sqrt(body.delta / body.a))
         self._build_tables(4 * self.cycle.resolution)
+        self._equilibria = None
 
     # -- closed forms (the direct method) ---------------------------------------------------
     def effective_mass(self, u):
@@ -157,15 +168,18 @@ class RollingDynamics:
         """[(Equilibrium, small-oscillation period in s or None)] for all eight equilibria.
 
         T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u).
+        Computed once per dynamics object.
         """
-        result = []
-        for eq in equilibria(self.body):
-            period = None
-            if eq.stability == STABLE and self.gravity > 0:
-                stiffness = self.mass.mass * self.gravity * eq.phase_curvature
-                period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
-            result.append((eq, period))
-        return result
+        if self._equilibria is None:
+            result = []
+            for eq in equilibria(self.body):
+                period = None
+                if eq.stability == STABLE and self.gravity > 0:
+                    stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                    period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
+                result.append((eq, period))
+            self._equilibria = result
+        return list(self._equilibria)
 
     def small_oscillation_periods(self):
         """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
@@ -189,7 +203,7 @@ class RollingDynamics:
 
     def potential_curvature(self, u):
         """d²V/du² (J/rad²) at an equilibrium phase u (spectral, as in the equilibria)."""
-        for eq in equilibria(self.body):
+        for eq, _ in self.equilibria_with_periods():
             gap = abs(math.remainder(u - eq.phase, TWO_PI))
             if gap < 1e-9:
                 return self.mass.mass * self.gravity * eq.phase_curvature
@@ -334,27 +348,25 @@ class _Libration:
 
     _GAUSS = np.polynomial.legendre.leggauss(20)
 
-    def __init__(self, dynamics, u0, u_dot0, n):
+    def __init__(self, dynamics, u0, u_dot0, max_nodes):
         self._dynamics = dynamics
-        u_min, u_low, u_high = dynamics.well(u0)
+        u_min, self._u_low, self._u_high = dynamics.well(u0)
         self._u_min = u_min
-        f_min, f0 = dynamics.tabulated(u_min), dynamics.tabulated(u0)
+        f0 = dynamics.tabulated(u0)
         rise0 = float(self._rise(np.array(u0)))
-        depth = 0.5 * f0[0] * u_dot0**2 + rise0          # E − V*, without cancellation
-        stiffness = dynamics.potential_curvature(u_min)
-        phi = TWO_PI * np.arange(n) / n
-        sin_phi, cos_phi = np.sin(phi), np.cos(phi)
-        u = self._solve_rise(depth * sin_phi**2, np.where(sin_phi >= 0, u_min, u_low),
-                             np.where(sin_phi >= 0, u_high, u_min))
-        centre = np.isclose(np.abs(sin_phi), 0.0, atol=1e-12)
-        u = np.where(centre, u_min, u)
-        f = dynamics.tabulated(u)
-        slope = dynamics.tabulated(u, derivative=1)[..., 1]
-        safe = np.where(centre, 1.0, slope)
-        amplitude = math.sqrt(2 * depth / stiffness)
-        du_dphi = np.where(centre, amplitude * cos_phi, 2 * depth * sin_phi * cos_phi / safe)
-        dt_dphi = np.where(centre, math.sqrt(f_min[0] / stiffness),
-                           np.sqrt(2 * f[..., 0] * depth) * sin_phi / safe)
+        self._depth = depth = 0.5 * f0[0] * u_dot0**2 + rise0   # E − V*, no cancellation
+        self._stiffness = dynamics.potential_curvature(u_min)
+        # resolve u(φ) spectrally on few nodes, then upsample ×4 for the Hermite tables
+        n = 128
+        while True:
+            u, du_dphi, dt_dphi = self._samples(n)
+            resolved = max(spectral_tail(du_dphi), spectral_tail(dt_dphi)) < 1e-13
+            if resolved or 4 * n >= max_nodes:
+                break
+            n *= 2
+        u = u_min + _upsample(u - u_min, 4)
+        du_dphi, dt_dphi = _upsample(du_dphi, 4), _upsample(dt_dphi, 4)
+        n *= 4
         d2u_dphi2 = _spectral_derivative(du_dphi)
         self._u = HermiteTable(0.0, TWO_PI / n, np.append(u, u[0]),
                                np.append(du_dphi, du_dphi[0]), np.append(d2u_dphi2, d2u_dphi2[0]))
@@ -362,6 +374,24 @@ class _Libration:
         cos0 = u_dot0 / math.sqrt(2 * depth / f0[0])
         self._phase = _Quadrature(dynamics, math.atan2(sin0, cos0), 1.0, lambda x: dt_dphi, n)
         self.period = self._phase.cycle_time
+
+    def _samples(self, n):
+        """u, du/dφ and dt/dφ at φ_j = 2πj/n."""
+        dynamics, u_min, depth = self._dynamics, self._u_min, self._depth
+        phi = TWO_PI * np.arange(n) / n
+        sin_phi, cos_phi = np.sin(phi), np.cos(phi)
+        u = self._solve_rise(depth * sin_phi**2, np.where(sin_phi >= 0, u_min, self._u_low),
+                             np.where(sin_phi >= 0, self._u_high, u_min))
+        centre = np.isclose(np.abs(sin_phi), 0.0, atol=1e-12)
+        u = np.where(centre, u_min, u)
+        m = dynamics.tabulated(u)[..., 0]
+        slope = dynamics.tabulated(u, derivative=1)[..., 1]
+        safe = np.where(centre, 1.0, slope)
+        amplitude = math.sqrt(2 * depth / self._stiffness)
+        du_dphi = np.where(centre, amplitude * cos_phi, 2 * depth * sin_phi * cos_phi / safe)
+        dt_dphi = np.where(centre, math.sqrt(dynamics.tabulated(u_min)[0] / self._stiffness),
+                           np.sqrt(2 * m * depth) * sin_phi / safe)
+        return u, du_dphi, dt_dphi
 
     def _rise(self, u):
         """V(u) − V(u*) (J) as ∫ V′ from u* (20-point Gauss): no cancellation near u*."""
@@ -376,7 +406,7 @@ class _Libration:
         dynamics, v_star = self._dynamics, float(self._dynamics.tabulated(self._u_min)[1])
         low, high = np.array(low, float), np.array(high, float)
         rising = high > self._u_min + 1e-15      # right side of the well: V increases
-        for _ in range(50):
+        for _ in range(30):                         # to ~1e-9 rad, then Newton
             mid = 0.5 * (low + high)
             above = (dynamics.tabulated(mid)[..., 1] - v_star > level) == rising
             low, high = np.where(above, low, mid), np.where(above, mid, high)

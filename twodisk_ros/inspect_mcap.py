@@ -93,7 +93,6 @@ __all__ = [
     'format_report',
     'inspect_recording',
     'main',
-    'plot_inspection',
 ]
 
 PROG = 'twodisk-inspect'
@@ -191,7 +190,8 @@ class Inspection:
         JSON-ready: file, truncation, duration, topics, parameters, samples.
     checks : list of Check
     series : dict of str to numpy.ndarray
-        Time series for :func:`plot_inspection` (times in s from the first stamp).
+        Time series for :func:`twodisk_ros.inspection_plot.plot_inspection` (times in s
+        from the first stamp).
     """
 
     summary: dict
@@ -1105,92 +1105,6 @@ def format_report(inspection):
     return '\n'.join(lines)
 
 
-def plot_inspection(inspection, path):
-    """Write a figure of a recording: traces on the ground, height of G, energy over time.
-
-    Parameters
-    ----------
-    inspection : Inspection
-    path : str or os.PathLike
-        PNG file to write.
-
-    Notes
-    -----
-    Uses matplotlib's object-oriented API with the Agg canvas (no pyplot, no display).  The
-    left panel shows the traces of A and B and the path of G on the ground with equal aspect,
-    as Figures 3-4 of the paper; on the right the height of G and the energy: from the
-    recorded poses (central differences), exact E(u, u̇) from the rolling state, and the
-    node's diagnostics.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    data = inspection.series
-    figure = Figure(figsize=(14, 8), layout='constrained')
-    FigureCanvasAgg(figure)
-    grid = figure.add_gridspec(3, 2, width_ratios=(1.3, 1.0))
-    ground = figure.add_subplot(grid[:, 0])
-    height = figure.add_subplot(grid[0, 1])
-    energy = figure.add_subplot(grid[1, 1], sharex=height)
-    drift = figure.add_subplot(grid[2, 1], sharex=height)
-    for role, label, style in (('contact_a', 'trace of A', dict(color='tab:red', lw=1.0)),
-                               ('contact_b', 'trace of B', dict(color='tab:blue', lw=1.0)),
-                               ('pose', 'path of G (projection)',
-                                dict(color='k', lw=1.4, ls='--'))):
-        if role in data:
-            ground.plot(data[role][:, 0], data[role][:, 1], label=label, **style)
-            ground.plot(data[role][:1, 0], data[role][:1, 1], 'o', color=style['color'], ms=4)
-    ground.set_aspect('equal', adjustable='datalim')
-    ground.set_xlabel('X (m)')
-    ground.set_ylabel('Y (m)')
-    ground.set_title('on the ground (dots: start)')
-    if 'pose' in data:
-        height.plot(data['t_pose'], data['pose'][:, 2], color='k', lw=1.0)
-    height.set_ylabel('z_G (m)')
-    height.set_title('height of G')
-    scale = float(data['energy_scale']) if 'energy_scale' in data else None
-    if 't_fd' in data:
-        total = data['kinetic_fd'] + data['potential_fd']
-        energy.plot(data['t_fd'], total, color='k', lw=1.2, label='E from poses (FD)')
-        energy.plot(data['t_fd'], data['kinetic_fd'], color='tab:orange', lw=0.8, label='T')
-        energy.plot(data['t_fd'], data['potential_fd'], color='tab:green', lw=0.8,
-                    label='V = M g z_G')
-        drift.plot(data['t_fd'], (total - total[0]) / scale, color='k', lw=1.0,
-                   label='from poses (FD)')
-    if 't_model' in data:
-        exact = data['energy_model']
-        energy.plot(data['t_model'], exact, color='tab:purple', lw=0.8, ls=':',
-                    label='E(u, u̇) of rolling_state')
-        drift.plot(data['t_model'], (exact - exact[0]) / scale, color='tab:purple', lw=0.8,
-                   ls=':', label='E(u, u̇) of rolling_state')
-    if 't_diagnostics' in data:
-        recorded = data['energy_diagnostics']
-        energy.plot(data['t_diagnostics'], recorded, 's', ms=3, color='tab:red',
-                    label='diagnostics')
-        if scale:
-            drift.plot(data['t_diagnostics'], (recorded - recorded[0]) / scale, 's', ms=3,
-                       color='tab:red', label='diagnostics')
-    energy.set_ylabel('energy (J)')
-    drift.set_ylabel('(E − E₀) / (M g L)')
-    drift.set_xlabel('t (s)')
-    for axes in (ground, height, energy, drift):
-        axes.grid(True, lw=0.3)
-        if len(axes.lines) > 1:
-            axes.legend(loc='best', fontsize='small')
-    summary = inspection.summary
-    params = summary['parameters']
-    title = os.path.basename(summary['file'])
-    if params:
-        title += (f" — a = {params.get('a')}, b = {params.get('b')}, "
-                  f"delta = {params.get('delta')} m, {params.get('mass_model')}, "
-                  f"{params.get('mode')}")
-    title += ' — ' + ('all checks pass' if inspection.passed else 'CHECKS FAIL')
-    if summary['truncated']:
-        title += ' (truncated file)'
-    figure.suptitle(title)
-    figure.savefig(path, dpi=110)
-
-
 # --------------------------------------------------------------------------------------------
 # Command line.
 
@@ -1244,6 +1158,7 @@ def main(argv=None):
         _print(format_report(inspection))
     if args.plot:
         try:
+            from .inspection_plot import plot_inspection
             plot_inspection(inspection, args.plot)
         except (OSError, ValueError) as error:
             print(f'{PROG}: cannot write plot {args.plot}: {" ".join(str(error).split())}',
