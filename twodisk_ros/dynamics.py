@@ -252,7 +252,11 @@ class RollingMotion:
 
     @property
     def energy_drift(self):
-        """max |E − E₀| over the samples, relative to :attr:`RollingDynamics.energy_scale`."""
+        """max |E − E₀| over the samples, relative to :attr:`RollingDynamics.energy_scale`.
+
+        A conservation check in dynamic mode only: in kinematic mode the motor does work and
+        E changes along the cycle by design.
+        """
         return float(np.max(np.abs(self.energy - self.energy[0]))) / self.dynamics.energy_scale
 
     def positions(self):
