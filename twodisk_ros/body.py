@@ -171,9 +171,9 @@ class TwoDiskBody:
 
     # -- shared pieces of the closed forms ---------------------------------------------------
     def _ellipse_terms(self, cos_t, sin_t):
+        """D = √(a² sin²θ + b² cos²θ) (m), the denominator of the polar ellipse ρ = ab/D."""
         a, b = self.a, self.b
-        d = np.sqrt(a * a * sin_t * sin_t + b * b * cos_t * cos_t)
-        return d
+        return np.sqrt(a * a * sin_t * sin_t + b * b * cos_t * cos_t)
 
     def _q_cofactor(self, cos_t, d):
         """L·F2 where Q = (cos θ − cos θ_max)·L·F2 (exact factorisation, see module doc)."""
