@@ -487,3 +487,23 @@ def test_unwritable_record_path_exits_2(tmp_path):
     assert len(lines) == 1 and str(missing.parent) in lines[0]
     assert 'Traceback' not in result.stderr
     assert not missing.exists()
+
+
+def test_two_changes_before_a_tick_both_apply():
+    """Parameter changes queued between two samples are merged, not the last one alone."""
+    harness = Harness([Parameter('rate', value=RATE)])
+    try:
+        assert harness.spin(3.0, until=lambda: len(harness.got['pose']) >= 3)
+        (first,) = harness.node.set_parameters([Parameter('delta', value=0.06)])
+        (second,) = harness.node.set_parameters([Parameter('omega0', value=1.0)])
+        assert first.successful and second.successful
+        assert harness.spin(2.0, until=lambda: harness.node._pending is None)
+        settings = harness.node.settings
+        assert settings.delta == 0.06 and settings.omega0 == 1.0
+        # a change is judged against the queued ones: delta 0.08 is queued, so a = 0.07
+        # (fine with the applied delta 0.06) must be refused
+        (third,) = harness.node.set_parameters([Parameter('delta', value=0.08)])
+        (fourth,) = harness.node.set_parameters([Parameter('a', value=0.07)])
+        assert third.successful and fourth.successful is False and 'delta' in fourth.reason
+    finally:
+        harness.close()

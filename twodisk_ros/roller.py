@@ -125,8 +125,9 @@ class Roller(Node):
 
     def _on_set_parameters(self, parameters):
         changes = {p.name: p.value for p in parameters if p.name in _DESCRIPTIONS}
+        base = self._pending or self.settings   # changes not yet applied still count
         try:
-            candidate = self.settings.with_values(**changes).checked()
+            candidate = base.with_values(**changes).checked()
         except (ValueError, TypeError) as error:
             return SetParametersResult(successful=False, reason=str(error))
         self._pending = candidate
