@@ -144,6 +144,9 @@ class RollingDynamics:
         close = np.concatenate
         self._table = HermiteTable(0.0, TWO_PI / n, close([values, values[:1]]),
                                    close([first, first[:1]]), close([second, second[:1]]))
+        # V alone, for the level searches of oscillations (a third of the work)
+        self._potential = HermiteTable(0.0, TWO_PI / n, close([v, v[:1]]),
+                                       close([dv, dv[:1]]), close([second[:, 1], second[:1, 1]]))
         self._nodes = u
         self.potential_range = (float(v.min()), float(v.max()))
 
@@ -151,6 +154,10 @@ class RollingDynamics:
         """(m, V, |ω_u|) at phase(s) u from the tables, shape u.shape + (3,)."""
         u = np.asarray(u, dtype=float)
         return self._table(np.mod(u, TWO_PI), derivative)
+
+    def tabulated_potential(self, u, derivative=0):
+        """V(u) (J) or V′(u) (J/rad) from the tables."""
+        return self._potential(np.mod(np.asarray(u, dtype=float), TWO_PI), derivative)
 
     # -- derived quantities -----------------------------------------------------------------
     def energy(self, u, u_dot):
@@ -402,24 +409,36 @@ class _Libration:
         nodes, weights = self._GAUSS
         half = 0.5 * (np.asarray(u) - self._u_min)
         points = self._u_min + half[..., None] * (1 + nodes)
-        slopes = self._dynamics.tabulated(points, derivative=1)[..., 1]
+        slopes = self._dynamics.tabulated_potential(points, derivative=1)
         return half * np.sum(weights * slopes, axis=-1)
 
     def _solve_rise(self, level, low, high):
-        """u in [low, high] with V(u) − V* = level, V monotone there (bisection, Newton)."""
-        dynamics, v_star = self._dynamics, float(self._dynamics.tabulated(self._u_min)[1])
-        low, high = np.array(low, float), np.array(high, float)
-        rising = high > self._u_min + 1e-15      # right side of the well: V increases
-        for _ in range(30):                         # to ~1e-9 rad, then Newton
-            mid = 0.5 * (low + high)
-            above = (dynamics.tabulated(mid)[..., 1] - v_star > level) == rising
-            low, high = np.where(above, low, mid), np.where(above, mid, high)
-        u = 0.5 * (low + high)
-        for _ in range(3):                          # polish with the accurate rise
-            slope = dynamics.tabulated(u, derivative=1)[..., 1]
-            step = (self._rise(u) - level) / np.where(slope == 0, 1.0, slope)
-            u = np.clip(u - np.where(slope == 0, 0.0, step), np.minimum(low, high) - 1e-9,
-                        np.maximum(low, high) + 1e-9)
+        """u in [low, high] with V(u) − V* = level, V monotone there.
+
+        Safeguarded Newton (bisection when a step leaves the bracket) on the tabulated V,
+        then two Newton steps on the Gauss-integrated rise (accurate near u*).
+        """
+        dynamics, u_min = self._dynamics, self._u_min
+        v_star = float(dynamics.tabulated_potential(u_min))
+        lo, hi = np.minimum(low, high).astype(float), np.maximum(low, high).astype(float)
+        orient = np.where(np.asarray(high) > u_min + 1e-15, 1.0, -1.0)   # g increasing in u
+        u = 0.5 * (lo + hi)
+        for _ in range(100):
+            g = orient * (dynamics.tabulated_potential(u) - v_star - level)
+            dg = orient * dynamics.tabulated_potential(u, derivative=1)
+            lo, hi = np.where(g < 0, u, lo), np.where(g > 0, u, hi)
+            newton = u - g / np.where(dg > 0, dg, 1.0)
+            inside = (dg > 0) & (newton > lo) & (newton < hi)
+            u_new = np.where(inside, newton, 0.5 * (lo + hi))
+            done = np.max(np.abs(u_new - u), initial=0.0) <= 1e-14
+            u = u_new
+            if done:
+                break
+        for _ in range(2):
+            slope = dynamics.tabulated_potential(u, derivative=1)
+            step = np.where(slope == 0, 0.0, (self._rise(u) - level)
+                            / np.where(slope == 0, 1.0, slope))
+            u = np.clip(u - step, lo - 1e-12, hi + 1e-12)
         return u
 
     def __call__(self, t):
