@@ -178,7 +178,8 @@ def test_equilibria_extremes(shape):
         for name in ('phase', 'theta', 'psi', 'height', 'curvature', 'phase_curvature'):
             assert math.isfinite(getattr(e, name)), (e.name, name)
     a, b, delta = shape
-    assert_allclose([e.height for e in found], [height_at_theta0(*shape), b / SQRT2] * 4, rtol=1e-9)
+    assert_allclose([e.height for e in found], [height_at_theta0(*shape), b / SQRT2] * 4,
+                    rtol=1e-9)
     margin = b * b - 2 * a * a + 2 * delta * delta
     zero_family = STABLE if margin > 0 else UNSTABLE
     assert found[0].stability == found[2].stability == zero_family

@@ -273,7 +273,8 @@ class TwoDiskBody:
         theta = self._theta_array(theta)
         a, b = self.a, self.b
         s, c = np.sin(theta), np.cos(theta)
-        return a * b * np.sqrt(a**4 * s * s + b**4 * c * c) / (a * a * s * s + b * b * c * c) ** 1.5
+        d2 = a * a * s * s + b * b * c * c
+        return a * b * np.sqrt(a**4 * s * s + b**4 * c * c) / d2**1.5
 
     def height(self, theta):
         """z_G = V/(M g) (m), the same on both branches (paper, section 4)."""

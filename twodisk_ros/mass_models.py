@@ -43,7 +43,6 @@ analyticity strip narrows like ``sqrt(delta / a)`` (about 2 000 nodes for ``delt
 """
 
 import math
-import numbers
 from dataclasses import dataclass, fields
 
 import numpy as np
