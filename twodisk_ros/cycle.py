@@ -214,7 +214,7 @@ class RollingCycle:
             return tuple(array.reshape(u.shape + (3,)) for array in out)
         return self._positions(u)
 
-    def _positions(self, u):
+    def _positions(self, u, with_heading=False):
         cycles, rest = self._split(u)
         turn, shift = self.displacement.power(cycles)
         f = self._table(rest)
@@ -225,9 +225,10 @@ class RollingCycle:
         z_g = z_a - c * (f[..., 3] + 1j * f[..., 4])
         z_b = z_g + c * (f[..., 6] + 1j * f[..., 7])
         zeros = np.zeros_like(turn)
-        return (np.stack([z_g.real, z_g.imag, -f[..., 5]], -1),
-                np.stack([z_a.real, z_a.imag, zeros], -1),
-                np.stack([z_b.real, z_b.imag, zeros], -1))
+        result = (np.stack([z_g.real, z_g.imag, -f[..., 5]], -1),
+                  np.stack([z_a.real, z_a.imag, zeros], -1),
+                  np.stack([z_b.real, z_b.imag, zeros], -1))
+        return result + (f[..., 0] + turn,) if with_heading else result
 
     def heading(self, u):
         """α(u) (rad): direction of motion of A on the ground, α(0) = 0."""
@@ -247,9 +248,8 @@ class RollingCycle:
         """The body's state at phase(s) u (rad, any real value, also many cycles ahead)."""
         u = np.asarray(u, dtype=float)
         geo = self.body.phase_geometry(u)
-        alpha = self.heading(u)
+        g_world, a_world, b_world, alpha = self._positions(u, with_heading=True)
         rotation = self._rotation(alpha, geo.tangent_a, geo.ground_normal)
-        g_world, a_world, b_world = self.positions(u)
         return RollingState(phase=u, theta=geo.theta, psi=geo.psi, branch=geo.branch,
                             tilt=geo.tilt, heading=alpha, position_g=g_world,
                             contact_a=a_world, contact_b=b_world, rotation=rotation)
