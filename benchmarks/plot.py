@@ -8,6 +8,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from scenarios import BODIES  # noqa: E402
 
+from twodisk_ros.dynamics import CLOSED_FORM_SOLVERS  # noqa: E402
+
 KIND_COLORS = {'rolling': '#1f77b4', 'oscillating': '#d62728', 'kinematic': '#2ca02c'}
 KIND_LABELS = {'rolling': 'dynamic, rolling over', 'oscillating': 'dynamic, oscillating',
                'kinematic': 'kinematic (|ω| const.)'}
@@ -40,7 +42,7 @@ def work_precision_figure(results, reference_errors, path):
                 if not pts:
                     continue
                 color = KIND_COLORS[kind]
-                quad = pts[0].solver in ('quadrature', 'libration')
+                quad = pts[0].solver in CLOSED_FORM_SOLVERS
                 if quad:       # tolerance-independent: one point
                     pts = [min(pts, key=lambda r: r.wall_per_second)]
                 xs = [r.wall_per_second for r in pts]

@@ -4,6 +4,8 @@ import math
 
 from scenarios import BODIES, GRAVITY, MASS
 
+from twodisk_ros.dynamics import CLOSED_FORM_SOLVERS
+
 KIND_TEXT = {'rolling': 'dynamic, rolling over', 'oscillating': 'dynamic, oscillating',
              'kinematic': 'kinematic'}
 TARGET_RATE = 1e6
@@ -182,7 +184,7 @@ def write_report(path, ctx):
     if not ok2:
         w('   - Why missed: ' + ctx['target2_why'])
     ratios = ctx['ratios']
-    closed = ('quadrature', 'libration')
+    closed = CLOSED_FORM_SOLVERS
     quad = [r for r in ratios if r.table_solver in closed]
     ode = [r for r in ratios if r.table_solver not in closed]
 
