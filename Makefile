@@ -30,7 +30,7 @@ demo: venv
 
 ## The paper's figures, whole cycles, the height of G and the stability map (PNG).
 figures: venv
-	$(PY) -m twodisk_ros.figures --out docs/figures
+	$(PY) -m twodisk_ros.plotting.figures --out docs/figures
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
 bench: venv

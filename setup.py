@@ -22,9 +22,9 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'roller = twodisk_ros.roller:main',
-            'twodisk-inspect = twodisk_ros.inspect_mcap:main',
-            'twodisk-figures = twodisk_ros.figures:main',
+            'roller = twodisk_ros.node.roller:main',
+            'twodisk-inspect = twodisk_ros.inspect.cli:main',
+            'twodisk-figures = twodisk_ros.plotting.figures:main',
         ],
     },
 )

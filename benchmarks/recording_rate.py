@@ -13,7 +13,7 @@ import sys
 import tempfile
 import time
 
-from twodisk_ros.recording import read_recording
+from twodisk_ros.io import read_recording
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

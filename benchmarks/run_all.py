@@ -36,7 +36,7 @@ from report import write_report, TARGET_RATE, TARGET_POS_ERROR, TARGET_RATIO  # 
 from reference import ReferenceBody  # noqa: E402
 
 from twodisk_ros import TwoDiskBody  # noqa: E402
-from twodisk_ros.dynamics import CLOSED_FORM_SOLVERS  # noqa: E402
+from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 from recording_rate import recording_throughput  # noqa: E402
 
 

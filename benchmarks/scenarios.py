@@ -1,6 +1,6 @@
 """The bodies and initial states of the benchmark.
 
-Every initial state is a (θ0, branch, ω0) triple as taken by ``twodisk_ros.dynamics.simulate``;
+Every initial state is a (θ0, branch, ω0) triple as taken by ``twodisk_ros.physics.simulate``;
 the reference maps it to its own phase with its own formulas.
 """
 

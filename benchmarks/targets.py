@@ -14,7 +14,7 @@ from work_precision import (REFERENCE_CHECK_RTOL, REFERENCE_RTOL, position_error
                             _timed)
 
 from twodisk_ros import simulate
-from twodisk_ros.dynamics import CLOSED_FORM_SOLVERS
+from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS
 
 TWO_PI = 2 * math.pi
 

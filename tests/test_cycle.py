@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.cycle`: whole rolling cycles in the world frame.
+"""Tests of :mod:`twodisk_ros.physics.cycle`: whole rolling cycles in the world frame.
 
 World frame (m): Z up, the ground is Z = 0; ``state.rotation`` maps body → world.
 References never come from the code under test:
@@ -29,8 +29,8 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from twodisk_ros.body import TwoDiskBody
-from twodisk_ros.cycle import RollingCycle, integrate_contact_trace
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
 
 TWO_PI = 2 * math.pi
 SQRT2, SQRT3 = math.sqrt(2.0), math.sqrt(3.0)

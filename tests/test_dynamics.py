@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.dynamics` against independent references.
+"""Tests of :mod:`twodisk_ros.physics.dynamics` against independent references.
 
 Nothing here compares the module with its own output. The references are:
 
@@ -30,11 +30,11 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.interpolate import CubicSpline
 
-from twodisk_ros.body import TwoDiskBody
-from twodisk_ros.cycle import RollingCycle, integrate_contact_trace
-from twodisk_ros.dynamics import MotionStream, RollingDynamics, simulate, simulate_phase
-from twodisk_ros.equilibria import STABLE, UNSTABLE, equilibria
-from twodisk_ros.mass_models import laminae, solid_hull
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
+from twodisk_ros.physics import MotionStream, RollingDynamics, simulate, simulate_phase
+from twodisk_ros.physics.equilibria import STABLE, UNSTABLE, equilibria
+from twodisk_ros.physics.mass_models import laminae, solid_hull
 
 # ----------------------------------------------------------------------------- constants
 

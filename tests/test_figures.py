@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.figures`: files written, and plotted data against closed forms."""
+"""Tests of :mod:`twodisk_ros.plotting.figures`: files written, and plotted data against closed forms."""
 
 import math
 import struct
@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from numpy.testing import assert_allclose  # noqa: E402
 
-from twodisk_ros import figures  # noqa: E402
-from twodisk_ros.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.plotting import figures  # noqa: E402
+from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
 
 EXPECTED = ['figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png']
 PNG_SIGNATURE = b'\x89PNG\r\n\x1a\n'
@@ -98,8 +98,8 @@ def test_stability_map_neutral_curve():
 
 
 def test_core_does_not_import_matplotlib():
-    code = ('import sys; import twodisk_ros.body, twodisk_ros.cycle, twodisk_ros.equilibria, '
-            'twodisk_ros.tables; print("matplotlib" in sys.modules)')
+    code = ('import sys; import twodisk_ros.physics; '
+            'import twodisk_ros.physics.tables; print("matplotlib" in sys.modules)')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == 'False'

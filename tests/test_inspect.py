@@ -25,11 +25,12 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
-from twodisk_ros import inspect_mcap  # noqa: E402
-from twodisk_ros.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.dynamics import RollingDynamics, simulate  # noqa: E402
-from twodisk_ros.mass_models import mass_properties  # noqa: E402
-from twodisk_ros.recording import McapRecorder, read_recording  # noqa: E402
+from twodisk_ros.inspect import cli as inspect_cli  # noqa: E402
+from twodisk_ros.inspect import finite_differences, inspect_recording  # noqa: E402
+from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
+from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.io import McapRecorder, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -153,13 +154,13 @@ def write_run(path, run, params, *, namespace='/roller', skip=(), late=None,
 
 
 def run_main(capsys, *argv):
-    status = inspect_mcap.main([str(arg) for arg in argv])
+    status = inspect_cli.main([str(arg) for arg in argv])
     out = capsys.readouterr()
     return status, out.out, out.err
 
 
 def checks_of(path):
-    return {check.name: check for check in inspect_mcap.inspect_recording(path).checks}
+    return {check.name: check for check in inspect_recording(path).checks}
 
 
 @pytest.fixture(scope='module')
@@ -240,7 +241,7 @@ def test_finite_differences_are_fourth_order():
         t = np.arange(0.0, 1.0, step)
         t = t + 1e-3 * step * np.sin(7 * t)   # stamps within 1 % of the step, not uniform
         position = np.stack([np.sin(3 * t), t**3, np.cos(t)], axis=1)
-        index, velocity, omega = inspect_mcap.finite_differences(
+        index, velocity, omega = finite_differences(
             t, position, Rotation.from_rotvec(spin(t)), step)
         assert index[0] == 2 and index[-1] == t.size - 3
         exact_v = np.stack([3 * np.cos(3 * t), 3 * t**2, -np.sin(t)], axis=1)[index]

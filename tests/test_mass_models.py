@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.mass_models` against independent references.
+"""Tests of :mod:`twodisk_ros.physics.mass_models` against independent references.
 
 Body frame ``G e1 e2 e3`` (m): disk 1 in ``x3 = 0`` centred at ``(0, -delta, 0)``, disk 2 in
 ``x1 = 0`` centred at ``(0, +delta, 0)``, semi-axis ``a`` along e2 and ``b`` across.
@@ -10,7 +10,6 @@ ellipses, split into tetrahedra with exact moments.
 
 import dataclasses
 import math
-import time
 
 import numpy as np
 import pytest
@@ -21,8 +20,8 @@ from scipy.integrate import dblquad
 from scipy.spatial import ConvexHull
 from scipy.special import ellipe, ellipk
 
-from twodisk_ros import mass_models
-from twodisk_ros.mass_models import MassProperties, custom, laminae, mass_properties, solid_hull
+from twodisk_ros.physics import hull, mass_models
+from twodisk_ros.physics.mass_models import MassProperties, custom, laminae, mass_properties, solid_hull
 
 # Oloid volume / r**3 = (2/3) (2 E(m) + K(m)) with parameter m = 3/4 (Dirnboeck & Stachel 1997,
 # "The development of the oloid"; numerically 3.0524184684...). Its surface area is 4 pi r**2.
@@ -96,7 +95,7 @@ def test_oloid_volume_matches_closed_form():
 def test_oloid_surface_area_is_that_of_the_sphere():
     # Checks the ruled surface (both sheets, both ends) that the solid is built from.
     for r in (1.0, 0.04):
-        area = mass_models._hull_surface_area(r, r, r / 2.0, n=256)
+        area = hull.hull_surface_area(r, r, r / 2.0, n=256)
         assert_allclose(area, 4.0 * np.pi * r * r, rtol=1e-12)
 
 
@@ -158,12 +157,10 @@ def test_solid_limit_of_coinciding_centres(a, b):
 
 
 @pytest.mark.parametrize('a, b, delta', EXTREMES + [(1.0, 1.0, 0.5)])
-def test_solid_extremes_converge_fast(a, b, delta):
-    start = time.perf_counter()
+def test_solid_extremes_converge(a, b, delta):
+    # (its cost is measured in benchmarks: `make bench`, docs/benchmarks.md)
     props = solid_hull(a, b, delta, 1.0, rtol=1e-9)
-    elapsed = time.perf_counter() - start
     assert props.relative_error <= 1e-9
-    assert elapsed < 0.5  # measured a few ms; generous for loaded CI machines
     # A tighter tolerance only refines the result within the looser one.
     fine = solid_hull(a, b, delta, 1.0, rtol=1e-12)
     assert fine.relative_error <= 1e-12

@@ -38,9 +38,8 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import ColorRGBA, Header  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
-from twodisk_ros import _msgdefs  # noqa: E402
-from twodisk_ros import recording  # noqa: E402
-from twodisk_ros.recording import McapRecorder, RecordingError, read_recording  # noqa: E402
+from twodisk_ros.io import msgdefs, rosbag2_metadata, writer  # noqa: E402
+from twodisk_ros.io import McapRecorder, RecordingError, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -180,7 +179,7 @@ def test_read_recording_gives_the_same_messages(tmp_path):
     assert rec.recovered_bytes == rec.total_bytes == path.stat().st_size
     assert [(m.topic, m.log_time_ns) for m in rec.messages] == [(t, s) for t, s, _ in written]
     for (topic, _, msg), got in zip(written, rec.messages):
-        assert got.type_name == recording._msgdefs.ros_type_name(type(msg))
+        assert got.type_name == msgdefs.ros_type_name(type(msg))
         assert_same(msg, got.msg, topic)
     assert rec.topics['/markers'].type_name == 'visualization_msgs/msg/MarkerArray'
     assert {t: i.message_count for t, i in rec.topics.items()} == {t: 5 for t in SAMPLES}
@@ -291,8 +290,8 @@ def test_pose_stamped_schema_follows_rosbag2_rule(tmp_path):
 
 @pytest.mark.parametrize('msg_type', [t for t, _ in SAMPLES.values()])
 def test_every_sample_schema_follows_rosbag2_rule(msg_type):
-    name = _msgdefs.ros_type_name(msg_type)
-    assert _msgdefs.full_text(name).decode() == expected_definition(name, set())
+    name = msgdefs.ros_type_name(msg_type)
+    assert msgdefs.full_text(name).decode() == expected_definition(name, set())
 
 
 def test_one_schema_per_type(tmp_path):
@@ -312,9 +311,9 @@ def test_definitions_found_through_ament_prefix_path(tmp_path, monkeypatch):
     msg_dir.mkdir(parents=True)
     (msg_dir / 'Header.msg').write_bytes(b'# overlay\nstring frame_id\n')
     monkeypatch.setenv('AMENT_PREFIX_PATH', os.pathsep.join([str(tmp_path), '/nonexistent']))
-    assert _msgdefs.full_text('std_msgs/msg/Header') == b'# overlay\nstring frame_id\n'
+    assert msgdefs.full_text('std_msgs/msg/Header') == b'# overlay\nstring frame_id\n'
     monkeypatch.delenv('AMENT_PREFIX_PATH')
-    assert _msgdefs.full_text('std_msgs/msg/Header').startswith(b'# Standard metadata')
+    assert msgdefs.full_text('std_msgs/msg/Header').startswith(b'# Standard metadata')
 
 
 # ------------------------------------------------------------------------------------------
@@ -428,7 +427,7 @@ def test_set_metadata_replaces_what_close_writes(tmp_path):
 @given(st.text(max_size=40))
 def test_metadata_yaml_reads_back_any_string(text):
     tree = {'name': text, 'list': [text, {'k': text}], 'empty': [], 'none': None}
-    assert yaml.safe_load(recording._dump(tree)) == tree
+    assert yaml.safe_load(rosbag2_metadata.dump_yaml(tree)) == tree
 
 
 # ------------------------------------------------------------------------------------------
@@ -490,7 +489,7 @@ def test_unwritable_paths_raise_at_construction(tmp_path, monkeypatch):
     def refuse(*args, **kwargs):
         raise PermissionError(13, 'Permission denied', str(denied))
 
-    monkeypatch.setattr(recording, 'open', refuse, raising=False)
+    monkeypatch.setattr(writer, 'open', refuse, raising=False)
     with pytest.raises(RecordingError) as error:
         McapRecorder(denied)
     assert_one_line_naming(error, denied, 'permission denied')
@@ -551,7 +550,7 @@ def test_truncated_files_keep_every_complete_chunk(tmp_path):
 KILLED_WRITER = textwrap.dedent("""
     import sys, time
     from geometry_msgs.msg import PoseStamped
-    from twodisk_ros.recording import McapRecorder
+    from twodisk_ros.io import McapRecorder
 
     path, count, flush = sys.argv[1], int(sys.argv[2]), sys.argv[3] == 'flush'
     rec = McapRecorder(path, chunk_size=8192, metadata={'run': 'killed'})

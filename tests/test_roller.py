@@ -32,10 +32,10 @@ from nav_msgs.msg import Path as PathMsg  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from visualization_msgs.msg import MarkerArray  # noqa: E402
 
-from twodisk_ros.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.equilibria import equilibria  # noqa: E402
-from twodisk_ros.recording import read_recording  # noqa: E402
-from twodisk_ros.roller import Roller  # noqa: E402
+from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.equilibria import equilibria  # noqa: E402
+from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.node.roller import Roller  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

@@ -1,15 +1,21 @@
 """twodisk_ros: rolling of a rigid body made of two elliptic disks in perpendicular planes.
 
-The physics (``body``, ``cycle``, ``equilibria``, ``mass_models``, ``dynamics``) is pure
-numpy/scipy and imports without rclpy; ``roller`` is the ROS 2 node, ``recording`` the MCAP
-layer and ``inspect_mcap`` the offline checker.
+Folders are the architecture:
+
+- :mod:`twodisk_ros.physics`: the body, its cycle, equilibria, mass models and dynamics
+  (numpy/scipy only; imports without rclpy or matplotlib);
+- :mod:`twodisk_ros.io`: MCAP recordings in rosbag2's layout (writer and tolerant reader);
+- :mod:`twodisk_ros.node`: the ``roller`` node, its parameters and its messages;
+- :mod:`twodisk_ros.inspect`: ``twodisk-inspect``, the offline checks of a recording;
+- :mod:`twodisk_ros.plotting`: every figure (matplotlib).
+
+The physics is re-exported here: ``from twodisk_ros import TwoDiskBody, simulate``.
 """
 
-from .body import PhaseGeometry, TwoDiskBody
-from .cycle import CycleDisplacement, RollingCycle, RollingState, integrate_contact_trace
-from .dynamics import RollingDynamics, RollingMotion, simulate
-from .equilibria import Equilibrium, equilibria, stability_map
-from .mass_models import MassProperties, mass_properties
+from .physics import (CycleDisplacement, Equilibrium, MassProperties, PhaseGeometry,
+                      RollingCycle, RollingDynamics, RollingMotion, RollingState, TwoDiskBody,
+                      equilibria, integrate_contact_trace, mass_properties, simulate,
+                      stability_map)
 
 __version__ = '0.1.0'
 

@@ -1,9 +1,10 @@
-"""Equilibria of the body on the plane and their stability (paper, section 4, and the notes).
+"""Equilibria of the body on the plane and their stability (paper, section 4).
 
 Over one cycle the height of G, z_G(u), has eight critical points: θ = 0 on both branches
 (ψ = ±ψ_max), θ = ±π/2 on both branches, and the two turning points θ = ±θ_max (ψ = 0).
 The turning points are equivalent to θ = 0 by the symmetry that swaps the disks, so their
-natural coordinate is ψ. Stability alternates with the sign of b² − 2a² + 2Δ².
+natural coordinate is ψ. Stability alternates with the sign of b² − 2a² + 2Δ²
+(docs/physics.md#equilibria-and-their-stability).
 """
 
 from dataclasses import dataclass
@@ -11,8 +12,8 @@ import math
 
 import numpy as np
 
-from .body import complex_step
-from .tables import spectral_tail
+from .analytic import complex_step
+from .spectral import refine_grid, spectral_derivative_at, spectral_tail
 
 __all__ = ['Equilibrium', 'equilibria', 'stability_map', 'STABLE', 'UNSTABLE', 'NEUTRAL']
 
@@ -44,24 +45,19 @@ def _height_phase_curvatures(body, phases):
     z_G is smooth and 2π-periodic in u; the grid is doubled until the upper half of the
     spectrum of dz_G/du is below 1e-13 of its peak (or dz_G/du vanishes: the neutral case).
     """
-    n = 256
-    while True:
+    def sample(n):
         u = 2 * math.pi * np.arange(n) / n
         slope = complex_step(body.phase_height, u)
         flat = np.max(np.abs(slope)) <= 1e-12 * body.size
-        if flat or spectral_tail(slope) < 1e-13 or n >= 2**17:
-            break
-        n *= 2
-    coeffs = np.fft.fft(slope) / n
-    k = np.fft.fftfreq(n, d=1.0 / n)
-    coeffs[n // 2] = 0.0
-    return [float(np.real(np.sum(1j * k * coeffs * np.exp(1j * k * p)))) for p in phases]
+        return (0.0 if flat else spectral_tail(slope)), slope
+    _, slope = refine_grid(sample, 256, 2**17)
+    return spectral_derivative_at(slope, phases)
 
 
 def _psi_rate(body, u):
     """dψ/du near ψ = 0, where ψ = arctan(σ√Q / (−a² cos θ)) is analytic."""
     def psi_near_zero(x):
-        _, cos_t, _, _ = body._phase_angles(x)
+        _, cos_t, _, _ = body.phase_angles(x)
         return np.arctan(body.phase_signed_sqrt_q(x) / (-body.a**2 * cos_t))
     return float(complex_step(psi_near_zero, u))
 

@@ -1,4 +1,4 @@
-"""Uniform-grid tables with quintic Hermite interpolation, and spectral integration.
+"""Uniform-grid tables with quintic Hermite interpolation.
 
 Used for the smooth functions of the cycle phase u: values, first and second derivatives
 are stored at the nodes, so the interpolant is C² and its error is O(h⁶ f⁽⁶⁾/46080).
@@ -6,7 +6,7 @@ are stored at the nodes, so the interpolant is C² and its error is O(h⁶ f⁽�
 
 import numpy as np
 
-__all__ = ['HermiteTable', 'spectral_antiderivative', 'spectral_tail']
+__all__ = ['HermiteTable']
 
 
 class HermiteTable:
@@ -62,38 +62,12 @@ class HermiteTable:
             return (g0 * (y0 - y1) + g1 * d0 + g2 * s0 + g3 * s1 + g4 * d1) / self.step
         raise ValueError(f'derivative must be 0 or 1, got {derivative!r}')
 
+    @classmethod
+    def periodic(cls, values, first, second):
+        """A table over one cycle [0, 2π] from samples at u_j = 2πj/N of a periodic function.
 
-def spectral_tail(samples):
-    """Relative size of the upper half of the spectrum of periodic samples (|k| > N/4).
-
-    A resolution check: ~1e-16 for a resolved smooth function, larger when not.
-    """
-    coeffs = np.abs(np.fft.fft(samples, axis=0))
-    n = coeffs.shape[0]
-    k = np.abs(np.fft.fftfreq(n, d=1.0 / n))
-    scale = max(float(np.max(coeffs)), np.finfo(float).tiny)
-    return float(np.max(coeffs[k > n // 4])) / scale
-
-
-def spectral_antiderivative(rate):
-    """Antiderivative of a smooth 2π-periodic function sampled at u_j = 2πj/N.
-
-    Returns ``(mean, periodic)``: the integral is ``mean·u + periodic(u)`` with
-    ``periodic(0) = 0``, given at the same nodes.
-    """
-    rate = np.asarray(rate)
-    n = rate.shape[0]
-    coeffs = np.fft.fft(rate, axis=0)
-    mean = coeffs[0] / n
-    k = np.fft.fftfreq(n, d=1.0 / n)
-    k_shape = (n,) + (1,) * (rate.ndim - 1)
-    k = k.reshape(k_shape)
-    safe_k = np.where(k == 0, 1.0, k)
-    integ = np.where(k == 0, 0.0, coeffs / (1j * safe_k))
-    if n % 2 == 0:
-        integ[n // 2] = 0.0
-    periodic = np.fft.ifft(integ, axis=0)
-    periodic = periodic - periodic[0]
-    if not np.iscomplexobj(rate):
-        return float(np.real(mean)), periodic.real
-    return mean, periodic
+        ``values``, ``first`` and ``second`` (shape (N, ...)) are f, f′ and f″ at the N nodes;
+        the node u = 2π repeats u = 0.
+        """
+        closed = [np.concatenate([x, x[:1]]) for x in (values, first, second)]
+        return cls(0.0, 2.0 * np.pi / len(values), *closed)

@@ -10,7 +10,7 @@ The heading α and the trace of A solve the paper's eqs. (4)-(6), written in u b
 rule. Their rates are smooth and 2π-periodic in u, so one cycle is integrated spectrally
 (FFT, exact to rounding once resolved) and tabulated for quintic Hermite interpolation;
 any number of cycles follows by composing the one-cycle planar displacement in closed form
-(no accumulation, no drift).
+(no accumulation, no drift); docs/physics.md#rolling-kinematics-and-the-contact-traces.
 """
 
 from dataclasses import dataclass
@@ -20,8 +20,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from .body import _COMPLEX_STEP, TwoDiskBody
-from .tables import HermiteTable, spectral_antiderivative, spectral_tail
+from .analytic import COMPLEX_STEP, complex_step_jet, sinc
+from .body import TwoDiskBody
+from .spectral import refine_grid, spectral_antiderivative, spectral_derivative, spectral_tail
+from .tables import HermiteTable
 
 __all__ = ['RollingCycle', 'RollingState', 'CycleDisplacement', 'integrate_contact_trace']
 
@@ -30,18 +32,15 @@ TWO_PI = 2.0 * math.pi
 
 def _arc_rate_and_turn(body, u):
     """(ds/du, dα/du) and their u-derivatives (complex step) at real u."""
-    ds, dalpha = body.phase_rates(u)
-    ds_c, dalpha_c = body.phase_rates(np.asarray(u, dtype=float) + 1j * _COMPLEX_STEP)
-    return ds, dalpha, ds_c.imag / _COMPLEX_STEP, dalpha_c.imag / _COMPLEX_STEP
+    (ds, dds), (dalpha, ddalpha) = complex_step_jet(
+        body.phase_rates(np.asarray(u, dtype=float) + 1j * COMPLEX_STEP))
+    return ds, dalpha, dds, ddalpha
 
 
 def _exp_integral(mu, u):
     """∫₀ᵘ e^{iμv} dv, robust as μ → 0."""
     x = 0.5 * mu * u
-    small = np.abs(x) < 1e-8
-    x_safe = np.where(small, 1.0, x)
-    sinc = np.where(small, 1.0 - x * x / 6.0, np.sin(x_safe) / x_safe)
-    return u * np.exp(1j * x) * sinc
+    return u * np.exp(1j * x) * sinc(x)
 
 
 @dataclass(frozen=True)
@@ -60,16 +59,9 @@ class CycleDisplacement:
         phi = math.remainder(self.turn, TWO_PI)
         half = 0.5 * phi
         # Σ_{j<k} e^{ijφ} = e^{i(k-1)φ/2} sin(kφ/2)/sin(φ/2), written with sinc: exact at φ = 0
-        ratio = k * _sinc_real(k * half) / _sinc_real(half)
+        ratio = k * sinc(k * half) / sinc(half)
         geometric = np.exp(1j * (k - 1) * half) * ratio
         return k * self.turn, self.shift * geometric
-
-
-def _sinc_real(x):
-    x = np.asarray(x, dtype=float)
-    small = np.abs(x) < 1e-4
-    x_safe = np.where(small, 1.0, x)
-    return np.where(small, 1.0 - x * x / 6.0, np.sin(x_safe) / x_safe)
 
 
 @dataclass(frozen=True)
@@ -128,14 +120,12 @@ class RollingCycle:
             raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
         self.body = body
         if resolution is None:
-            resolution = 512
-            while True:
-                tail = self._tails(resolution)
-                if tail < 1e-13 or resolution >= self.MAX_RESOLUTION:
-                    break
-                resolution *= 2
+            resolution, tail = refine_grid(lambda n: (self._tails(n),) * 2, 512,
+                                           self.MAX_RESOLUTION)
+        else:
+            tail = self._tails(resolution)
         self.resolution = int(resolution)
-        self.spectral_tail = self._tails(self.resolution)
+        self.spectral_tail = tail
         self._build(self.resolution * int(oversampling))
 
     def _tails(self, n):
@@ -180,14 +170,12 @@ class RollingCycle:
     def _frame_samples(self, u, n):
         """r1 and r2 in the contact frame (t1, n × t1, n) at the nodes, closed at u = 2π."""
         def components(x):
-            r1, r2, normal, t1 = self.body._phase_vectors(x)[:4]
+            r1, r2, normal, t1 = self.body.phase_vectors(x)[:4]
             m = np.cross(normal, t1)
             return np.stack([np.sum(r1 * t1, -1), np.sum(r1 * m, -1), np.sum(r1 * normal, -1),
                              np.sum(r2 * t1, -1), np.sum(r2 * m, -1)], axis=-1)
-        values = components(u)
-        first = np.imag(components(u + 1j * _COMPLEX_STEP)) / _COMPLEX_STEP
-        k = np.fft.fftfreq(n, d=1.0 / n)[:, None]
-        second = np.real(np.fft.ifft(1j * k * np.fft.fft(first, axis=0), axis=0))
+        values, first = complex_step_jet(components(u + 1j * COMPLEX_STEP))
+        second = spectral_derivative(first)
         return tuple(np.concatenate([x, x[:1]]) for x in (values, first, second))
 
     def _split(self, u):
@@ -231,7 +219,11 @@ class RollingCycle:
         return result + (f[..., 0] + turn,) if with_heading else result
 
     def heading(self, u):
-        """α(u) (rad): direction of motion of A on the ground, α(0) = 0."""
+        """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
+
+        On branch +1 this is the direction in which A moves on the ground; on branch −1 A
+        moves the opposite way.
+        """
         cycles, rest = self._split(u)
         return self._table(rest)[..., 0] + cycles * self.displacement.turn
 

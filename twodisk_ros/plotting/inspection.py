@@ -1,6 +1,6 @@
 """The figure of ``twodisk-inspect --plot``: traces on the ground, height of G and energy.
 
-Kept apart from :mod:`twodisk_ros.inspect_mcap` so that the checks never import matplotlib.
+Kept apart from :mod:`twodisk_ros.inspect` so that the checks never import matplotlib.
 """
 
 import os

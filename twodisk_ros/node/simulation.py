@@ -9,9 +9,10 @@ import math
 
 import numpy as np
 
-from .body import TwoDiskBody
-from .dynamics import METHODS, MODES, MotionStream, RollingDynamics
-from .mass_models import MODELS, mass_properties
+from ..physics.body import TwoDiskBody
+from ..physics.dynamics import RollingDynamics
+from ..physics.mass_models import MODELS, mass_properties
+from ..physics.motion import METHODS, MODES, MotionStream
 
 __all__ = ['RollerSettings', 'Simulation', 'DEFAULTS']
 

@@ -1,6 +1,6 @@
 """Figures of the paper and of the notes, as PNG files (matplotlib, Agg).
 
-Run ``python -m twodisk_ros.figures --out DIR`` (``make figures`` writes ``docs/figures``):
+Run ``python -m twodisk_ros.plotting.figures --out DIR`` (``make figures`` writes ``docs/figures``):
 
 * ``figure3.png``, ``figure4.png``, ``oloid_traces.png``: traces of the contact points A and B
   on the ground over three whole cycles (world frame, m), as in the paper's Figures 3 and 4;
@@ -23,9 +23,9 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from .body import TwoDiskBody  # noqa: E402
-from .cycle import RollingCycle  # noqa: E402
-from .equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
+from ..physics.body import TwoDiskBody  # noqa: E402
+from ..physics.cycle import RollingCycle  # noqa: E402
+from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
 __all__ = ['FIGURE3', 'FIGURE4', 'plot_traces', 'plot_height', 'plot_stability_map',
            'write_figures', 'main']
@@ -259,7 +259,7 @@ def write_figures(out_dir):
 
 
 def main(argv=None):
-    """Command line: ``python -m twodisk_ros.figures --out DIR``."""
+    """Command line: ``python -m twodisk_ros.plotting.figures --out DIR``."""
     parser = argparse.ArgumentParser(description='Write the figures (PNG) of twodisk_ros.')
     parser.add_argument('--out', default='docs/figures', help='output directory')
     args = parser.parse_args(argv)

@@ -13,9 +13,9 @@ Two ways to name a configuration are offered:
 * the regular cycle parameter ``u`` (``phase``, rad): the eccentric anomaly of A is
   η = η_max sin u (tan θ = (b/a) tan η) and ``branch = sign(cos u)``. Every quantity below
   is a smooth, 2π-periodic function of u, also through the turning points θ = ±θ_max where
-  θ turns back (physics notes). The physics notes suggest θ = θ_max sin u; sweeping η
-  instead keeps the sharp features of thin disks (b/a → 0 or ∞) at width ~min(a,b)/max(a,b)
-  in u rather than its square, so far fewer table nodes are needed.
+  θ turns back (docs/physics.md#the-regular-phase-u). Sweeping η rather than
+  θ = θ_max sin u keeps the sharp features of thin disks (b/a → 0 or ∞) at width
+  ~min(a,b)/max(a,b) in u rather than its square, so far fewer table nodes are needed.
 
 Accuracy (measured by the tests against independent constructions).
 
@@ -40,33 +40,9 @@ import math
 
 import numpy as np
 
-__all__ = ['TwoDiskBody', 'PhaseGeometry', 'complex_step']
+from .analytic import COMPLEX_STEP, complex_step, sinc
 
-_COMPLEX_STEP = 1e-30
-
-
-def complex_step(function, u):
-    """Derivative of an analytic real function at real ``u`` by complex step (exact to rounding).
-
-    Parameters
-    ----------
-    function : callable
-        Accepts complex arrays and is analytic in its argument.
-    u : array_like
-        Points where the derivative is taken.
-    """
-    u = np.asarray(u, dtype=float)
-    return np.imag(function(u + 1j * _COMPLEX_STEP)) / _COMPLEX_STEP
-
-
-def _sinc(x):
-    """sin(x)/x, analytic (complex-step safe), exact at x = 0."""
-    x = np.asarray(x)
-    small = np.abs(x) < 1e-3
-    x_safe = np.where(small, 1.0, x)
-    x2 = x * x
-    series = 1.0 - x2 / 6.0 + x2 * x2 / 120.0 - x2 * x2 * x2 / 5040.0
-    return np.where(small, series, np.sin(x_safe) / x_safe)
+__all__ = ['TwoDiskBody', 'PhaseGeometry']
 
 
 def _check_parameter(name, value, low, high, rule):
@@ -321,8 +297,11 @@ class TwoDiskBody:
         """η at the turning point θ = θ_max (rad)."""
         return math.atan2(self.a * self._sin_theta_max, self.b * self._cos_theta_max)
 
-    def _phase_angles(self, u):
-        """(θ, cos θ, sin θ, cos θ − cos θ_max = cos²u · j, j) at phase u; analytic in u."""
+    def phase_angles(self, u):
+        """(θ, cos θ, sin θ, j) at phase u (rad), with cos θ − cos θ_max = j cos²u.
+
+        Analytic in u (complex-step safe); exact near the turning points u = ±π/2.
+        """
         a, b = self.a, self.b
         eta_m, tm = self.eta_max, self.theta_max
         w = np.sin(u)
@@ -346,7 +325,7 @@ class TwoDiskBody:
         tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
         abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
         j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
-             * a * b * v_over_c2 * _sinc(v) / denom)
+             * a * b * v_over_c2 * sinc(v) / denom)
         return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
 
     def phase_from_theta(self, theta, branch=1):
@@ -368,30 +347,36 @@ class TwoDiskBody:
 
     def phase_theta(self, u):
         """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
-        return self._phase_angles(u)[0]
+        return self.phase_angles(u)[0]
 
     def phase_signed_sqrt_q(self, u):
         """σ√Q as a smooth function of u: cos u · √(j L F2), with cos θ − cos θ_max = j cos²u.
 
         Analytic in u (complex-step safe) and exact near the turning points u = ±π/2.
         """
-        _, cos_t, sin_t, j = self._phase_angles(u)
-        d = self._ellipse_terms(cos_t, sin_t)
-        return np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        return self._phase_sqrt_q(u, cos_t, sin_t, j)
 
-    def _phase_vectors(self, u):
-        """(r1, r2, n, t1, height, planar, norm_n, theta, sq) at phase u (complex-safe)."""
-        theta, cos_t, sin_t, j = self._phase_angles(u)
-        d = self._ellipse_terms(cos_t, sin_t)
-        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+    def _phase_sqrt_q(self, u, cos_t, sin_t, j):
+        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe)."""
+        cofactor = self._q_cofactor(cos_t, self._ellipse_terms(cos_t, sin_t))
+        return np.cos(u) * np.sqrt(j * cofactor)
+
+    def phase_vectors(self, u):
+        """(r1, r2, n, t1, z_G, planar, |N|, θ, σ√Q) at phase u, body frame (complex-safe).
+
+        r1, r2 (m), the unit ground normal n and the unit tangent t1 of disk 1 at A, the height
+        z_G (m) and the unnormalised lengths of the normal; for complex-step derivatives.
+        """
+        theta, cos_t, sin_t, j = self.phase_angles(u)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
         return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
 
     def phase_geometry(self, u):
         """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
         u = np.asarray(u, dtype=float)
-        theta, cos_t, sin_t, j = self._phase_angles(u)
-        d = self._ellipse_terms(cos_t, sin_t)
-        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        theta, cos_t, sin_t, j = self.phase_angles(u)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
         branch = np.where(np.cos(u) < 0, -1.0, 1.0)
         return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
 
@@ -405,14 +390,14 @@ class TwoDiskBody:
 
     def phase_height(self, u):
         """z_G(u) (m), analytic in u."""
-        return self._phase_vectors(u)[4]
+        return self.phase_vectors(u)[4]
 
     def phase_angle_rates(self, u):
         """(dθ/du, dψ/du) at phase u, by complex step (ψ = 2 arctan(sin ψ / (1 + cos ψ)))."""
         a = self.a
 
         def psi(x):
-            _, cos_t, _, _ = self._phase_angles(x)
+            _, cos_t, _, _ = self.phase_angles(x)
             sq = self.phase_signed_sqrt_q(x)
             norm = np.sqrt(sq * sq + a**4 * cos_t * cos_t)
             return 2 * np.arctan(sq / (norm - a * a * cos_t))
@@ -429,9 +414,8 @@ class TwoDiskBody:
         speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
         ds_du = np.sqrt(speed2) * self.eta_max * np.cos(u)
         k = a * b / speed2**1.5
-        _, cos_t, sin_t, j = self._phase_angles(u)
-        d = self._ellipse_terms(cos_t, sin_t)
-        sq = np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
         planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
         cos_phi = sq / np.sqrt(planar2 + sq * sq)
         return ds_du, k * cos_phi * ds_du
@@ -443,12 +427,12 @@ class TwoDiskBody:
         ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
         """
         u = np.asarray(u, dtype=float)
-        uc = u + 1j * _COMPLEX_STEP
-        vec = self._phase_vectors(uc)
+        uc = u + 1j * COMPLEX_STEP
+        vec = self.phase_vectors(uc)
         n, t1 = vec[2], vec[3]
         m = np.cross(n, t1)
         n_re, t1_re, m_re = n.real, t1.real, m.real
-        dn, dt1, dm = (x.imag / _COMPLEX_STEP for x in (n, t1, m))
+        dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))
         frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
         _, dalpha = self.phase_rates(u)
         return dalpha[..., None] * n_re - frame_rate

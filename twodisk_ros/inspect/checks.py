@@ -1,0 +1,432 @@
+"""The checks of ``twodisk-inspect``: what the physics says a recording must satisfy.
+
+Everything is recomputed from the recorded messages and the recorded parameters alone.
+
+The checks (L is the body size, :attr:`TwoDiskBody.size`; X = max(L, max |G|) the coordinate
+scale, so that round-off far from the origin is allowed for):
+
+``inputs``
+    pose, contacts and rolling state are recorded with the expected types and the parameters
+    define a body, a mass model and a mode (tolerance 0 problems; the diagnostics, only
+    reported and plotted, may be missing).
+``ground``
+    A and B on the ground: max |z| ≤ 1e-9 X.
+``contact_points``
+    A and B where the body puts them: |A − (G + R r1(u))| and |B − (G + R r2(u))| ≤ 1e-8 X,
+    r1, r2 from :meth:`TwoDiskBody.phase_geometry` at the recorded phase u.  The recorded
+    values are float64 from closed forms and tables accurate to ~1e-13 L, so anything above
+    the tolerance is an inconsistency, not round-off.
+``tangent_plane``
+    the ground is the tangent plane: angle between R n(u) and the world's up ≤ 1e-8 rad.
+``theta``
+    recorded θ equals θ(u): ≤ 1e-8 rad.
+``psi``
+    recorded ψ equals ψ(θ, branch), branch = sign(cos u), ≤ 1e-7 rad.  ψ(θ) has a square-root
+    singularity at the turning points θ = ±θ_max, so ψ is compared with the range of
+    ψ(θ ± 1e-12 rad): the last bits of θ would otherwise move ψ by ~1e-8 rad there.
+``no_slip``
+    material velocity of the body at A and at B, v_G + ω × (P − G), max over the samples,
+    relative to the largest |v_G|; v_G and ω by central differences of the recorded poses over
+    the neighbouring samples t ± h, t ± 2h (:func:`finite_differences`; ω from the rotation
+    vectors of R(t + kh) R(t)ᵀ).  Their error is ~ (ω h)⁴ relative, times a factor set by the
+    body's geometry and the speed profile; the plain three-point difference would leave
+    ~ (ω h)² (about 1e-3 at 100 Hz, hiding millimetre errors of the contacts).  The tolerance
+    is *computed*: the same differences of the model's poses at the recorded phases (rolling
+    exactly without slip) give the slip a perfect recording shows at this rate; the tolerance
+    is twice that, plus round-off 100 ε X / (h max |v_G|).
+``energy`` (dynamic mode)
+    relative drift max |E − E₀| / (M g L) of E = ½ M |v_G|² + ½ ωᵀ (R I Rᵀ) ω + M g z_G, with
+    v_G and ω from the recorded poses alone as above (I from the recorded mass model).
+    FD-limited: the tolerance is 4 × the largest FD error of E that the model's poses at the
+    recorded phases show against the exact E(u, u̇) of the recorded rolling state (a drift is
+    the difference of two errors; factor 2 margin), plus max(1e-9, 10 × the recorded solver
+    ``tolerance``) for the integration itself.
+``angular_speed`` (kinematic mode)
+    max | |ω| − |omega0| | / |omega0| with ω from the recorded poses; tolerance twice the FD
+    error of the model's poses at the recorded phases plus the same solver allowance.
+``timestamps``
+    stamps of pose, contacts and rolling state increase with no gaps: every interval within
+    1 % of 1/rate (the recorded ``rate``; the median interval if it is missing).
+``stamps``
+    header stamp = log time = publish time, and pose, contacts and rolling state carry the same
+    stamps (the tail cut off a truncated file excepted); tolerance 0 mismatches.
+"""
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .differences import kinetic_energy, motion_of
+from .results import Check, json_ready
+from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES
+
+__all__ = ['TITLES', 'run_checks']
+
+GROUND_TOLERANCE = 1e-9       # × coordinate scale (m)
+CONTACT_TOLERANCE = 1e-8      # × coordinate scale (m)
+ANGLE_TOLERANCE = 1e-8        # rad: θ against θ(u), R n against the world's up
+PSI_TOLERANCE = 1e-7          # rad, beyond the spread of ψ(θ ± THETA_UNCERTAINTY)
+THETA_UNCERTAINTY = 1e-12     # rad
+FD_MARGIN = 2.0               # tolerance of an FD-limited check / FD error of a perfect record
+ROUNDOFF = 100 * np.finfo(float).eps
+SOLVER_FLOOR = 1e-9           # relative energy or speed drift always allowed to the solver
+
+#: What each check verifies, in words.
+TITLES = {
+    'inputs': 'topics and parameters present and valid',
+    'ground': 'contact points A and B on the ground (max |z|)',
+    'contact_points': 'A and B where the body puts them: G + R r1(u), G + R r2(u)',
+    'tangent_plane': 'the ground is the tangent plane: R n(u) is vertical',
+    'theta': 'recorded θ equals θ(u) of the recorded phase u',
+    'psi': 'recorded ψ equals ψ(θ, branch), branch = sign(cos u)',
+    'no_slip': 'no slip at A and B (velocities by central differences of poses)',
+    'energy': 'energy conserved (from the recorded poses alone)',
+    'angular_speed': 'kinematic mode: angular speed |ω| constant = |omega0|',
+    'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
+    'stamps': 'consistent stamps across messages and topics',
+}
+
+
+def _where(samples, k):
+    return f'at t = {samples.t[k]:.6g} s'
+
+
+def _fmt(value):
+    return 'n/a' if value is None or not math.isfinite(value) else f'{value:.3g}'
+
+
+def _check(name, value, tolerance, unit='', detail=()):
+    """A :class:`Check` titled from :data:`TITLES`; it passes if ``value <= tolerance``."""
+    passed = value is not None and tolerance is not None and bool(value <= tolerance)
+    return Check(name, TITLES[name], passed, json_ready(value), json_ready(tolerance), unit,
+                 list(detail))
+
+
+def _not_evaluated(name, reason, unit=''):
+    """A failed check that could not be evaluated."""
+    return _check(name, None, None, unit, [reason])
+
+
+def _check_inputs(problems, chosen, model):
+    missing = [role for role in SAMPLED if role not in chosen]
+    detail = [f'no {role} topic of type {TOPIC_TYPES[role]}' for role in missing]
+    detail += problems
+    if model is None and not detail:
+        detail.append('no model')
+    if not detail:
+        body = model.body
+        return _check('inputs', 0, 0, 'problems', [
+            f'body a = {body.a:g} m, b = {body.b:g} m, delta = {body.delta:g} m, mass model '
+            f'{model.dynamics.mass.model}, mode {model.mode}; topics '
+            + ', '.join(chosen[role] for role in TOPIC_TYPES if role in chosen)])
+    return _check('inputs', len(detail), 0, 'problems', detail)
+
+
+def _check_ground(series, scale):
+    points = [series[role].values['point'] for role in ('contact_a', 'contact_b')
+              if role in series and len(series[role])]
+    if not points:
+        return _not_evaluated('ground', 'no contact points recorded', 'm')
+    heights = np.abs(np.concatenate(points)[:, 2])
+    tolerance = GROUND_TOLERANCE * scale
+    return _check('ground', float(np.max(heights)), tolerance, 'm', [
+        f'{heights.size} points, {int(np.sum(heights > tolerance))} above the tolerance '
+        f'(1e-9 × coordinate scale {scale:.3g} m)'])
+
+
+def _check_contact_points(samples, geometry, scale):
+    rotation = samples.rotation
+    error_a = np.linalg.norm(
+        samples.contact_a - samples.position_g - rotation.apply(geometry.contact_a), axis=1)
+    error_b = np.linalg.norm(
+        samples.contact_b - samples.position_g - rotation.apply(geometry.contact_b), axis=1)
+    worst = np.maximum(error_a, error_b)
+    k = int(np.argmax(worst))
+    tolerance = CONTACT_TOLERANCE * scale
+    return _check('contact_points', float(worst[k]), tolerance, 'm', [
+        f'max |A − (G + R r1)| = {_fmt(np.max(error_a))} m, max |B − (G + R r2)| = '
+        f'{_fmt(np.max(error_b))} m, worst {_where(samples, k)}; '
+        f'{int(np.sum(worst > tolerance))} of {worst.size} samples off; '
+        f'tolerance 1e-8 × coordinate scale {scale:.3g} m'])
+
+
+def _check_tangent_plane(samples, geometry):
+    up = samples.rotation.apply(geometry.ground_normal)
+    angle = np.arctan2(np.hypot(up[:, 0], up[:, 1]), up[:, 2])
+    k = int(np.argmax(angle))
+    return _check('tangent_plane', float(angle[k]), ANGLE_TOLERANCE, 'rad', [
+        f'largest angle between R n(u) and the up direction, {_where(samples, k)}'])
+
+
+def _wrap(angle):
+    return np.angle(np.exp(1j * angle))
+
+
+def _check_theta(samples, geometry):
+    error = np.abs(_wrap(samples.angles[:, 0] - geometry.theta))
+    k = int(np.argmax(error))
+    return _check('theta', float(error[k]), ANGLE_TOLERANCE, 'rad',
+                  [f'worst {_where(samples, k)}'])
+
+
+def _check_psi(samples, body):
+    phase = samples.angles[:, 2]
+    branch = np.where(np.cos(phase) < 0, -1, 1)
+    theta = np.clip(samples.angles[:, 0], -body.theta_max, body.theta_max)
+    psi = body.contact_angle_psi(theta, branch)
+    spread = np.zeros_like(psi)
+    for shift in (-THETA_UNCERTAINTY, THETA_UNCERTAINTY):
+        moved = np.clip(theta + shift, -body.theta_max, body.theta_max)
+        spread = np.maximum(spread, np.abs(_wrap(body.contact_angle_psi(moved, branch) - psi)))
+    error = np.maximum(np.abs(_wrap(samples.angles[:, 1] - psi)) - spread, 0.0)
+    k = int(np.argmax(error))
+    return _check('psi', float(error[k]), PSI_TOLERANCE, 'rad', [
+        f'worst {_where(samples, k)} (branch {int(branch[k]):+d}); ψ compared with '
+        f'ψ(θ ± {THETA_UNCERTAINTY:g} rad, branch), up to {_fmt(np.max(spread))} rad apart '
+        'near the turning points'])
+
+
+_NO_DIFFERENCES = 'no sample with four regular intervals around it for central differences'
+
+
+def _slip(position_g, contact_a, contact_b, velocity, omega):
+    slip_a = velocity + np.cross(omega, contact_a - position_g)
+    slip_b = velocity + np.cross(omega, contact_b - position_g)
+    return np.maximum(np.linalg.norm(slip_a, axis=1), np.linalg.norm(slip_b, axis=1))
+
+
+def _check_no_slip(samples, motion, scale):
+    k = motion.index
+    if k.size == 0:
+        return _not_evaluated('no_slip', _NO_DIFFERENCES)
+    state = motion.model_state
+    recorded = _slip(samples.position_g[k], samples.contact_a[k], samples.contact_b[k],
+                     motion.velocity, motion.angular_velocity)
+    expected = _slip(state.position_g[k], state.contact_a[k], state.contact_b[k],
+                     motion.model_velocity, motion.model_angular_velocity)
+    speed = float(np.max(np.linalg.norm(motion.velocity, axis=1)))
+    roundoff = ROUNDOFF * scale / motion.step
+    worst = int(np.argmax(recorded))
+    omega_h = float(np.max(np.linalg.norm(motion.angular_velocity, axis=1))) * motion.step
+    if speed > roundoff:
+        unit, norm = '', speed
+        what = f'max |v_A|, |v_B| / max |v_G| (max |v_G| = {speed:.4g} m/s)'
+    else:
+        unit, norm = 'm/s', 1.0
+        what = 'max |v_A|, |v_B| (the body is at rest)'
+    fd_error = float(np.max(expected)) / norm
+    return _check('no_slip', float(recorded[worst]) / norm,
+                  FD_MARGIN * fd_error + roundoff / norm, unit, [
+                      f'{what}, worst {_where(samples, k[worst])}, {k.size} samples',
+                      f'FD-limited: the model poses at the recorded phases (rolling without '
+                      f'slip) show {fd_error:.3g} at h = {motion.step:.4g} s '
+                      f'((ω h)⁴ = {omega_h**4:.3g}); tolerance {FD_MARGIN:g} × that + '
+                      'round-off'])
+
+
+def _solver_allowance(model):
+    return max(SOLVER_FLOOR, 10.0 * model.solver_tolerance)
+
+
+def _energies(samples, motion, model):
+    """Energy from the recorded poses, from the model's poses and exact, at motion.index."""
+    k = motion.index
+    mass, gravity = model.dynamics.mass, model.dynamics.gravity
+    recorded = (kinetic_energy(mass, motion.velocity, motion.angular_velocity,
+                                samples.rotation[k])
+                + mass.mass * gravity * samples.position_g[k, 2])
+    state = motion.model_state
+    model_fd = (kinetic_energy(mass, motion.model_velocity, motion.model_angular_velocity,
+                                Rotation.from_matrix(state.rotation[k]))
+                + mass.mass * gravity * state.position_g[k, 2])
+    phase = np.unwrap(samples.angles[:, 2])[k]
+    exact = model.dynamics.energy(phase, samples.rates[k, 2])
+    return recorded, model_fd, exact
+
+
+def _check_energy(samples, motion, model):
+    k = motion.index
+    if k.size == 0:
+        return _not_evaluated('energy', _NO_DIFFERENCES)
+    if not np.all(np.isfinite(samples.rates[k, 2])):
+        return _not_evaluated('energy', 'rolling_state carries no phase rate: the FD error '
+                                        'cannot be estimated')
+    scale = model.dynamics.energy_scale
+    recorded, model_fd, exact = _energies(samples, motion, model)
+    drift = np.abs(recorded - recorded[0]) / scale
+    worst = int(np.argmax(drift))
+    fd_error = float(np.max(np.abs(model_fd - exact))) / scale
+    solver = _solver_allowance(model)
+    model_drift = float(np.max(np.abs(exact - exact[0]))) / scale
+    return _check('energy', float(drift[worst]), 2 * FD_MARGIN * fd_error + solver, '', [
+        f'max |E − E0| / (M g L), E0 = {recorded[0]:.8g} J, M g L = {scale:.4g} J; worst '
+        f'{_where(samples, k[worst])}, {k.size} samples',
+        f'FD-limited: the model poses at the recorded phases give E within {fd_error:.3g} of '
+        f'the exact E(u, u̇); tolerance 2 × {FD_MARGIN:g} × that + {solver:.3g} (solver)',
+        f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}'])
+
+
+def _check_angular_speed(samples, motion, model):
+    k = motion.index
+    if k.size == 0:
+        return _not_evaluated('angular_speed', _NO_DIFFERENCES)
+    target = abs(model.omega0)
+    speed = np.linalg.norm(motion.angular_velocity, axis=1)
+    model_speed = np.linalg.norm(motion.model_angular_velocity, axis=1)
+    if target > 0:
+        error = np.abs(speed - target) / target
+        fd_error = float(np.max(np.abs(model_speed - target))) / target
+        tolerance = FD_MARGIN * fd_error + _solver_allowance(model)
+        unit, what = '', f'max ||ω| − |omega0|| / |omega0|, |omega0| = {target:g} rad/s'
+    else:
+        error = speed
+        fd_error = float(np.max(model_speed))
+        tolerance = FD_MARGIN * fd_error + ROUNDOFF / motion.step
+        unit, what = 'rad/s', 'max |ω| (omega0 = 0)'
+    worst = int(np.argmax(error))
+    return _check('angular_speed', float(error[worst]), tolerance, unit, [
+        f'{what}; worst {_where(samples, k[worst])}, {k.size} samples',
+        f'FD-limited: the model poses at the recorded phases show {fd_error:.3g}; '
+        f'tolerance {FD_MARGIN:g} × that + solver allowance'])
+
+
+def _nominal_step_ns(series, model):
+    """1/rate in ns from the recorded rate, else the median stamp interval; and its source."""
+    if model is not None and model.rate:
+        return 1e9 / model.rate, f'1/rate, rate = {model.rate:g} Hz'
+    intervals = [np.diff(series[role].stamp_ns) for role in SAMPLED
+                 if role in series and len(series[role]) > 1]
+    if not intervals:
+        return None, 'no intervals'
+    return float(np.median(np.concatenate(intervals))), 'median interval (no valid rate)'
+
+
+def _check_timestamps(series, step_ns, source):
+    roles = [role for role in SAMPLED if role in series]
+    if step_ns is None or not roles:
+        return _check('timestamps', None, STAMP_TOLERANCE, '', ['too few messages'])
+    detail, worst = [], 0.0
+    for role in roles:
+        stamps = series[role].stamp_ns
+        if stamps.size < 2:
+            detail.append(f'{series[role].topic}: {stamps.size} message(s), no interval')
+            worst = math.inf
+            continue
+        intervals = np.diff(stamps)
+        deviation = np.abs(intervals - step_ns) / step_ns
+        bad = np.nonzero(deviation > STAMP_TOLERANCE)[0]
+        worst = max(worst, float(np.max(deviation)))
+        line = f'{series[role].topic}: {stamps.size} stamps'
+        if bad.size:
+            first = int(bad[0])
+            line += (f', {bad.size} bad intervals, the first {intervals[first] * 1e-9:.6g} s '
+                     f'after t = {stamps[first] * 1e-9:.6g} s')
+            if np.any(intervals <= 0):
+                line += f', {int(np.sum(intervals <= 0))} not increasing'
+        detail.append(line)
+    detail.append(f'nominal interval {step_ns * 1e-9:.6g} s ({source}); '
+                  f'tolerance {STAMP_TOLERANCE:.0%} of it')
+    return _check('timestamps', worst, STAMP_TOLERANCE, '', detail)
+
+
+def _check_stamps(series, truncated):
+    roles = [role for role in SAMPLED if role in series and len(series[role])]
+    detail, mismatches = [], 0
+    for role in roles:
+        data = series[role]
+        count = int(np.sum(data.stamp_ns != data.log_ns) + np.sum(data.log_ns != data.publish_ns))
+        if count:
+            detail.append(f'{data.topic}: {count} header stamp / log time / publish time '
+                          'mismatches')
+        mismatches += count
+    if roles:
+        sets = {role: np.unique(series[role].stamp_ns) for role in roles}
+        union = np.unique(np.concatenate(list(sets.values())))
+        if truncated:
+            union = union[union <= min(stamps[-1] for stamps in sets.values())]
+        for role, stamps in sets.items():
+            lacking = union.size - np.intersect1d(union, stamps).size
+            if lacking:
+                detail.append(f'{series[role].topic}: lacks {lacking} stamps of the others')
+            mismatches += lacking
+    if not detail:
+        detail.append('pose, contacts and rolling_state share their stamps; header stamp = '
+                      'log time = publish time'
+                      + (' (the tail cut by the truncation ignored)' if truncated else ''))
+    return _check('stamps', mismatches, 0, 'mismatches', detail)
+
+
+def _run(checks, name, function, *args):
+    """Append ``function(*args)``; an error while evaluating it is a failed check."""
+    try:
+        checks.append(function(*args))
+    except Exception as error:  # noqa: BLE001 - reported as a failed check, not a traceback
+        checks.append(_not_evaluated(name, f'cannot be evaluated: {type(error).__name__}: '
+                                           f'{" ".join(str(error).split())}'))
+
+
+def run_checks(recording, problems, chosen, series, samples, model, parameters):
+    """Every check of a recording, in report order; returns (checks, Motion or None).
+
+    An error while evaluating a check makes that check fail with the reason: never an
+    exception out of here.
+    """
+    checks = []
+    scale = _coordinate_scale(model, series)
+    _run(checks, 'inputs', _check_inputs, problems, chosen, model)
+    _run(checks, 'ground', _check_ground, series, scale)
+    step_ns, source = _nominal_step_ns(series, model)
+    motion = _physics_checks(checks, samples, model, step_ns, scale, parameters)
+    _run(checks, 'timestamps', _check_timestamps, series, step_ns, source)
+    _run(checks, 'stamps', _check_stamps, series, recording.truncated)
+    return checks, motion
+
+
+def _physics_checks(checks, samples, model, step_ns, scale, parameters):
+    """Append the checks that need the model; return the finite differences (or None)."""
+    speed_check = 'angular_speed' if parameters.get('mode') == 'kinematic' else 'energy'
+    if model is None or samples is None:
+        reason = ('no model (see inputs)' if model is None
+                  else 'no stamps shared by pose, contacts and rolling_state')
+        _not_evaluated_all(checks, ('contact_points', 'tangent_plane', 'theta', 'psi',
+                                    'no_slip', speed_check), reason)
+        return None
+    try:
+        geometry = model.body.phase_geometry(samples.angles[:, 2])
+    except (ValueError, FloatingPointError) as error:
+        geometry, reason = None, f'phases unusable: {" ".join(str(error).split())}'
+    if geometry is None:
+        _not_evaluated_all(checks, ('contact_points', 'tangent_plane', 'theta'), reason)
+    else:
+        _run(checks, 'contact_points', _check_contact_points, samples, geometry, scale)
+        _run(checks, 'tangent_plane', _check_tangent_plane, samples, geometry)
+        _run(checks, 'theta', _check_theta, samples, geometry)
+    _run(checks, 'psi', _check_psi, samples, model.body)
+    motion, reason = None, 'no stamp interval'
+    if step_ns is not None:
+        try:
+            motion = motion_of(samples, model, step_ns * 1e-9)
+        except Exception as error:  # noqa: BLE001 - reported as failed checks
+            reason = f'{type(error).__name__}: {" ".join(str(error).split())}'
+    if motion is None:
+        _not_evaluated_all(checks, ('no_slip', speed_check), f'no finite differences: {reason}')
+        return None
+    _run(checks, 'no_slip', _check_no_slip, samples, motion, scale)
+    if model.mode == 'kinematic':
+        _run(checks, 'angular_speed', _check_angular_speed, samples, motion, model)
+    else:
+        _run(checks, 'energy', _check_energy, samples, motion, model)
+    return motion
+
+
+def _not_evaluated_all(checks, names, reason):
+    checks.extend(_not_evaluated(name, f'not evaluated: {reason}') for name in names)
+
+
+def _coordinate_scale(model, series):
+    size = model.body.size if model is not None else 1.0
+    pose = series.get('pose')
+    if pose is not None and len(pose):
+        size = max(size, float(np.max(np.abs(pose.values['position']))))
+    return size

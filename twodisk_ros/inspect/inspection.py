@@ -1,0 +1,145 @@
+"""``inspect_recording``: read a recording, join its samples, run the checks, summarise.
+
+``twodisk-inspect FILE.mcap [--json] [--plot PNG]`` (or ``python -m twodisk_ros.inspect_mcap``)
+reads an MCAP file written by the node (:mod:`twodisk_ros.io`), summarises it (topics,
+types, counts, duration, rates, recorded parameters) and runs the checks of
+:mod:`twodisk_ros.inspect.checks`. A truncated file (writer killed, no footer) is checked
+on the part that was recovered; the report says how many messages and bytes that is.
+"""
+
+import numpy as np
+
+from ..io import read_recording
+from .checks import run_checks
+from .differences import kinetic_energy
+from .model import build_model
+from .results import Inspection, json_ready
+from .series import (METADATA_NAME, TOPIC_TYPES, extract_series, join_samples, select_topics,
+                     topic_role)
+
+__all__ = ['inspect_recording']
+
+_DECODED = frozenset(TOPIC_TYPES)
+
+
+def _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns):
+    truncated = recording.truncated
+    topics = []
+    times = {}
+    for message in recording.messages:
+        first, last = times.get(message.topic, (message.log_time_ns, message.log_time_ns))
+        times[message.topic] = (min(first, message.log_time_ns), max(last, message.log_time_ns))
+    for name in sorted(recording.topics):
+        info = recording.topics[name]
+        first, last = times.get(name, (None, None))
+        rate = None
+        if info.message_count > 1 and last > first:
+            rate = (info.message_count - 1) / ((last - first) * 1e-9)
+        topics.append({'topic': name, 'type': info.type_name, 'count': info.message_count,
+                       'first_s': None if first is None else (first - t0_ns) * 1e-9,
+                       'last_s': None if last is None else (last - t0_ns) * 1e-9,
+                       'rate_hz': rate, 'role': next((r for r, t in chosen.items()
+                                                      if t == name), None)})
+    size = recording.total_bytes
+    summary = {
+        'file': recording.path,
+        'size_bytes': size,
+        'profile': recording.profile,
+        'library': recording.library,
+        'truncated': truncated,
+        'recovered': {'messages': len(recording.messages), 'bytes': recording.recovered_bytes,
+                      'total_bytes': size,
+                      'fraction': recording.recovered_bytes / size if size else None},
+        'message_count': len(recording.messages),
+        'start_ns': t0_ns,
+        'end_ns': t1_ns,
+        'duration_s': None if t0_ns is None else (t1_ns - t0_ns) * 1e-9,
+        'topics': topics,
+        'parameters': dict(parameters),
+        'samples': 0 if samples is None else int(samples.stamp_ns.size),
+        'mode': None if model is None else model.mode,
+    }
+    return json_ready(summary)
+
+
+def inspect_recording(path):
+    """Read a recording and run every check.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An MCAP file written by the ``roller`` node (or a truncated copy).
+
+    Returns
+    -------
+    Inspection
+
+    Raises
+    ------
+    RecordingError
+        If the file cannot be read at all (missing, a directory, not MCAP, damaged).
+    """
+    recording = read_recording(path, decode=lambda topic: topic_role(topic) in _DECODED)
+    problems = []
+    chosen = select_topics(recording.topics, problems)
+    series = extract_series(recording, chosen, problems)
+    parameters = recording.metadata.get(METADATA_NAME)
+    if parameters is None:
+        problems.append(f'no metadata record {METADATA_NAME!r} (node parameters)')
+        parameters = {}
+    model = build_model(parameters, problems) if METADATA_NAME in recording.metadata else None
+    log_times = [message.log_time_ns for message in recording.messages]
+    t0_ns = min(log_times) if log_times else None
+    t1_ns = max(log_times) if log_times else None
+    stamp0 = min([int(s.stamp_ns.min()) for s in series.values() if len(s)] or [0])
+    samples = None
+    try:
+        samples = join_samples(series, stamp0)
+    except ValueError as error:  # e.g. a zero quaternion
+        problems.append(f'cannot use the poses: {" ".join(str(error).split())}')
+    checks, motion = run_checks(recording, problems, chosen, series, samples, model,
+                                parameters)
+    summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
+    summary['diagnostics'] = _diagnostics_summary(series)
+    return Inspection(summary, checks, _plot_series(series, samples, motion, model, stamp0))
+
+
+def _diagnostics_summary(series):
+    diagnostics = series.get('diagnostics')
+    if diagnostics is None or not len(diagnostics):
+        return None
+    energy = diagnostics.values['energy']
+    drift = diagnostics.values['energy_drift']
+    return json_ready({
+        'topic': diagnostics.topic,
+        'count': len(diagnostics),
+        'energy_first': energy[0] if energy.size else None,
+        'energy_last': energy[-1] if energy.size else None,
+        'max_energy_drift': float(np.nanmax(np.abs(drift))) if np.any(np.isfinite(drift))
+        else None,
+    })
+
+
+def _plot_series(series, samples, motion, model, stamp0):
+    out = {}
+    for role, key in (('contact_a', 'point'), ('contact_b', 'point'), ('pose', 'position')):
+        if role in series and len(series[role]):
+            out[role] = series[role].values[key]
+            out[f't_{role}'] = (series[role].stamp_ns - stamp0) * 1e-9
+    if 'diagnostics' in series and len(series['diagnostics']):
+        out['t_diagnostics'] = (series['diagnostics'].stamp_ns - stamp0) * 1e-9
+        out['energy_diagnostics'] = series['diagnostics'].values['energy']
+    if motion is not None and motion.index.size:
+        k = motion.index
+        mass, gravity = model.dynamics.mass, model.dynamics.gravity
+        kinetic = kinetic_energy(mass, motion.velocity, motion.angular_velocity,
+                                  samples.rotation[k])
+        out['t_fd'] = samples.t[k]
+        out['kinetic_fd'] = kinetic
+        out['potential_fd'] = mass.mass * gravity * samples.position_g[k, 2]
+        out['energy_scale'] = np.array(model.dynamics.energy_scale)
+        if np.all(np.isfinite(samples.rates[:, 2])):
+            phase = np.unwrap(samples.angles[:, 2])
+            out['t_model'] = samples.t
+            out['energy_model'] = model.dynamics.energy(phase, samples.rates[:, 2])
+    return out

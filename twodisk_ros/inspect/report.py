@@ -1,0 +1,85 @@
+"""The human-readable report of ``twodisk-inspect``."""
+
+import textwrap
+
+from .series import METADATA_NAME
+
+__all__ = ['PROG', 'format_report']
+
+PROG = 'twodisk-inspect'
+
+
+def _size(nbytes):
+    for unit in ('B', 'KiB', 'MiB', 'GiB'):
+        if nbytes < 1024 or unit == 'GiB':
+            return f'{nbytes:.0f} {unit}' if unit == 'B' else f'{nbytes:.1f} {unit}'
+        nbytes /= 1024
+    return f'{nbytes} B'
+
+
+def _value(value, unit):
+    if value is None:
+        return 'n/a'
+    text = f'{value:.3g}'
+    return f'{text} {unit}' if unit else text
+
+
+def format_report(inspection):
+    """The human-readable report of an :class:`Inspection` (several lines, no final newline)."""
+    s = inspection.summary
+    lines = [f'{PROG}: {s["file"]}',
+             f'  file: {_size(s["size_bytes"])}, MCAP profile {s["profile"]!r}, '
+             f'written by {s["library"] or "?"}']
+    if s['truncated']:
+        rec = s['recovered']
+        fraction = rec['fraction'] if rec['fraction'] is not None else 0.0
+        lines.append(f'  TRUNCATED (no footer: the writer did not close it): recovered '
+                     f'{rec["messages"]} messages from {rec["bytes"]} of {rec["total_bytes"]} '
+                     f'bytes ({fraction:.1%}); the checks below are of that part')
+    if s['duration_s'] is not None:
+        lines.append(f'  duration: {s["duration_s"]:.3f} s, {s["message_count"]} messages on '
+                     f'{len(s["topics"])} topics')
+    else:
+        lines.append('  no messages')
+    lines.append('topics:')
+    width = max([len(t['topic']) for t in s['topics']] + [5])
+    type_width = max([len(t['type']) for t in s['topics']] + [4])
+    for topic in s['topics']:
+        rate = f'{topic["rate_hz"]:9.3f} Hz' if topic['rate_hz'] is not None else '        -'
+        lines.append(f'  {topic["topic"]:<{width}}  {topic["type"]:<{type_width}}  '
+                     f'{topic["count"]:7d}  {rate}')
+    lines.append(f'parameters (metadata {METADATA_NAME!r}):')
+    if s['parameters']:
+        items = [f'{key} = {value}' for key, value in s['parameters'].items()]
+        row = '  '
+        for item in items:
+            if len(row) + len(item) > 96 and row.strip():
+                lines.append(row.rstrip())
+                row = '  '
+            row += item + '; '
+        lines.append(row.rstrip().rstrip(';'))
+    else:
+        lines.append('  (none)')
+    if s.get('diagnostics'):
+        d = s['diagnostics']
+        lines.append(f'diagnostics: {d["count"]} messages, energy {_value(d["energy_first"], "J")}'
+                     f' → {_value(d["energy_last"], "J")}, max recorded energy_drift '
+                     f'{_value(d["max_energy_drift"], "")}')
+    else:
+        lines.append('diagnostics: none recorded')
+    lines.append(f'samples: {s["samples"]} stamps shared by pose, contacts and rolling_state'
+                 + (f' ({s["mode"]} mode)' if s['mode'] else ''))
+    lines.append('checks:')
+    for check in inspection.checks:
+        lines.append(f'  {check.status}  {check.name:<14} {_value(check.value, check.unit)} '
+                     f'(tolerance {_value(check.tolerance, check.unit)})  {check.title}')
+        for line in check.detail:
+            lines.extend(textwrap.wrap(line, 99, initial_indent=' ' * 8,
+                                       subsequent_indent=' ' * 10))
+    failed = [check.name for check in inspection.checks if not check.passed]
+    if failed:
+        lines.append(f'result: FAIL ({len(failed)} of {len(inspection.checks)} checks failed: '
+                     f'{", ".join(failed)})')
+    else:
+        lines.append(f'result: PASS (all {len(inspection.checks)} checks passed)')
+    return '\n'.join(lines)

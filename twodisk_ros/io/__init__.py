@@ -1,0 +1,15 @@
+"""Recordings: MCAP files in the layout rosbag2 (Jazzy) writes, and a tolerant reader.
+
+- :mod:`~twodisk_ros.io.writer`: :class:`McapRecorder` (needs rclpy only for its defaults);
+- :mod:`~twodisk_ros.io.reader`: :func:`read_recording` (mcap and mcap-ros2-support only);
+- :mod:`~twodisk_ros.io.msgdefs`: the ``ros2msg`` schema texts;
+- :mod:`~twodisk_ros.io.rosbag2_metadata`: the QoS and bag-metadata YAML;
+- :mod:`~twodisk_ros.io.errors`: :class:`RecordingError`.
+"""
+
+from .errors import RecordingError
+from .reader import RecordedMessage, Recording, TopicInfo, read_recording
+from .writer import DEFAULT_CHUNK_SIZE, McapRecorder
+
+__all__ = ['DEFAULT_CHUNK_SIZE', 'McapRecorder', 'RecordedMessage', 'Recording',
+           'RecordingError', 'TopicInfo', 'read_recording']

@@ -1,0 +1,27 @@
+"""The physics of the rolling two-disk body: pure numpy/scipy, no ROS, plots or files.
+
+Modules, from geometry to motion (docs/physics.md derives each):
+
+- :mod:`~twodisk_ros.physics.body`: the body and the closed forms, in θ and in the phase u;
+- :mod:`~twodisk_ros.physics.cycle`: poses and contact traces over whole cycles;
+- :mod:`~twodisk_ros.physics.equilibria`: the eight equilibria and their stability;
+- :mod:`~twodisk_ros.physics.mass_models` (with :mod:`~twodisk_ros.physics.hull`): inertia;
+- :mod:`~twodisk_ros.physics.dynamics`: the equation of motion in u;
+- :mod:`~twodisk_ros.physics.solvers`, :mod:`~twodisk_ros.physics.motion`: u(t);
+- :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
+  :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
+"""
+
+from .body import PhaseGeometry, TwoDiskBody
+from .cycle import CycleDisplacement, RollingCycle, RollingState, integrate_contact_trace
+from .dynamics import RollingDynamics
+from .equilibria import Equilibrium, equilibria, stability_map
+from .mass_models import MassProperties, mass_properties
+from .motion import MotionStream, RollingMotion, simulate, simulate_phase
+
+__all__ = [
+    'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState', 'CycleDisplacement',
+    'integrate_contact_trace', 'Equilibrium', 'equilibria', 'stability_map', 'MassProperties',
+    'mass_properties', 'RollingDynamics', 'RollingMotion', 'MotionStream', 'simulate',
+    'simulate_phase',
+]

@@ -1,0 +1,192 @@
+"""The equation of motion of the rolling body: one degree of freedom in the cycle phase u.
+
+With no slip at A and B the body turns about the line AB, so its motion is fixed by u(t)
+(docs/physics.md#dynamics). Kinetic and potential energy (SI units):
+
+    T = ½ m(u) u̇²,   m(u) = ω_uᵀ I_G ω_u + M |ω_u × r1|²,   V(u) = M g z_G(u),
+
+ω_u being the angular velocity per unit u̇ (body frame, rad) and I_G the inertia about G.
+Lagrange's equation: m ü + ½ m′ u̇² + V′ = 0; energy E = T + V is conserved.
+
+:class:`RollingDynamics` holds these functions twice: as closed forms (the ``direct``
+method) and as periodic tables of one cycle (the ``table`` method); the motion itself is
+solved in :mod:`twodisk_ros.physics.motion`.
+"""
+
+import math
+
+import numpy as np
+
+from .analytic import complex_step
+from .body import TwoDiskBody
+from .cycle import RollingCycle, TWO_PI
+from .equilibria import equilibria, STABLE
+from .mass_models import MassProperties
+from .spectral import spectral_derivative
+from .tables import HermiteTable
+
+__all__ = ['RollingDynamics']
+
+_FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u), times the feature width
+
+
+class RollingDynamics:
+    """The equation of motion of one body with one mass model.
+
+    Parameters
+    ----------
+    body : TwoDiskBody
+    mass_properties : MassProperties
+        Mass (kg) and inertia about G (kg m², body frame); the centre of mass must be G.
+    gravity : float
+        g (m/s²), finite and ≥ 0.
+    cycle : RollingCycle, optional
+        Reused if given (it holds the kinematic tables).
+    """
+
+    def __init__(self, body, mass_properties, gravity=9.81, cycle=None):
+        if not isinstance(body, TwoDiskBody):
+            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
+        if not isinstance(mass_properties, MassProperties):
+            raise TypeError('mass_properties must be a MassProperties')
+        gravity = float(gravity)
+        if not (math.isfinite(gravity) and gravity >= 0):
+            raise ValueError(f'gravity must be finite and >= 0 m/s^2, got {gravity!r}')
+        if np.max(np.abs(mass_properties.center_of_mass)) > 1e-9 * body.size:
+            raise ValueError('mass_properties.center_of_mass must be G (the origin)')
+        self.body = body
+        self.mass = mass_properties
+        self.gravity = gravity
+        self.cycle = cycle if cycle is not None else RollingCycle(body)
+        self._feature_width = min(1.0, body.b / body.a, body.a / body.b,
+                                  2 * math.sqrt(body.delta / body.a))
+        self._build_tables(4 * self.cycle.resolution)
+        self._equilibria = None
+
+    # -- closed forms (the direct method) ---------------------------------------------------
+    def effective_mass(self, u):
+        """m(u) (kg m²/rad²): T = ½ m(u) u̇²."""
+        u = np.asarray(u, dtype=float)
+        omega = self.body.phase_angular_velocity(u)
+        r1 = self.body.phase_geometry(u).contact_a
+        v = np.cross(omega, r1)
+        inertia = self.mass.inertia
+        return (np.einsum('...i,ij,...j->...', omega, inertia, omega)
+                + self.mass.mass * np.sum(v * v, axis=-1))
+
+    def angular_speed_per_phase(self, u):
+        """|ω_u| (rad of body rotation per rad of u)."""
+        return np.linalg.norm(self.body.phase_angular_velocity(u), axis=-1)
+
+    def potential(self, u):
+        """V(u) = M g z_G(u) (J)."""
+        return self.mass.mass * self.gravity * self.body.phase_height(u)
+
+    def potential_slope(self, u):
+        """dV/du (J/rad), by complex step of the closed form."""
+        return self.mass.mass * self.gravity * complex_step(self.body.phase_height, u)
+
+    def effective_mass_slope(self, u):
+        """dm/du (kg m²/rad³): 5-point difference of :meth:`effective_mass`.
+
+        The step is 1e-3 rad times the width of the sharpest feature of the body's functions
+        of u, min(1, b/a, a/b, 2√(Δ/a)) (body module docstring).
+        """
+        u = np.asarray(u, dtype=float)
+        h = _FD_STEP * self._feature_width
+        m = [self.effective_mass(u + k * h) for k in (-2, -1, 1, 2)]
+        return (m[0] - 8 * m[1] + 8 * m[2] - m[3]) / (12 * h)
+
+    # -- tables (the table method) ----------------------------------------------------------
+    def _build_tables(self, n):
+        u = TWO_PI * np.arange(n) / n
+        m = self.effective_mass(u)
+        w = self.angular_speed_per_phase(u)
+        v = self.potential(u)
+        dv = self.potential_slope(u)
+        first = np.column_stack([spectral_derivative(m), dv, spectral_derivative(w)])
+        second = spectral_derivative(first)
+        self._table = HermiteTable.periodic(np.column_stack([m, v, w]), first, second)
+        # V alone, for the level searches of oscillations (a third of the work)
+        self._potential = HermiteTable.periodic(v, dv, second[:, 1])
+        self.table_size = n
+        self.potential_range = (float(v.min()), float(v.max()))
+
+    def tabulated(self, u, derivative=0):
+        """(m, V, |ω_u|) at phase(s) u from the tables, shape u.shape + (3,)."""
+        u = np.asarray(u, dtype=float)
+        return self._table(np.mod(u, TWO_PI), derivative)
+
+    def tabulated_potential(self, u, derivative=0):
+        """V(u) (J) or V′(u) (J/rad) from the tables."""
+        return self._potential(np.mod(np.asarray(u, dtype=float), TWO_PI), derivative)
+
+    # -- derived quantities -----------------------------------------------------------------
+    def energy(self, u, u_dot):
+        """E = ½ m(u) u̇² + V(u) (J), from the tables."""
+        f = self.tabulated(u)
+        return 0.5 * f[..., 0] * np.asarray(u_dot) ** 2 + f[..., 1]
+
+    @property
+    def energy_scale(self):
+        """M g L (J), L = body size: the scale of relative energy drifts (g → 1 m/s² if g = 0)."""
+        g = self.gravity if self.gravity > 0 else 1.0
+        return self.mass.mass * g * self.body.size
+
+    def equilibria_with_periods(self):
+        """[(Equilibrium, small-oscillation period in s or None)] for all eight equilibria.
+
+        T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u).
+        Computed once per dynamics object.
+        """
+        if self._equilibria is None:
+            result = []
+            for eq in equilibria(self.body):
+                period = None
+                if eq.stability == STABLE and self.gravity > 0:
+                    stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                    period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
+                result.append((eq, period))
+            self._equilibria = result
+        return list(self._equilibria)
+
+    def small_oscillation_periods(self):
+        """[(Equilibrium, period in s)] for every stable equilibrium (T = 2π √(m / V″))."""
+        return [(eq, period) for eq, period in self.equilibria_with_periods()
+                if period is not None]
+
+    def well(self, u):
+        """(u*, u_low, u_high): the minimum of V in the well holding phase u, between maxima."""
+        found = sorted((eq.phase, eq.stability) for eq, _ in self.equilibria_with_periods())
+        maxima = np.array([p for p, kind in found if kind != STABLE])
+        minima = np.array([p for p, kind in found if kind == STABLE])
+        if len(maxima) == 0 or len(minima) == 0:
+            raise RuntimeError('V has no wells (neutral body): no oscillation')
+        base = TWO_PI * math.floor(u / TWO_PI)
+        edges = np.concatenate([maxima - TWO_PI, maxima, maxima + TWO_PI]) + base
+        i = np.searchsorted(edges, u, side='right')
+        low, high = edges[i - 1], edges[i]
+        centres = np.concatenate([minima - TWO_PI, minima, minima + TWO_PI]) + base
+        inside = centres[(centres > low) & (centres < high)]
+        return float(inside[0]), float(low), float(high)
+
+    def potential_curvature(self, u):
+        """d²V/du² (J/rad²) at an equilibrium phase u (spectral, as in the equilibria)."""
+        for eq, _ in self.equilibria_with_periods():
+            gap = abs(math.remainder(u - eq.phase, TWO_PI))
+            if gap < 1e-9:
+                return self.mass.mass * self.gravity * eq.phase_curvature
+        raise ValueError(f'u = {u!r} rad is not an equilibrium phase')
+
+    def is_equilibrium(self, u):
+        """True if phase u (rad) is one of the equilibria (within 1e-9 rad), or V′(u) vanishes
+        there to rounding (z_G constant: the neutral case)."""
+        phases = np.array([eq.phase for eq, _ in self.equilibria_with_periods()])
+        gap = np.abs(np.remainder(u - phases + math.pi, TWO_PI) - math.pi)
+        if np.min(gap) <= 1e-9:
+            return True
+        return abs(float(self.potential_slope(u))) <= 1e-13 * self.energy_scale
+
+    def initial_phase_rate(self, u0, omega0):
+        """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0."""
+        return float(omega0) / float(self.angular_speed_per_phase(u0))

@@ -1,0 +1,275 @@
+"""Simulated motions u(t): the public API (:func:`simulate`) and the node's stream.
+
+Two modes: ``dynamic`` (gravity only) and ``kinematic`` (constant angular speed |ω| = Ω, so
+u̇ = Ω / |ω_u(u)|). Two methods (docs/physics.md#the-two-methods-direct-and-table):
+
+``direct``
+    DOP853 (scipy ``solve_ivp``) with the geometry evaluated on the fly from the closed
+    forms; ``tolerance`` is its rtol (atol = tolerance × scale).
+``table``
+    Periodic tables of one cycle (m, V, |ω_u| with derivatives, spectral to rounding), then:
+    when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
+    t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
+    bracketed Newton (no time stepping, no drift); when it oscillates in a well (E < max V),
+    the same in the angle φ of V(u(φ)) = V* + (E − V*) sin²φ. Only within 1e-6 M g L of the
+    separatrix E = max V is DOP853 run on the tabulated right-hand side, with ``tolerance``
+    as its rtol.
+
+A body exactly at an equilibrium with u̇ = 0 stays there (the exact solution). Every motion
+carries its solution as ``sol``, a :class:`~twodisk_ros.physics.solvers.PhaseSolution`.
+"""
+
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .dynamics import RollingDynamics
+from .solvers import (LibrationSolution, OdeSolution, QuadratureSolution, RestSolution)
+
+__all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMotion',
+           'simulate', 'simulate_phase']
+
+METHODS = ('direct', 'table')
+MODES = ('dynamic', 'kinematic')
+#: names of the solvers whose motion is known at any time without stepping (for reports)
+CLOSED_FORM_SOLVERS = tuple(kind.name for kind in (QuadratureSolution, LibrationSolution,
+                                                   RestSolution))
+
+
+@dataclass
+class RollingMotion:
+    """A simulated motion u(t), with dense output over ``[0, t_end]``.
+
+    Attributes
+    ----------
+    t : ndarray
+        Sample times (s).
+    phase, phase_rate : ndarray
+        u (rad) and u̇ (rad/s) at ``t``.
+    energy : ndarray
+        E (J) at ``t``, recomputed from (u, u̇) with the tables.
+    nfev : int
+        Right-hand-side evaluations (0 for the quadrature path).
+    solver : str
+        Name of the solver used: 'quadrature', 'libration', 'rest' or 'DOP853'.
+    sol : PhaseSolution
+        Dense output: ``sol(t)`` is an array (2, ...) of u (rad) and u̇ (rad/s) at times t
+        (s), for every method, like scipy's ``OdeSolution``.
+    """
+
+    dynamics: RollingDynamics
+    mode: str
+    method: str
+    t: np.ndarray
+    phase: np.ndarray
+    phase_rate: np.ndarray
+    energy: np.ndarray
+    nfev: int
+    solver: str
+    sol: object = field(repr=False)
+
+    @property
+    def energy_drift(self):
+        """max |E − E₀| over the samples, relative to :attr:`RollingDynamics.energy_scale`.
+
+        A conservation check in dynamic mode only: in kinematic mode the motor does work and
+        E changes along the cycle by design.
+        """
+        return float(np.max(np.abs(self.energy - self.energy[0]))) / self.dynamics.energy_scale
+
+    def positions(self):
+        """World positions of G, A and B at the samples (m), each shape (len(t), 3)."""
+        return self.dynamics.cycle.positions(self.phase)
+
+    def states(self):
+        """Full :class:`RollingState` at the samples (pose, contacts, angles)."""
+        return self.dynamics.cycle.state(self.phase)
+
+
+
+def _real(name, value, rule, allowed):
+    """``value`` as a float if ``allowed(value)``, else ValueError naming ``name`` and ``rule``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f'{name} must be a number {rule}, got {value!r}') from None
+    if not allowed(number):
+        raise ValueError(f'{name} must be {rule}, got {value!r}')
+    return number
+
+
+def _check_choice(name, value, allowed):
+    if value not in allowed:
+        raise ValueError(f'{name} must be one of {", ".join(map(repr, allowed))}, got {value!r}')
+
+
+def simulate(dynamics, t_eval, *, mode='dynamic', theta0=0.0, branch=1, omega0=0.0,
+             method='table', tolerance=1e-10):
+    """Simulate the rolling body from an initial state and sample it at ``t_eval``.
+
+    Parameters
+    ----------
+    dynamics : RollingDynamics
+    t_eval : array_like
+        Sample times (s), increasing, starting at ≥ 0 (t = 0 is the initial state).
+    mode : {'dynamic', 'kinematic'}
+    theta0 : float
+        Initial θ (rad), |theta0| ≤ θ_max.
+    branch : {+1, -1}
+        +1: the paper's branch (B below the plane of disk 1), −1: its mirror.
+    omega0 : float
+        Signed angular speed of the body (rad/s); positive: θ increasing on branch +1.
+        In kinematic mode it is held constant.
+    method : {'direct', 'table'}
+    tolerance : float
+        Relative tolerance of the ODE solver (in (0, 1)).
+
+    Returns
+    -------
+    RollingMotion
+    """
+    _check_choice('mode', mode, MODES)
+    _check_choice('method', method, METHODS)
+    tolerance = _real('tolerance', tolerance, 'in (0, 1)', lambda x: 0 < x < 1)
+    omega0 = _real('omega0', omega0, 'finite (rad/s)', math.isfinite)
+    theta_max = dynamics.body.theta_max
+    theta0 = _real('theta0', theta0, f'finite with |theta0| <= theta_max = {theta_max!r} rad',
+                   lambda x: math.isfinite(x) and abs(x) <= theta_max)
+    try:
+        t_eval = np.asarray(t_eval, dtype=float)
+    except (TypeError, ValueError):
+        t_eval = np.array([np.nan])
+    if (t_eval.ndim != 1 or t_eval.size == 0 or not np.all(np.isfinite(t_eval))
+            or t_eval[0] < 0 or np.any(np.diff(t_eval) <= 0)):
+        raise ValueError('t_eval must be a non-empty 1-d array of finite, strictly increasing '
+                         'times >= 0 s')
+    u0 = float(dynamics.body.phase_from_theta(theta0, branch))
+    return simulate_phase(dynamics, t_eval, u0, dynamics.initial_phase_rate(u0, omega0),
+                          mode=mode, method=method, tolerance=tolerance)
+
+
+def simulate_phase(dynamics, t_eval, u0, u_dot0, *, mode='dynamic', method='table',
+                   tolerance=1e-10):
+    """As :func:`simulate`, from the phase u0 (rad) and phase rate u_dot0 (rad/s).
+
+    In kinematic mode the angular speed held is |u_dot0|·|ω_u(u0)|.
+    """
+    _check_choice('mode', mode, MODES)
+    _check_choice('method', method, METHODS)
+    t_eval = np.asarray(t_eval, dtype=float)
+    if mode == 'kinematic':
+        omega = float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
+        return _simulate_kinematic(dynamics, t_eval, float(u0), omega, method, tolerance)
+    return _simulate_dynamic(dynamics, t_eval, float(u0), float(u_dot0), method, tolerance)
+
+
+class MotionStream:
+    """Samples of one motion at increasing times, for as long as asked (the node's source).
+
+    A closed-form solution is evaluated at any time; an ODE solution covers ``chunk``
+    seconds and is continued from its end state when the samples go past it.
+    """
+
+    def __init__(self, dynamics, u0, u_dot0, *, mode='dynamic', method='table',
+                 tolerance=1e-10, chunk=10.0):
+        self.dynamics, self.mode, self.method, self.tolerance = dynamics, mode, method, tolerance
+        self._chunk = float(chunk)
+        self._start = 0.0
+        motion = simulate_phase(dynamics, [0.0, self._chunk], u0, u_dot0, mode=mode,
+                                method=method, tolerance=tolerance)
+        self._sol = motion.sol
+        self.initial_energy = float(motion.energy[0])
+
+    def sample(self, t):
+        """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
+        t = np.asarray(t, dtype=float)
+        pieces = []
+        while True:
+            end = self._start + self._sol.t_end
+            inside = t <= end
+            pieces.append(self._sol(t[inside] - self._start))
+            t = t[~inside]
+            if not t.size:
+                break
+            u_end, u_dot_end = self._sol(end - self._start)
+            self._start = end
+            self._sol = simulate_phase(self.dynamics, [0.0, self._chunk], u_end, u_dot_end,
+                                       mode=self.mode, method=self.method,
+                                       tolerance=self.tolerance).sol
+        joined = np.concatenate(pieces, axis=1)
+        return joined[0], joined[1]
+
+
+def _motion(dynamics, mode, method, t, sol, nfev=0):
+    u, u_dot = sol(t)
+    return RollingMotion(dynamics=dynamics, mode=mode, method=method, t=t, phase=u,
+                         phase_rate=u_dot, energy=dynamics.energy(u, u_dot), nfev=nfev,
+                         solver=sol.name, sol=sol)
+
+
+def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
+    if omega0 == 0:
+        return _motion(dynamics, 'kinematic', method, t_eval, RestSolution(u0))
+    speed = abs(omega0)
+    direction = math.copysign(1.0, omega0)
+    if method == 'table':
+        quad = QuadratureSolution(u0, direction,
+                                  lambda u: dynamics.tabulated(u)[..., 2] / speed,
+                                  dynamics.table_size)
+        return _motion(dynamics, 'kinematic', method, t_eval, quad)
+
+    def rate(u):
+        return direction * speed / dynamics.angular_speed_per_phase(u)
+
+    def rhs(t, y):
+        return [float(rate(y[0]))]
+    sol, nfev = _solve(rhs, t_eval, [u0], tolerance, 1.0, rate=rate)
+    return _motion(dynamics, 'kinematic', method, t_eval, sol, nfev)
+
+
+def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
+    if u_dot0 == 0 and dynamics.is_equilibrium(u0):
+        return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+    if method == 'table':
+        f0 = dynamics.tabulated(u0)
+        energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
+        v_max = dynamics.potential_range[1]
+        margin = energy - v_max
+        n = dynamics.table_size
+        if u_dot0 != 0 and margin > 1e-6 * dynamics.energy_scale:
+            def inverse_speed(u):
+                f = dynamics.tabulated(u)
+                return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
+            quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed, n)
+            return _motion(dynamics, 'dynamic', method, t_eval, quad)
+        if margin < -1e-6 * dynamics.energy_scale:
+            libration = LibrationSolution(dynamics, u0, u_dot0, n)
+            return _motion(dynamics, 'dynamic', method, t_eval, libration)
+
+        def rhs(t, y):
+            f = dynamics.tabulated(y[0])
+            df = dynamics.tabulated(y[0], derivative=1)
+            return [y[1], -(df[1] + 0.5 * df[0] * y[1] ** 2) / f[0]]
+    else:
+        def rhs(t, y):
+            m = float(dynamics.effective_mass(y[0]))
+            dm = float(dynamics.effective_mass_slope(y[0]))
+            dv = float(dynamics.potential_slope(y[0]))
+            return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
+    rate_scale = max(abs(u_dot0), 1.0)
+    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
+    return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+
+
+def _solve(rhs, t_eval, y0, tolerance, scale, rate=None):
+    """DOP853 over [0, t_eval[-1]]: (OdeSolution, right-hand-side evaluations)."""
+    t_end = float(t_eval[-1])
+    if t_end == 0.0:
+        return OdeSolution(None, y0, t_end, rate), 0
+    result = solve_ivp(rhs, (0.0, t_end), y0, method='DOP853', rtol=tolerance,
+                       atol=tolerance * scale, dense_output=True)
+    if not result.success:
+        raise RuntimeError(f'integration failed: {result.message}')
+    return OdeSolution(result.sol, y0, t_end, rate), result.nfev
