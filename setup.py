@@ -22,7 +22,7 @@ setup(
     tests_require=['pytest'],
     entry_points={
         'console_scripts': [
-            'roller = twodisk_ros.node.roller:main',
+            'roller = twodisk_ros.roller:main',
             'twodisk-inspect = twodisk_ros.inspect.cli:main',
             'twodisk-figures = twodisk_ros.plotting.figures:main',
         ],

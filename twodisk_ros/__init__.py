@@ -9,13 +9,24 @@ Folders are the architecture:
 - :mod:`twodisk_ros.inspect`: ``twodisk-inspect``, the offline checks of a recording;
 - :mod:`twodisk_ros.plotting`: every figure (matplotlib).
 
-The physics is re-exported here: ``from twodisk_ros import TwoDiskBody, simulate``.
+The physics is re-exported here (imported on first use):
+``from twodisk_ros import TwoDiskBody, simulate``.
 """
 
-from .physics import (CycleDisplacement, Equilibrium, MassProperties, PhaseGeometry,
-                      RollingCycle, RollingDynamics, RollingMotion, RollingState, TwoDiskBody,
-                      equilibria, integrate_contact_trace, mass_properties, simulate,
-                      stability_map)
+import importlib
+
+_PHYSICS = ('CycleDisplacement', 'Equilibrium', 'MassProperties', 'PhaseGeometry', 'RollingCycle',
+            'RollingDynamics', 'RollingMotion', 'RollingState', 'TwoDiskBody', 'equilibria',
+            'integrate_contact_trace', 'mass_properties', 'simulate', 'stability_map')
+
+
+def __getattr__(name):
+    """The physics names, imported on first use (``python -m twodisk_ros.roller`` starts
+    without numpy, so its signal handlers are in place within milliseconds)."""
+    if name in _PHYSICS:
+        return getattr(importlib.import_module('.physics', __name__), name)
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')
+
 
 __version__ = '0.1.0'
 

@@ -7,9 +7,9 @@
 - :mod:`~twodisk_ros.io.errors`: :class:`RecordingError`.
 """
 
-from .errors import RecordingError
+from .errors import RecordingError, RecordingExistsError
 from .reader import RecordedMessage, Recording, TopicInfo, read_recording
 from .writer import DEFAULT_CHUNK_SIZE, McapRecorder
 
 __all__ = ['DEFAULT_CHUNK_SIZE', 'McapRecorder', 'RecordedMessage', 'Recording',
-           'RecordingError', 'TopicInfo', 'read_recording']
+           'RecordingError', 'RecordingExistsError', 'TopicInfo', 'read_recording']

@@ -2,11 +2,16 @@
 
 import os
 
-__all__ = ['RecordingError', 'io_errors', 'one_line', 'os_error_reason']
+__all__ = ['RecordingError', 'RecordingExistsError', 'io_errors', 'one_line',
+           'os_error_reason']
 
 
 class RecordingError(Exception):
     """A recording file cannot be written or read; the message is one line naming the path."""
+
+
+class RecordingExistsError(RecordingError):
+    """The recording file exists and the writer was not asked to replace it."""
 
 
 def one_line(text):

@@ -3,21 +3,20 @@
 Topics (relative names, so namespaces work), frames per REP-103, SI units:
 ``pose`` (PoseStamped, body frame at G), ``contact_a`` / ``contact_b`` (PointStamped),
 ``rolling_state`` (JointState: theta, psi, phase), ``path_a`` / ``path_b`` / ``path_g``
-(Path, ≤ 10 Hz), ``markers`` (MarkerArray, ≤ 10 Hz) and ``/diagnostics`` (1 Hz).
+(Path, ≤ 2 Hz), ``markers`` (MarkerArray, ≤ 10 Hz) and ``/diagnostics`` (1 Hz).
 Run: ``ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml``.
+
+States are computed in blocks ahead of time and encoded to CDR in one vectorised step
+(:mod:`twodisk_ros.io.cdr`); the per-sample work is handing bytes to DDS and to the recorder.
 """
 
 from collections import deque
-import signal
-import sys
+import math
+import os
+import time
 
 import numpy as np
-import rclpy
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.serialization import serialize_message
-from rclpy.signals import SignalHandlerOptions
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 
@@ -28,275 +27,343 @@ from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 
 from .. import __version__
-from ..io import McapRecorder, RecordingError
+from ..io import McapRecorder, cdr
 from . import messages
-from .simulation import DEFAULTS, RollerSettings, Simulation
+from .parameters import BY_NAME, DEFAULTS, PARAMETERS
+from .simulation import Simulation
 
-MARKER_RATE = 10.0       # Hz: markers at most this often
-PATH_RATE = 2.0          # Hz: paths (up to path_length poses each) at most this often
-DIAGNOSTICS_RATE = 1.0   # Hz
-BATCH = 500              # samples computed at once in batch runs
+__all__ = ['Roller']
+
+MARKER_RATE = 10.0       # Hz of simulated time: markers at most this often
+PATH_RATE = 2.0          # Hz of simulated time: paths (up to path_length poses each)
+DIAGNOSTICS_RATE = 1.0   # Hz of simulated time
+BATCH_SAMPLES = 2000     # samples computed and written at once in batch runs
+AHEAD = 0.05             # s: realtime states are computed this far ahead, in one block
+MAX_LAG = 0.1            # s: a realtime node further behind drops samples to catch up
 QOS_DEPTH = 10
-
-_DESCRIPTIONS = {
-    'a': ('semi-axis of each disk along the common axis (m)', (1e-9, 1e9)),
-    'b': ('other semi-axis of each disk (m); b > a is allowed', (1e-9, 1e9)),
-    'delta': ('half the distance between the disk centres (m), 0 < delta < a', (0.0, 1e9)),
-    'mass': ('total mass (kg)', (1e-12, 1e12)),
-    'gravity': ('gravitational acceleration (m/s^2)', (0.0, 1e3)),
-    'mass_model': ('laminae (two thin disks), solid (convex hull), or custom', None),
-    'principal_moments': ('custom mass model: I1, I2, I3 about G (kg m^2)', None),
-    'mode': ('dynamic (gravity only) or kinematic (constant angular speed)', None),
-    'theta0': ('initial contact angle theta on disk 1 (rad), |theta0| <= theta_max', None),
-    'branch': ('+1: the paper branch (B below the plane of disk 1), -1: its mirror', (-1, 1)),
-    'omega0': ('initial signed angular speed (rad/s); + means theta increasing on branch +1',
-               None),
-    'rate': ('publishing rate (Hz); read-only at run time', (1e-3, 1e5)),
-    'duration': ('simulated time (s), 0 = until stopped; read-only at run time', None),
-    'realtime': ('true: paced by the clock; false: as fast as possible, then exit', None),
-    'method': ('table (fast, precomputed cycle tables) or direct (closed forms on the fly)',
-               None),
-    'tolerance': ('relative ODE tolerance; energy drift above it raises a WARN', (1e-15, 0.5)),
-    'frame_id': ('world frame of poses, points, paths and markers', None),
-    'path_length': ('poses kept in each Path', (1, 1000000)),
-    'record': ('MCAP file to record every published message to, empty = off; read-only', None),
+MIN_SAMPLES = 5          # a stopped run that began publishing ends with at least this many
+SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
+TOPIC_TYPES = {
+    'pose': PoseStamped, 'contact_a': PointStamped, 'contact_b': PointStamped,
+    'rolling_state': JointState, 'path_a': Path, 'path_b': Path, 'path_g': Path,
+    'markers': MarkerArray, '/diagnostics': DiagnosticArray,
 }
-_READ_ONLY = ('rate', 'duration', 'realtime', 'record')
 
 
-def _descriptor(name):
-    text, bounds = _DESCRIPTIONS[name]
-    descriptor = ParameterDescriptor(description=text, read_only=name in _READ_ONLY)
-    if bounds is not None and isinstance(getattr(DEFAULTS, name), int) and not isinstance(
-            getattr(DEFAULTS, name), bool):
-        step = 2 if name == 'branch' else 1
-        descriptor.integer_range = [IntegerRange(from_value=bounds[0], to_value=bounds[1],
-                                                 step=step)]
-    elif bounds is not None:
-        descriptor.floating_point_range = [FloatingPointRange(from_value=float(bounds[0]),
-                                                              to_value=float(bounds[1]))]
+def _descriptor(p):
+    """The ROS ParameterDescriptor of a contract entry."""
+    unit = f' ({p.unit})' if p.unit else ''
+    descriptor = ParameterDescriptor(description=f'{p.description}{unit}; {p.rule}',
+                                     read_only=p.read_only)
+    if p.kind is int and p.choices is not None:
+        low, high = min(p.choices), max(p.choices)
+        step = (high - low) if len(p.choices) == 2 else 1
+        descriptor.integer_range = [IntegerRange(from_value=low, to_value=high, step=step)]
+    elif p.kind is int:
+        descriptor.integer_range = [IntegerRange(from_value=int(p.low), to_value=int(p.high),
+                                                 step=1)]
+    elif p.kind is float:
+        descriptor.floating_point_range = [FloatingPointRange(from_value=float(p.low),
+                                                              to_value=float(p.high))]
+    if p.choices is not None and p.kind is str:
+        descriptor.additional_constraints = f'one of {", ".join(p.choices)}'
     return descriptor
 
 
-def _default_value(name):
-    value = getattr(DEFAULTS, name)
-    return [float(x) for x in value] if isinstance(value, tuple) else value
+def _ros_value(p):
+    return [float(x) for x in p.default] if p.kind is tuple else p.default
 
 
 class Roller(Node):
-    """Publishes the rolling body; the physics lives in :class:`Simulation`."""
+    """Publishes the rolling body; the physics lives in :class:`Simulation`.
+
+    Raises ValueError or RuntimeError (one line) if the parameters define no valid run,
+    and :class:`~twodisk_ros.io.RecordingError` if the record file cannot be written.
+    """
 
     def __init__(self, **kwargs):
         super().__init__('roller', **kwargs)
-        for name in _DESCRIPTIONS:
-            self.declare_parameter(name, _default_value(name), _descriptor(name))
-        values = {name: self.get_parameter(name).value for name in _DESCRIPTIONS}
+        for p in PARAMETERS:
+            self.declare_parameter(p.name, _ros_value(p), _descriptor(p))
+        values = {p.name: self.get_parameter(p.name).value for p in PARAMETERS}
         self.settings = DEFAULTS.with_values(**values).checked()
         self.simulation = Simulation(self.settings)
         self._recorder = None
+        self._pubs = {topic: self.create_publisher(kind, topic, QOS_DEPTH)
+                      for topic, kind in TOPIC_TYPES.items()}
         if self.settings.record:
-            self._recorder = McapRecorder(self.settings.record, metadata=self._metadata())
-        self._pubs = {}  # topic → publisher
-        for topic, kind in (('pose', PoseStamped), ('contact_a', PointStamped),
-                            ('contact_b', PointStamped), ('rolling_state', JointState),
-                            ('path_a', Path), ('path_b', Path), ('path_g', Path),
-                            ('markers', MarkerArray), ('/diagnostics', DiagnosticArray)):
-            publisher = self.create_publisher(kind, topic, QOS_DEPTH)
-            self._pubs[topic] = publisher
-            if self._recorder is not None:
+            self._recorder = McapRecorder(self.settings.record, metadata=self._metadata(),
+                                          overwrite=self.settings.overwrite)
+            for topic, kind in TOPIC_TYPES.items():
+                publisher = self._pubs[topic]
                 self._recorder.add_topic(publisher.topic_name, kind, publisher.qos_profile)
+        self.samples_published = 0      # samples since start (across motion restarts)
+        self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
+        self.messages_built = {topic: 0 for topic in TOPIC_TYPES}
         self._paths = {key: deque(maxlen=self.settings.path_length) for key in 'abg'}
-        self._tick = 0            # samples published since the motion (re)started
-        self._t_offset = 0.0      # simulated time (s) at which the motion (re)started
-        self._next_path = 0.0
-        self._next_marker = 0.0
-        self._next_diagnostics = 0.0
+        self._tick = 0                  # global sample index: simulated time tick / rate
+        self._motion_tick = 0           # tick at which the motion (re)started
+        self._next = {'path': 0.0, 'marker': 0.0, 'diagnostics': 0.0}
         self._pending = None
+        self._block = None              # realtime: (first tick, Sample, encoded messages)
         self._start_ns = self.get_clock().now().nanoseconds
+        self._wall_start = time.monotonic()
+        self._rate_window = deque(maxlen=64)   # (wall time, tick) for the achieved rate
         self.finished = False
         self.add_on_set_parameters_callback(self._on_set_parameters)
         if self.settings.realtime:
             self._timer = self.create_timer(1.0 / self.settings.rate, self._on_timer)
 
     # -- parameters -------------------------------------------------------------------------
+    @property
+    def pending_changes(self):
+        """True while accepted parameter changes wait for the next sample."""
+        return self._pending is not None
+
     def _metadata(self):
         metadata = self.settings.as_strings()
         metadata['version'] = __version__
         return metadata
 
     def _on_set_parameters(self, parameters):
-        changes = {p.name: p.value for p in parameters if p.name in _DESCRIPTIONS}
-        base = self._pending or self.settings   # changes not yet applied still count
+        changes = {p.name: p.value for p in parameters if p.name in BY_NAME}
+        read_only = [name for name in changes if BY_NAME[name].read_only]
+        if read_only:
+            return SetParametersResult(successful=False,
+                                       reason=f'{read_only[0]} is read-only at run time')
+        base = self._pending[0] if self._pending else self.settings
         try:
             candidate = base.with_values(**changes).checked()
-        except (ValueError, TypeError) as error:
-            return SetParametersResult(successful=False, reason=str(error))
-        self._pending = candidate
+            simulation = (Simulation(candidate) if candidate.physics_differs(self.settings)
+                          else None)
+        except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
+            return SetParametersResult(successful=False, reason=' '.join(str(error).split()))
+        self._pending = (candidate, simulation)
         return SetParametersResult(successful=True)
 
-    def _apply_pending(self, now):
-        candidate, self._pending = self._pending, None
-        physics_changed = any(getattr(candidate, k) != getattr(self.settings, k)
-                              for k in RollerSettings.PHYSICS)
+    def _apply_pending(self):
+        (candidate, simulation), self._pending = self._pending, None
         self.settings = candidate
         for key in 'abg':
             self._paths[key] = deque(self._paths[key], maxlen=candidate.path_length)
-        if physics_changed:
-            self.simulation = Simulation(candidate)
-            self._t_offset, self._tick = now, 0
+        if simulation is not None:
+            self.simulation = simulation
+            self._motion_tick = self._tick
+            self._block = None
             for path in self._paths.values():
                 path.clear()
-            self._next_diagnostics = now
+            self._next['diagnostics'] = self._tick / self.settings.rate
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
 
-    # -- publishing -------------------------------------------------------------------------
+    # -- computing and publishing -----------------------------------------------------------
     def _wanted(self, topic):
         return self._recorder is not None or self._pubs[topic].get_subscription_count() > 0
 
-    def _publish(self, topic, message, time_ns):
-        data = serialize_message(message)   # once, for the wire and the file
-        self._pubs[topic].publish(data)
+    def _prepare(self, first, count):
+        """Sample and encode ``count`` samples from global tick ``first``."""
+        rate = self.settings.rate
+        ticks = np.arange(first, first + count)
+        sample = self.simulation.sample((ticks - self._motion_tick) / rate)
+        stamps = self._start_ns + np.round(ticks * (1e9 / rate)).astype(np.int64)
+        frame = self.settings.frame_id
+        encoders = {
+            'pose': lambda: cdr.encode_pose_stamped(stamps, frame, sample.position_g,
+                                                    sample.quaternion),
+            'contact_a': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_a),
+            'contact_b': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_b),
+            'rolling_state': lambda: cdr.encode_joint_state(
+                stamps, messages.JOINT_NAMES,
+                np.column_stack([sample.theta, sample.psi, sample.phase]),
+                np.column_stack([sample.theta_rate, sample.psi_rate, sample.phase_rate])),
+        }
+        encoded = {topic: encode() for topic, encode in encoders.items() if self._wanted(topic)}
+        for topic, column in encoded.items():
+            self.messages_built[topic] += len(column)
+        return sample, stamps, encoded
+
+    def _emit(self, sample, stamps, encoded, start, stop):
+        """Publish and record samples [start, stop) of a prepared block, sample by sample."""
+        subscribed = [topic for topic in encoded
+                      if self._pubs[topic].get_subscription_count() > 0]
+        for i in range(start, stop):
+            for topic in subscribed:
+                self._pubs[topic].publish(encoded[topic][i])
+        if self._recorder is not None and encoded:
+            topics = list(encoded)
+            self._recorder.write_interleaved(
+                [self._pubs[t].topic_name for t in topics],
+                [encoded[t][start:stop] for t in topics], stamps[start:stop])
+        for i in range(start, stop):
+            self._after_sample(sample, stamps, i)
+        self._tick += stop - start
+        self.samples_published += stop - start
+
+    def _after_sample(self, sample, stamps, i):
+        """Paths, markers and diagnostics at their lower rates; the validity of the motion."""
+        time_s = sample.t[i] + self._motion_tick / self.settings.rate
+        for key, points in (('a', sample.contact_a), ('b', sample.contact_b),
+                            ('g', sample.position_g)):
+            self._paths[key].append((int(stamps[i]), points[i]))
+        if time_s + 1e-12 >= self._next['path']:
+            self._next['path'] = time_s + 1.0 / PATH_RATE
+            self._publish_paths(int(stamps[i]))
+        if time_s + 1e-12 >= self._next['marker']:
+            self._next['marker'] = time_s + 1.0 / MARKER_RATE
+            self._publish_markers(sample, i, int(stamps[i]))
+        if time_s + 1e-12 >= self._next['diagnostics']:
+            self._next['diagnostics'] = time_s + 1.0 / DIAGNOSTICS_RATE
+            self._publish_diagnostics(sample, i, int(stamps[i]))
+
+    def _send(self, topic, data, time_ns):
+        self.messages_built[topic] += 1
+        if self._pubs[topic].get_subscription_count() > 0:
+            self._pubs[topic].publish(data)
         if self._recorder is not None:
             self._recorder.write_serialized(self._pubs[topic].topic_name, data, time_ns)
 
-    def _sim_time(self, tick):
-        return self._t_offset + tick / self.settings.rate
-
-    def _on_timer(self):
-        now = self._sim_time(self._tick)
-        if self._pending is not None:
-            self._apply_pending(now)
-        duration = self.settings.duration
-        if duration > 0 and now > duration + 1e-9:
-            self.finished = True
-            return
-        self.publish_samples(np.array([now]))
-
-    def publish_samples(self, times):
-        """Compute and publish the state at simulated times (s, increasing array)."""
-        sample = self.simulation.sample(times - self._t_offset)
-        frame = self.settings.frame_id
-        state = sample.state
-        quaternions = state.quaternion if self._wanted('pose') else None
-        for i, t in enumerate(times):
-            time_ns = self._start_ns + int(round(t * 1e9))
-            if quaternions is not None:
-                self._publish('pose', messages.pose_stamped(
-                    frame, time_ns, state.position_g[i], quaternions[i]), time_ns)
-            for key, points in (('contact_a', state.contact_a), ('contact_b', state.contact_b)):
-                if self._wanted(key):
-                    self._publish(key, messages.point_stamped(frame, time_ns, points[i]),
-                                  time_ns)
-            if self._wanted('rolling_state'):
-                self._publish('rolling_state', messages.rolling_state(
-                    time_ns, (state.theta[i], state.psi[i], sample.phase[i]),
-                    (sample.theta_rate[i], sample.psi_rate[i], sample.phase_rate[i])), time_ns)
-            for key, points in (('a', state.contact_a), ('b', state.contact_b),
-                                ('g', state.position_g)):
-                if self._wanted('path_' + key):
-                    self._paths[key].append(messages.path_pose(frame, time_ns, points[i]))
-            if t + 1e-12 >= self._next_path:
-                self._next_path = t + 1.0 / PATH_RATE
-                self._publish_paths(time_ns)
-            if t + 1e-12 >= self._next_marker:
-                self._next_marker = t + 1.0 / MARKER_RATE
-                self._publish_markers(sample, i, time_ns)
-            if t + 1e-12 >= self._next_diagnostics:
-                self._next_diagnostics = t + 1.0 / DIAGNOSTICS_RATE
-                self._publish_diagnostics(sample, i, time_ns)
-        self._tick += len(times)
-
     def _publish_paths(self, time_ns):
+        frame = self.settings.frame_id
         for key in 'abg':
             topic = 'path_' + key
             if self._wanted(topic):
-                self._publish(topic, messages.path(self.settings.frame_id, time_ns,
-                                                   self._paths[key]), time_ns)
+                entries = self._paths[key]
+                stamps = np.array([s for s, _ in entries], dtype=np.int64)
+                points = np.array([p for _, p in entries], dtype=float).reshape(-1, 3)
+                self._send(topic, cdr.encode_path(time_ns, frame, points, stamps_ns=stamps),
+                           time_ns)
 
     def _publish_markers(self, sample, i, time_ns):
-        frame = self.settings.frame_id
-        if self._wanted('markers'):
-            state = sample.state
-            disk1, disk2 = self.simulation.disk_outlines(state.rotation[i], state.position_g[i])
-            self._publish('markers', messages.body_markers(
-                frame, time_ns, disk1, disk2, state.contact_a[i], state.contact_b[i],
-                self.simulation.body.size), time_ns)
+        if not self._wanted('markers'):
+            return
+        rotation = self.simulation.rotation(sample, i)
+        disk1, disk2 = self.simulation.disk_outlines(rotation, sample.position_g[i])
+        message = messages.body_markers(self.settings.frame_id, time_ns, disk1, disk2,
+                                        sample.contact_a[i], sample.contact_b[i],
+                                        self.simulation.body.size)
+        self._send('markers', cdr.serialize(message), time_ns)
+
+    def achieved_rate(self):
+        """Samples per wall-clock second over the last few ticks (realtime), or None."""
+        if len(self._rate_window) < 2:
+            return None
+        (w0, k0), (w1, k1) = self._rate_window[0], self._rate_window[-1]
+        return (k1 - k0) / (w1 - w0) if w1 > w0 else None
 
     def _publish_diagnostics(self, sample, i, time_ns):
         if not self._wanted('/diagnostics'):
             return
-        drift = self.simulation.energy_drift(sample.energy[i])
-        dynamic = self.settings.mode == 'dynamic'
-        warn = dynamic and drift > self.settings.tolerance
-        values = [('energy', float(sample.energy[i])), ('energy_drift', drift),
-                  ('tilt', float(sample.state.tilt[i])), ('phase', float(sample.phase[i])),
-                  ('mode', self.settings.mode), ('method', self.settings.method)]
+        s = self.settings
+        name, value, drift = self.simulation.invariant(sample, i)
+        level, message = messages.OK, 'rolling'
+        if drift > s.tolerance:
+            level, message = messages.WARN, (f'{name} drift {drift:.2e} exceeds tolerance '
+                                              f'{s.tolerance:.1e}')
+        achieved = self.achieved_rate()
+        if s.realtime and achieved is not None and achieved < 0.95 * s.rate:
+            level = messages.WARN
+            message = (f'cannot hold rate {s.rate:g} Hz: achieved {achieved:.4g} Hz, '
+                       f'{self.samples_dropped} samples dropped to keep real time')
+        values = [(name, value), (f'{name}_drift', drift),
+                  ('energy', self.simulation.energy(sample, i)),
+                  ('tilt', float(self.simulation.dynamics.cycle.state(sample.phase[i]).tilt)),
+                  ('phase', float(sample.phase[i])), ('mode', s.mode), ('method', s.method),
+                  ('rate', s.rate), ('achieved_rate', achieved if achieved else s.rate),
+                  ('samples_dropped', self.samples_dropped)]
+        if name != 'energy':
+            values = [v for v in values if v[0] != 'energy'] + [
+                ('energy', self.simulation.energy(sample, i))]
         for k, (eq, period) in enumerate(self.simulation.equilibria):
             values.append((f'equilibrium {k}', (
                 f'{eq.name}: theta={eq.theta:.9g} rad, psi={eq.psi:.9g} rad, '
                 f'height={eq.height:.9g} m, d2z/d{eq.coordinate}2={eq.curvature:.6g} m, '
                 f'{eq.stability}' + (f', period={period:.9g} s' if period else ''))))
-        message = (f'energy drift {drift:.2e} exceeds tolerance {self.settings.tolerance:.1e}'
-                   if warn else 'rolling')
-        level = messages.WARN if warn else messages.OK
-        self._publish('/diagnostics', messages.diagnostics(
-            time_ns, 'twodisk_ros: roller', level, message, values), time_ns)
+        self._send('/diagnostics', cdr.serialize(messages.diagnostics(
+            time_ns, 'twodisk_ros: roller', level, message, values)), time_ns)
 
-    def run_batch(self):
-        """realtime=false: compute ``duration`` as fast as possible, publishing every sample."""
-        count = int(np.floor(self.settings.duration * self.settings.rate + 1e-9)) + 1
-        for start in range(0, count, BATCH):
-            if not rclpy.ok():
-                break
-            ticks = np.arange(start, min(count, start + BATCH))
-            self.publish_samples(ticks / self.settings.rate)
-        self.finished = True
+    # -- the two ways to run ----------------------------------------------------------------
+    def _on_timer(self):
+        """Realtime: publish every sample that is due by the wall clock (drop beyond MAX_LAG)."""
+        if self.finished:
+            return
+        rate = self.settings.rate
+        now = time.monotonic()
+        due = int(math.floor((now - self._wall_start) * rate)) + 1   # ticks due so far
+        if self._pending is not None:
+            self._apply_pending()
+        limit = self._end_tick()
+        if limit is not None:
+            due = min(due, limit)
+        backlog = due - self._tick
+        allowed = max(1, int(MAX_LAG * rate))
+        if backlog > allowed:
+            self.samples_dropped += backlog - allowed
+            self._tick = due - allowed
+            self._block = None
+            self.get_logger().warn(
+                f'cannot hold rate {rate:g} Hz: dropped {backlog - allowed} samples '
+                f'({self.samples_dropped} so far) to keep real time',
+                throttle_duration_sec=5.0)
+        while self._tick < due:
+            block = self._block
+            if block is None or not block[0] <= self._tick < block[0] + len(block[1]):
+                count = max(1, int(AHEAD * rate), due - self._tick)
+                if limit is not None:
+                    count = min(count, limit - self._tick)
+                self._block = block = (self._tick, *self._prepare(self._tick, count))
+            first, sample, stamps, encoded = block
+            start = self._tick - first
+            stop = min(len(sample), due - first)
+            self._emit(sample, stamps, encoded, start, stop)
+        self._rate_window.append((now, self._tick))
+        if limit is not None and self._tick >= limit:
+            self.finished = True
+
+    def _end_tick(self):
+        """One past the last tick of a run with a duration, or None."""
+        if self.settings.duration <= 0:
+            return None
+        return int(math.floor(self.settings.duration * self.settings.rate + 1e-9)) + 1
+
+    def run_batch(self, keep_going=lambda: True):
+        """realtime=false: compute ``duration`` as fast as possible, publishing every sample.
+
+        ``keep_going()`` is asked between blocks (a signal ends the run at a block boundary,
+        every topic on the same sample).
+        """
+        end = self._end_tick()
+        while self._tick < end and keep_going():
+            if self._pending is not None:
+                self._apply_pending()
+            count = min(BATCH_SAMPLES, end - self._tick)
+            sample, stamps, encoded = self._prepare(self._tick, count)
+            self._emit(sample, stamps, encoded, 0, count)
+        self.finished = self._tick >= end
+
+    def finish_samples(self):
+        """Publish at once what a stopped run still needs to be checkable offline.
+
+        A run stopped after its first sample ends with at least :data:`MIN_SAMPLES` samples
+        (the fewest the inspector's central differences use); stamps stay on the schedule.
+        """
+        missing = MIN_SAMPLES - self.samples_published
+        end = self._end_tick()
+        if end is not None:
+            missing = min(missing, end - self._tick)
+        if self.samples_published > 0 and missing > 0:
+            sample, stamps, encoded = self._prepare(self._tick, missing)
+            self._emit(sample, stamps, encoded, 0, missing)
 
     def close(self):
-        """Finish the recording (idempotent)."""
-        if self._recorder is not None:
-            self._recorder.close()
+        """Finish the recording (idempotent); RecordingError if it cannot be written.
 
-
-def _interrupt(signum, frame):
-    raise KeyboardInterrupt(signal.Signals(signum).name)
-
-
-def main(args=None):
-    """Entry point of ``ros2 run twodisk_ros roller``; exit 2 on invalid start-up values.
-
-    SIGINT and SIGTERM both end the node cleanly (recording finished) with exit code 0.
-    """
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.SIGINT)
-    signal.signal(signal.SIGTERM, _interrupt)
-    node = None
-    try:
-        try:
-            node = Roller()
-        except (ValueError, TypeError, RecordingError,
-                ParameterException) as error:
-            print(f'roller: {_one_line(error)}', file=sys.stderr)
-            return 2
-        if not node.settings.realtime:
-            node.run_batch()
-        else:
-            while rclpy.ok() and not node.finished:
-                rclpy.spin_once(node, timeout_sec=0.1)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.close()
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
-
-
-def _one_line(error):
-    text = ' '.join(str(error).split())
-    return text if len(text) < 400 else text[:397] + '...'
-
-
-if __name__ == '__main__':
-    sys.exit(main())
+        A recording that never received a sample (stopped during start-up) is removed:
+        nothing was recorded. Returns True if a recording was kept.
+        """
+        if self._recorder is None:
+            return False
+        self._recorder.close()
+        if self.samples_published == 0 and os.path.exists(self._recorder.path):
+            os.remove(self._recorder.path)
+            return False
+        return True

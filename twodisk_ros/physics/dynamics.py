@@ -143,8 +143,8 @@ class RollingDynamics:
             result = []
             for eq in equilibria(self.body):
                 period = None
-                if eq.stability == STABLE and self.gravity > 0:
-                    stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                if eq.stability == STABLE and stiffness > 0:
                     period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
                 result.append((eq, period))
             self._equilibria = result

@@ -1,0 +1,126 @@
+"""``roller``'s process: arguments, signals, exit codes (the node itself is in roller.py).
+
+Exit codes: 0 a run that ended (duration reached, SIGINT or SIGTERM: the recording is
+complete); 2 invalid input (arguments, parameters, an existing or unwritable record file),
+one line on stderr; 3 the recording could not be written during the run (disk full, I/O
+error), one line on stderr, everything written before stays readable; 1 an internal error,
+one line (``TWODISK_DEBUG=1`` prints the traceback).
+"""
+
+import os
+import sys
+import traceback
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
+
+from ..io import RecordingError, RecordingExistsError
+from ..io.errors import one_line
+from .arguments import ArgumentError, check_arguments
+from .stop import StopRequest
+
+__all__ = ['main', 'EXIT_OK', 'EXIT_INPUT', 'EXIT_IO', 'EXIT_INTERNAL']
+
+EXIT_OK, EXIT_INTERNAL, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
+PROG = 'roller'
+
+
+def _say(text):
+    print(f'{PROG}: {one_line(text)}', file=sys.stderr, flush=True)
+
+
+def _internal(error):
+    if os.environ.get('TWODISK_DEBUG'):
+        traceback.print_exc()
+    _say(f'internal error: {type(error).__name__}: {error} (TWODISK_DEBUG=1 shows the '
+         'traceback)')
+    return EXIT_INTERNAL
+
+
+def _start(argv):
+    """rclpy and the node, or (None, exit code) after one line on stderr."""
+    from .roller import Roller   # after the arguments are known to be well formed
+    try:
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as error:  # noqa: BLE001 - rclpy's argument errors are RCLError
+        _say(f'invalid ROS arguments: {error}')
+        return None, EXIT_INPUT
+    try:
+        return Roller(), EXIT_OK
+    except RecordingExistsError as error:
+        _say(f'{error}; pass -p overwrite:=true to replace it')
+    except RecordingError as error:
+        _say(error)
+    except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
+        _say(error)
+    except Exception as error:  # noqa: BLE001 - rclpy's parameter exceptions, one line
+        name = type(error).__name__
+        if 'Parameter' not in name and 'RCL' not in name:
+            raise
+        hint = ' (write doubles with a decimal point: 50.0, not 50)' if 'DOUBLE' in str(
+            error) else ''
+        _say(f'invalid parameter: {error}{hint}')
+    return None, EXIT_INPUT
+
+
+def _run(node, stop):
+    if not node.settings.realtime:
+        node.run_batch(keep_going=lambda: not stop)
+    else:
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        try:
+            while not stop and not node.finished:
+                executor.spin_once(timeout_sec=0.05)
+        finally:
+            executor.shutdown(timeout_sec=1.0)
+    if stop:
+        node.finish_samples()
+
+
+def main(args=None, stop=None):
+    """Run the node; returns the exit code (module doc).
+
+    ``stop`` is the :class:`StopRequest` installed by the entry point before the heavy
+    imports (one is installed here if not given).
+    """
+    argv = list(sys.argv if args is None else args)
+    stop = stop if stop is not None else StopRequest()
+    try:
+        for warning in check_arguments(argv):
+            _say(f'warning: {warning}')
+    except ArgumentError as error:
+        _say(error)
+        return EXIT_INPUT
+    if stop:
+        _say(f'stopped by {stop.requested} during start-up: no recording written')
+        return EXIT_OK
+    node, status = None, EXIT_OK
+    try:
+        node, status = _start(argv)
+        if node is not None and not stop:
+            _run(node, stop)
+    except RecordingError as error:
+        _say(error)
+        status = EXIT_IO
+    except Exception as error:  # noqa: BLE001 - one line, never a traceback
+        status = _internal(error)
+    finally:
+        if node is not None:
+            try:
+                kept = node.close()
+                if not kept and node.settings.record:
+                    _say(f'stopped before the first sample: no recording written to '
+                         f'{node.settings.record}')
+            except RecordingError as error:
+                if status == EXIT_OK:
+                    _say(error)
+                    status = EXIT_IO
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())

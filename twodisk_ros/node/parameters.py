@@ -1,0 +1,286 @@
+"""The parameter contract of the ``roller`` node: every parameter defined once.
+
+Names, types, defaults, ranges, units, read-only flags and descriptions live in
+:data:`PARAMETERS`; the node's ROS descriptors, the validation at start-up and at run time,
+the inspector's reading of recorded parameters and the README table all come from here
+(``tests/test_parameters.py`` compares the README with it).
+
+The ranges are those within which the motion stays representable and the physics keeps its
+stated accuracy (docs/physics.md#accuracy-and-its-limits): shapes with b/a in [0.01, 100] and
+Δ/a in [1e-3, 1 − 1e-6], speeds up to 1000 rad/s. No rclpy here, so the offline tools use the
+same contract.
+"""
+
+from dataclasses import dataclass, fields, make_dataclass, replace
+import math
+import re
+
+from ..physics.body import TwoDiskBody
+from ..physics.mass_models import MODELS, mass_properties
+from ..physics.motion import METHODS, MODES
+
+__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings',
+           'markdown_table', 'parse_recorded']
+
+B_OVER_A = (0.01, 100.0)             # allowed b/a
+DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter of the node.
+
+    ``kind`` is the Python type of the value (``float``, ``int``, ``bool``, ``str``, or
+    ``tuple`` for a list of doubles); ``low``/``high`` bound numbers (inclusive, per element
+    for lists); ``choices`` lists the allowed strings or integers.
+    """
+
+    name: str
+    kind: type
+    default: object
+    unit: str
+    description: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple | None = None
+    read_only: bool = False
+    physics: bool = False     #: a change restarts the motion
+
+    @property
+    def rule(self):
+        """The allowed values in words, e.g. ``'0.001 <= a <= 1000 m'``."""
+        if self.choices is not None:
+            return f'one of {", ".join(str(c) for c in self.choices)}'
+        if self.kind is bool:
+            return 'true or false'
+        if self.kind is str:
+            return 'a string'
+        unit = f' {self.unit}' if self.unit else ''
+        each = 'each element ' if self.kind is tuple else ''
+        return f'{each}{_number(self.low)} <= {self.name} <= {_number(self.high)}{unit}'
+
+
+def _number(value):
+    return f'{value:g}'
+
+
+PARAMETERS = (
+    Parameter('a', float, 0.1, 'm', 'semi-axis of each disk along the common axis',
+              1e-3, 1e3, physics=True),
+    Parameter('b', float, 0.1, 'm', 'other semi-axis of each disk; '
+              f'{B_OVER_A[0]:g} <= b/a <= {B_OVER_A[1]:g} (b > a is allowed)',
+              1e-5, 1e5, physics=True),
+    Parameter('delta', float, 0.05, 'm', 'half the distance between the disk centres; '
+              f'{DELTA_OVER_A[0]:g} <= delta/a <= 1 - 1e-6', 1e-6, 1e3, physics=True),
+    Parameter('mass', float, 1.0, 'kg', 'total mass', 1e-6, 1e6, physics=True),
+    Parameter('gravity', float, 9.81, 'm/s^2', 'gravitational acceleration g', 0.0, 1e3,
+              physics=True),
+    Parameter('mass_model', str, 'laminae', '', 'laminae (two thin disks), solid (uniform '
+              'convex hull: the oloid toy) or custom', choices=MODELS, physics=True),
+    Parameter('principal_moments', tuple, (0.0, 0.0, 0.0), 'kg m^2', 'custom mass model: '
+              'I1, I2, I3 about G along e1, e2, e3', 0.0, 1e12, physics=True),
+    Parameter('mode', str, 'dynamic', '', 'dynamic (gravity only) or kinematic (constant '
+              'angular speed |omega0|)', choices=MODES, physics=True),
+    Parameter('theta0', float, 0.3, 'rad', 'initial contact angle on disk 1; '
+              '|theta0| <= theta_max of the body', -math.pi, math.pi, physics=True),
+    Parameter('branch', int, 1, '', '+1: B below the plane of disk 1, -1: the mirror half '
+              'of the cycle', choices=(-1, 1), physics=True),
+    Parameter('omega0', float, 3.0, 'rad/s', 'initial signed angular speed; + means theta '
+              'increasing on branch +1', -1e3, 1e3, physics=True),
+    Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
+    Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
+              read_only=True),
+    Parameter('realtime', bool, True, '', 'true: paced by the clock; false: as fast as '
+              'possible, then exit 0', read_only=True),
+    Parameter('method', str, 'table', '', 'table (cycle tables, motion in closed form) or '
+              'direct (closed forms on the fly, DOP853)', choices=METHODS, physics=True),
+    Parameter('tolerance', float, 1e-10, '', 'relative ODE tolerance; a drift of the '
+              'invariant (energy, or |omega| in kinematic mode) above it is a WARN',
+              1e-13, 1e-3, physics=True),
+    Parameter('frame_id', str, 'world', '', 'frame of poses, points, paths and markers '
+              '(non-empty, no spaces)'),
+    Parameter('path_length', int, 1000, '', 'poses kept in each Path', 1, 100000),
+    Parameter('record', str, '', '', 'MCAP file to record every published message to, '
+              "'' = off", read_only=True),
+    Parameter('overwrite', bool, False, '', 'replace an existing record file (else the '
+              'node refuses to start)', read_only=True),
+)
+
+BY_NAME = {p.name: p for p in PARAMETERS}
+#: Names the node accepts that belong to rclpy itself (no warning for them).
+ROS_OWN = ('use_sim_time', 'start_type_description_service')
+
+
+def _check_one(parameter, value):
+    """Return the value coerced to the parameter's kind, or raise ValueError (one line)."""
+    p = parameter
+    if p.kind is tuple:
+        try:
+            items = tuple(float(x) for x in value)
+        except (TypeError, ValueError):
+            raise ValueError(f'{p.name} must be a list of 3 numbers, got {value!r}') from None
+        if len(items) != 3 or not all(math.isfinite(x) and p.low <= x <= p.high
+                                      for x in items):
+            raise ValueError(f'{p.name} must be 3 numbers with {p.rule}, got {value!r}')
+        return items
+    if p.kind is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f'{p.name} must be a number ({p.rule}), got {value!r}')
+        value = float(value)
+    elif p.kind is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ValueError(f'{p.name} must be an integer ({p.rule}), got {value!r}')
+    elif not isinstance(value, p.kind):
+        raise ValueError(f'{p.name} must be {p.rule}, got {value!r}')
+    if p.choices is not None and value not in p.choices:
+        raise ValueError(f'{p.name} must be {p.rule}, got {value!r}')
+    if p.low is not None and not (math.isfinite(value) and p.low <= value <= p.high):
+        raise ValueError(f'{p.name} must satisfy {p.rule}, got {value!r}')
+    return value
+
+
+def _check_together(s):
+    """Rules that involve several parameters; raise ValueError (one line)."""
+    ratio = s.b / s.a
+    if not B_OVER_A[0] <= ratio <= B_OVER_A[1]:
+        raise ValueError(f'b/a must be in [{B_OVER_A[0]:g}, {B_OVER_A[1]:g}], got '
+                         f'b = {s.b!r} m, a = {s.a!r} m (b/a = {ratio:.6g})')
+    ratio = s.delta / s.a
+    if not DELTA_OVER_A[0] <= ratio <= DELTA_OVER_A[1]:
+        raise ValueError(f'delta/a must be in [{DELTA_OVER_A[0]:g}, 1 - 1e-6] (0 < delta < a), '
+                         f'got delta = {s.delta!r} m, a = {s.a!r} m (delta/a = {ratio:.6g})')
+    body = TwoDiskBody(s.a, s.b, s.delta)
+    if abs(s.theta0) > body.theta_max:
+        raise ValueError(f'theta0 must satisfy |theta0| <= theta_max = {body.theta_max:.6g} '
+                         f'rad for this body, got {s.theta0!r}')
+    if not s.realtime and s.duration <= 0:
+        raise ValueError('duration must be > 0 s when realtime is false (a batch run needs '
+                         f'an end), got {s.duration!r}')
+    if s.duration * s.rate > 1e10:
+        raise ValueError(f'duration x rate must be <= 1e10 samples, got {s.duration!r} s x '
+                         f'{s.rate!r} Hz')
+    if 0 < s.gravity < 1e-6:
+        raise ValueError(f'gravity must be 0 (no gravity) or in [1e-6, 1000] m/s^2, got '
+                         f'{s.gravity!r}')
+    if not s.frame_id or re.search(r'\s', s.frame_id):
+        raise ValueError(f'frame_id must be non-empty without spaces, got {s.frame_id!r}')
+    if s.mass_model == 'custom':
+        moments = s.principal_moments
+        if min(moments) <= 0:
+            raise ValueError('principal_moments must be 3 numbers > 0 kg m^2 for '
+                             f'mass_model custom, got {list(moments)!r}')
+    s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
+
+
+class _SettingsMethods:
+    def checked(self):
+        """Return self if every value is allowed, else raise ValueError (one line)."""
+        for p in PARAMETERS:
+            _check_one(p, getattr(self, p.name))
+        _check_together(self)
+        return self
+
+    def with_values(self, **values):
+        """A checked-type copy with some parameters changed (unknown names: ValueError)."""
+        unknown = sorted(set(values) - set(BY_NAME))
+        if unknown:
+            raise ValueError(f'unknown parameter {unknown[0]!r}')
+        return replace(self, **{k: _check_one(BY_NAME[k], v) for k, v in values.items()})
+
+    def mass_properties(self):
+        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of these settings."""
+        moments = self.principal_moments if self.mass_model == 'custom' else None
+        return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
+                               principal_moments=moments)
+
+    def as_strings(self):
+        """Every parameter as text (the recording's metadata; read by :func:`parse_recorded`)."""
+        return {p.name: (str(list(getattr(self, p.name))) if p.kind is tuple
+                         else str(getattr(self, p.name))) for p in PARAMETERS}
+
+    def physics_differs(self, other):
+        """True if a parameter that shapes the motion differs (the motion restarts)."""
+        return any(getattr(self, p.name) != getattr(other, p.name)
+                   for p in PARAMETERS if p.physics)
+
+
+#: Settings of the node (SI units): a frozen dataclass with one field per parameter.
+RollerSettings = make_dataclass(
+    'RollerSettings', [(p.name, p.kind, p.default) for p in PARAMETERS],
+    bases=(_SettingsMethods,), frozen=True, namespace={'__doc__': __doc__.split('\n')[0]})
+RollerSettings.__module__ = __name__
+
+DEFAULTS = RollerSettings()
+
+_REQUIRED_RECORDED = ('a', 'b', 'delta', 'mass', 'gravity', 'omega0')
+_NUMBER = re.compile(r'[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan')
+
+
+def _from_text(parameter, text):
+    p = parameter
+    if p.kind is bool:
+        lowered = text.strip().lower()
+        if lowered not in ('true', 'false'):
+            raise ValueError(f'parameter {p.name} = {text!r} is not true or false')
+        return lowered == 'true'
+    if p.kind is tuple:
+        return tuple(float(x) for x in _NUMBER.findall(text))
+    if p.kind is str:
+        return text
+    try:
+        value = p.kind(float(text)) if p.kind is float else int(text)
+    except ValueError:
+        raise ValueError(f'parameter {p.name} = {text!r} is not a number') from None
+    return value
+
+
+def parse_recorded(strings):
+    """Settings from a recording's ``twodisk_ros`` metadata (every value as text).
+
+    Returns
+    -------
+    (RollerSettings or None, list of str)
+        The settings (missing optional parameters take their defaults) and the problems
+        found, one line each; None if the values define no valid run.
+    """
+    problems, values = [], {}
+    for name in _REQUIRED_RECORDED:
+        if name not in strings:
+            problems.append(f'parameter {name} is missing')
+    for p in PARAMETERS:
+        if p.name not in strings:
+            continue
+        try:
+            values[p.name] = _check_one(p, _from_text(p, strings[p.name]))
+        except ValueError as error:
+            problems.append(str(error))
+    if problems:
+        return None, problems
+    if values.get('mass_model', DEFAULTS.mass_model) != 'custom':
+        values.pop('principal_moments', None)
+    settings = replace(DEFAULTS, **values)
+    try:
+        _check_together(settings)
+    except (ValueError, RuntimeError) as error:
+        return None, [f'the recorded parameters define no valid run: {error}']
+    return settings, []
+
+
+def markdown_table():
+    """The README's parameter table, generated from :data:`PARAMETERS`."""
+    rows = ['| name | type | default | unit | allowed | read-only | meaning |',
+            '| --- | --- | --- | --- | --- | --- | --- |']
+    kinds = {float: 'double', int: 'int', bool: 'bool', str: 'string', tuple: 'double[3]'}
+    for p in PARAMETERS:
+        default = (f"'{p.default}'" if p.kind is str
+                   else str(list(p.default)) if p.kind is tuple
+                   else str(p.default).lower() if p.kind is bool else f'{p.default:g}')
+        rows.append(f'| `{p.name}` | {kinds[p.kind]} | {default} | {p.unit or "-"} | '
+                    f'{p.rule.replace("|", "/")} | {"yes" if p.read_only else "no"} | '
+                    f'{p.description.replace("|", "/")} |')
+    return '\n'.join(rows)
+
+
+def field_names():
+    """The parameter names in contract order (the fields of :class:`RollerSettings`)."""
+    return [f.name for f in fields(RollerSettings)]
