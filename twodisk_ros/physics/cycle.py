@@ -174,21 +174,20 @@ class RollingCycle:
         trace_second = (dds_all + 1j * ds_all * dalpha_all) * rot
         r1, r2, normal, t1 = self.body.phase_vectors(u + 1j * COMPLEX_STEP)[:4]
         frame_values, frame_first, frame_second = self._frame_samples(r1, r2, normal, t1)
-        # one table; columns X_A, Y_A, r1·t1, r1·m, r2·t1, r2·m, α, r1·n (m = n × t1): the
-        # first three pairs are read as complex numbers
+        # q_c(u) of the contact frame (x, y, w, z), continued to u = 2π by ε q_c(0)
+        q, q_first, q_second, self._cycle_sign = contact_quaternion_samples(t1, normal)
+        quaternion = (np.concatenate([x[:, [0, 1, 3, 2]], self._cycle_sign * x[:1, [0, 1, 3, 2]]])
+                      for x in (q, q_first, q_second))
+        # one table (one gather per sample); columns X_A, Y_A, r1·t1, r1·m, r2·t1, r2·m,
+        # q_x, q_y, q_w, q_z, α, r1·n (m = n × t1): the first five pairs are read as complex
+        # numbers Z_A, r1, r2 (contact frame), q_x + i q_y and q_w + i q_z
         columns = [(z_all.real, z_all.imag, alpha_all),
                    (trace_first.real, trace_first.imag, dalpha_all),
                    (trace_second.real, trace_second.imag, ddalpha_all)]
         self._table = HermiteTable(0.0, TWO_PI / n, *(
-            np.column_stack([x, y, frame[:, :4], alpha, frame[:, 4]])
-            for (x, y, alpha), frame in zip(columns, (frame_values, frame_first,
-                                                      frame_second))))
-        # q_c(u) of the contact frame, columns (x, y, w, z): pairs x + iy and w + iz
-        q, q_first, q_second, self._cycle_sign = contact_quaternion_samples(t1, normal)
-        order = [0, 1, 3, 2]
-        self._orientation = HermiteTable(0.0, TWO_PI / n, *(
-            np.concatenate([x[:, order], self._cycle_sign * x[:1, order]])
-            for x in (q, q_first, q_second)))
+            np.column_stack([x, y, frame[:, :4], quat, alpha, frame[:, 4]])
+            for (x, y, alpha), frame, quat in zip(columns, (frame_values, frame_first,
+                                                             frame_second), quaternion)))
         self.nodes = np.append(u, TWO_PI)
         self.displacement = CycleDisplacement(turn=slope * TWO_PI, shift=complex(z_end))
 
@@ -291,8 +290,8 @@ class RollingCycle:
         spin, shift, half, turn = self._cycle_terms(cycles)
         index, weights = self._table.weights(rest)
         f = self._table.combine(index, weights)
-        pairs = f[:, :6].view(np.complex128)          # Z_A, r1 and r2 in the contact frame
-        return index, weights, f, pairs, spin, shift, half, turn
+        pairs = f[:, :10].view(np.complex128)      # Z_A, r1, r2 (contact frame), q_c pairs
+        return f, pairs, spin, shift, half, turn
 
     @staticmethod
     def _world(f, pairs, spin, shift, c):
@@ -303,7 +302,7 @@ class RollingCycle:
         z_a = spin * pairs[:, 0] + shift
         z_g = z_a - c * pairs[:, 1]
         g[:, :2].view(np.complex128)[:, 0] = z_g
-        g[:, 2] = -f[:, 7]
+        g[:, 2] = -f[:, 11]
         a[:, :2].view(np.complex128)[:, 0] = z_a
         a[:, 2] = 0.0
         b[:, :2].view(np.complex128)[:, 0] = z_g + c * pairs[:, 2]
@@ -311,23 +310,22 @@ class RollingCycle:
         return g, a, b
 
     def _positions(self, u):
-        _, _, f, pairs, spin, shift, half, _ = self._evaluate(u)
-        half = half * np.exp(0.5j * f[:, 6])        # as in _poses: the same bits
+        f, pairs, spin, shift, half, _ = self._evaluate(u)
+        half = half * np.exp(0.5j * f[:, 10])        # as in _poses: the same bits
         return self._world(f, pairs, spin, shift, half * half)
 
     def _poses(self, u):
-        index, weights, f, pairs, spin, shift, half, turn = self._evaluate(u)
-        half = half * np.exp(0.5j * f[:, 6])        # ±e^{iα/2}: q_z(α) as a phasor
+        f, pairs, spin, shift, half, turn = self._evaluate(u)
+        half = half * np.exp(0.5j * f[:, 10])        # ±e^{iα/2}: q_z(α) as a phasor
         g, a, b = self._world(f, pairs, spin, shift, half * half)   # c_α = (±e^{iα/2})²
         # q_z(α) ⊗ q_c with q_z = (0, 0, sin α/2, cos α/2): (x + iy) and (w + iz) turn by α/2
-        q_c = self._orientation.combine(index, weights).view(np.complex128)
-        xy, wz = half * q_c[:, 0], half * q_c[:, 1]
+        xy, wz = half * pairs[:, 3], half * pairs[:, 4]
         scale = 1.0 / np.sqrt(xy.real**2 + xy.imag**2 + wz.real**2 + wz.imag**2)
         q = np.empty((f.shape[0], 4))
         q[:, :2].view(np.complex128)[:, 0] = xy * scale
         q[:, 2] = wz.imag * scale
         q[:, 3] = wz.real * scale
-        return g, a, b, q, f[:, 6] + turn
+        return g, a, b, q, f[:, 10] + turn
 
     def heading(self, u):
         """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
@@ -336,7 +334,7 @@ class RollingCycle:
         moves the opposite way.
         """
         cycles, rest = self._split(u)
-        return self._table(rest)[..., 6] + cycles * self.displacement.turn
+        return self._table(rest)[..., 10] + cycles * self.displacement.turn
 
     def trace_a(self, u):
         """World position of A at phase(s) u (m), shape u.shape + (3,)."""
