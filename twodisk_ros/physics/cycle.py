@@ -123,6 +123,13 @@ class RollingCycle:
         Nodes used for the spectral integration.
     spectral_tail : float
         Relative size of the unresolved spectrum (an error indicator; ~1e-16 when resolved).
+
+    Notes
+    -----
+    Evaluation, fastest first, all vectorised over any array of phases u (rad, any real):
+    :meth:`positions` (G, A, B), :meth:`poses` (also the heading and the continuous
+    orientation quaternion), both from one table lookup per sample; :meth:`state` adds θ, ψ,
+    φ and the rotation matrix from the closed forms (a few times slower).
     """
 
     MAX_RESOLUTION = 2**17
