@@ -64,6 +64,88 @@ def positions_throughput(built, n=10**6, span=(-TWO_PI, 2 * TWO_PI)):
                                n / wall_chunked)
 
 
+# ------------------------------------------------------------------ target 1, full poses
+@dataclass
+class PosesThroughput:
+    """RollingCycle.poses (G, A, B, heading, quaternion) and .positions, one run, one body."""
+
+    body: str
+    samples: int
+    rate_poses: float         #: samples/s, RollingCycle.poses, best of repeats
+    rate_positions: float     #: samples/s, RollingCycle.positions, best of repeats
+    rate_state: float         #: samples/s, RollingCycle.state (closed forms + quaternion)
+    position_error: float     #: max over G, A, B of |poses − reference| / size
+    orientation_error: float  #: max rotation angle between poses and reference (rad)
+    reference_error: float    #: estimated error of the reference, / size or rad (the larger)
+    sign_flips: int           #: consecutive quaternions with q_k · q_{k+1} < 0 (0 expected)
+    phase_span: tuple         #: (u_lo, u_hi) (rad)
+
+    def as_dict(self):
+        return asdict(self)
+
+
+def _reference_quaternions(rb, u, alpha):
+    """Body → world (x, y, z, w) of the reference: R = R_z(α)·[t1; n × t1; n], via scipy."""
+    from scipy.spatial.transform import Rotation
+    _, _, n, t1 = rb.frame(np.asarray(u, dtype=float), 0)
+    nv = np.stack([x.c[0] for x in n], -1)
+    tv = np.stack([x.c[0] for x in t1], -1)
+    contact = np.stack([tv, np.cross(nv, tv), nv], axis=-2)
+    heading = Rotation.from_euler('z', np.asarray(alpha)[:, None])
+    return (heading * Rotation.from_matrix(contact)).as_quat()
+
+
+def _angle(q, q_ref):
+    """Rotation angle between unit quaternions (rad), sign-blind: 2 atan2(|v|, |q·q_ref|).
+
+    v is the vector part of q ⊗ q̄_ref.
+    """
+    dot = np.abs(np.sum(q * q_ref, axis=-1))
+    w1, w2 = q[..., 3:], q_ref[..., 3:]
+    vec = w2 * q[..., :3] - w1 * q_ref[..., :3] - np.cross(q[..., :3], q_ref[..., :3])
+    return 2.0 * np.arctan2(np.linalg.norm(vec, axis=-1), dot)
+
+
+def poses_throughput(built, n=10**6, span=(-TWO_PI, 2 * TWO_PI), repeats=5):
+    """Full poses/s (RollingCycle.poses) and positions/s on n phases, errors vs the reference.
+
+    The reference: heading α and trace Z_A by DOP853 (``ReferenceTrace``), positions from
+    its own closed forms, orientation R_z(α)·C(u) from its own frame via scipy; its error is
+    estimated with a tighter second integration on every 50th sample.
+    """
+    cycle = built.dynamics.cycle
+    u = np.linspace(span[0], span[1], n)
+    cycle.poses(u[:1000])                                    # warm up
+    cycle.positions(u[:1000])
+    poses, wall_poses = _timed(lambda: cycle.poses(u), min_time=math.inf,
+                               max_repeats=repeats)
+    _, wall_positions = _timed(lambda: cycle.positions(u), min_time=math.inf,
+                               max_repeats=repeats)
+    sub = u[::50]
+    _, wall_state = _timed(lambda: cycle.state(sub).quaternion, min_time=math.inf,
+                           max_repeats=repeats)
+    rb = built.ref_body
+    trace = ReferenceTrace(rb, span[0], span[1], REFERENCE_RTOL)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        check = ReferenceTrace(rb, span[0], span[1], REFERENCE_CHECK_RTOL)
+    alpha, z_a = trace(u)
+    size = built.body.size
+    pos_err = position_error((poses.position_g, poses.contact_a, poses.contact_b),
+                             rb.world_positions(u, alpha, z_a), size)
+    q_ref = _reference_quaternions(rb, u, alpha)
+    rot_err = float(np.max(_angle(poses.quaternion, q_ref)))
+    alpha_check, z_check = check(sub)
+    ref_err = max(position_error(rb.world_positions(sub, alpha[::50], z_a[::50]),
+                                 rb.world_positions(sub, alpha_check, z_check), size),
+                  float(np.max(_angle(q_ref[::50], _reference_quaternions(rb, sub,
+                                                                          alpha_check)))))
+    q = poses.quaternion
+    flips = int(np.sum(np.sum(q[1:] * q[:-1], axis=-1) < 0))
+    return PosesThroughput(built.name, n, n / wall_poses, n / wall_positions,
+                           sub.size / wall_state, pos_err, rot_err, ref_err, flips, span)
+
+
 # ------------------------------------------------------------------ target 2
 @dataclass
 class HourRun:
@@ -307,3 +389,15 @@ def speed_ratios(results):
             out.append(SpeedRatio(body, kind, tr.solver, tr.tolerance, tr.error,
                                   tr.wall_per_second, w, w / tr.wall_per_second, rel, note))
     return out
+
+
+if __name__ == '__main__':       # PYTHONPATH=. python benchmarks/targets.py [body ...]
+    import sys
+    from scenarios import BODIES
+    from work_precision import build
+    for name in sys.argv[1:] or list(BODIES):
+        r = poses_throughput(build(name))
+        print(f'{name}: poses {r.rate_poses / 1e6:.2f} M/s, positions '
+              f'{r.rate_positions / 1e6:.2f} M/s, state {r.rate_state / 1e6:.2f} M/s; errors: '
+              f'position {r.position_error:.1e} of size, orientation {r.orientation_error:.1e} '
+              f'rad (reference {r.reference_error:.1e}), sign flips {r.sign_flips}')

@@ -4,7 +4,8 @@ World frame (paper, section 3): origin at A when θ = 0 on branch +1 (phase u = 
 to disk 1 there (direction of increasing θ), Z up. At phase u the body's contact frame
 ``(t1, n × t1, n)`` maps to ``(c_α, e_z × c_α, e_z)`` with c_α = (cos α, sin α, 0), so
 ``R = c_α t1ᵀ + (e_z × c_α)(n × t1)ᵀ + e_z nᵀ`` (body → world), A = (X_A, Y_A, 0),
-G = A − R r1 and B = G + R r2.
+G = A − R r1 and B = G + R r2. As a quaternion, q = q_z(α) ⊗ q_c(u), continuous in u
+(:mod:`~twodisk_ros.physics.orientation`).
 
 The heading α and the trace of A solve the paper's eqs. (4)-(6), written in u by the chain
 rule. Their rates are smooth and 2π-periodic in u, so one cycle is integrated spectrally
@@ -18,14 +19,15 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.spatial.transform import Rotation
 
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
 from .body import TwoDiskBody
+from .orientation import contact_quaternion_samples
 from .spectral import refine_grid, spectral_antiderivative, spectral_derivative, spectral_tail
 from .tables import HermiteTable
 
-__all__ = ['RollingCycle', 'RollingState', 'CycleDisplacement', 'integrate_contact_trace']
+__all__ = ['RollingCycle', 'RollingState', 'RollingPoses', 'CycleDisplacement',
+           'integrate_contact_trace']
 
 TWO_PI = 2.0 * math.pi
 
@@ -68,7 +70,9 @@ class CycleDisplacement:
 class RollingState:
     """State of the body at cycle phases u (arrays broadcast over u's shape).
 
-    Positions are in the world frame (m); ``rotation`` maps body → world, shape (..., 3, 3).
+    Positions are in the world frame (m); ``rotation`` maps body → world, shape (..., 3, 3),
+    from the closed forms; ``quaternion`` is the same orientation from the cycle's tables
+    (within ~1e-15), as a continuous function of u (see :meth:`RollingCycle.poses`).
     """
 
     phase: np.ndarray          #: u (rad)
@@ -81,12 +85,21 @@ class RollingState:
     contact_a: np.ndarray      #: A (m), shape (..., 3), z = 0
     contact_b: np.ndarray      #: B (m), shape (..., 3), z = 0
     rotation: np.ndarray       #: R body → world, shape (..., 3, 3)
+    quaternion: np.ndarray     #: R as (x, y, z, w), body → world, continuous in u, (..., 4)
 
-    @property
-    def quaternion(self):
-        """Orientation as (x, y, z, w), body → world, shape (..., 4)."""
-        flat = self.rotation.reshape(-1, 3, 3)
-        return Rotation.from_matrix(flat).as_quat().reshape(self.rotation.shape[:-2] + (4,))
+
+@dataclass(frozen=True)
+class RollingPoses:
+    """Poses at cycle phases u from the tables alone (:meth:`RollingCycle.poses`).
+
+    Arrays have u's shape plus the trailing axis shown; world frame, Z up, metres.
+    """
+
+    position_g: np.ndarray     #: G (m), (..., 3)
+    contact_a: np.ndarray      #: A (m), (..., 3), z = 0
+    contact_b: np.ndarray      #: B (m), (..., 3), z = 0
+    quaternion: np.ndarray     #: body → world as (x, y, z, w), unit, continuous in u, (..., 4)
+    heading: np.ndarray        #: α (rad), continuous, α(0) = 0
 
 
 class RollingCycle:
@@ -110,10 +123,19 @@ class RollingCycle:
         Nodes used for the spectral integration.
     spectral_tail : float
         Relative size of the unresolved spectrum (an error indicator; ~1e-16 when resolved).
+
+    Notes
+    -----
+    Evaluation, fastest first, all vectorised over any array of phases u (rad, any real):
+    :meth:`positions` (G, A, B), :meth:`poses` (also the heading and the continuous
+    orientation quaternion), both from one table lookup per sample; :meth:`state` adds θ, ψ,
+    φ and the rotation matrix from the closed forms (a few times slower).
     """
 
     MAX_RESOLUTION = 2**17
-    BLOCK = 65536
+    #: Samples evaluated at once by positions and poses (temporaries stay in cache; 16384
+    #: measured fastest among 4096 … 65536 on the 2-core benchmark machine).
+    BLOCK = 16384
 
     def __init__(self, body, resolution=None, oversampling=4):
         if not isinstance(body, TwoDiskBody):
@@ -157,66 +179,160 @@ class RollingCycle:
         rot = np.exp(1j * alpha_all)
         trace_first = ds_all * rot
         trace_second = (dds_all + 1j * ds_all * dalpha_all) * rot
-        frame_values, frame_first, frame_second = self._frame_samples(u, n)
-        # one table; columns: α, X_A, Y_A, then r1·t1, r1·m, r1·n, r2·t1, r2·m (m = n × t1)
-        self._table = HermiteTable(
-            0.0, TWO_PI / n,
-            np.column_stack([alpha_all, z_all.real, z_all.imag, frame_values]),
-            np.column_stack([dalpha_all, trace_first.real, trace_first.imag, frame_first]),
-            np.column_stack([ddalpha_all, trace_second.real, trace_second.imag, frame_second]))
+        r1, r2, normal, t1 = self.body.phase_vectors(u + 1j * COMPLEX_STEP)[:4]
+        frame_values, frame_first, frame_second = self._frame_samples(r1, r2, normal, t1)
+        # q_c(u) of the contact frame (x, y, w, z), continued to u = 2π by ε q_c(0)
+        q, q_first, q_second, self._cycle_sign = contact_quaternion_samples(t1, normal)
+        quaternion = (np.concatenate([x[:, [0, 1, 3, 2]], self._cycle_sign * x[:1, [0, 1, 3, 2]]])
+                      for x in (q, q_first, q_second))
+        # one table (one gather per sample); columns X_A, Y_A, r1·t1, r1·m, r2·t1, r2·m,
+        # q_x, q_y, q_w, q_z, α, r1·n (m = n × t1): the first five pairs are read as complex
+        # numbers Z_A, r1, r2 (contact frame), q_x + i q_y and q_w + i q_z
+        columns = [(z_all.real, z_all.imag, alpha_all),
+                   (trace_first.real, trace_first.imag, dalpha_all),
+                   (trace_second.real, trace_second.imag, ddalpha_all)]
+        self._table = HermiteTable(0.0, TWO_PI / n, *(
+            np.column_stack([x, y, frame[:, :4], quat, alpha, frame[:, 4]])
+            for (x, y, alpha), frame, quat in zip(columns, (frame_values, frame_first,
+                                                             frame_second), quaternion)))
         self.nodes = np.append(u, TWO_PI)
         self.displacement = CycleDisplacement(turn=slope * TWO_PI, shift=complex(z_end))
 
-    def _frame_samples(self, u, n):
-        """r1 and r2 in the contact frame (t1, n × t1, n) at the nodes, closed at u = 2π."""
-        def components(x):
-            r1, r2, normal, t1 = self.body.phase_vectors(x)[:4]
-            m = np.cross(normal, t1)
-            return np.stack([np.sum(r1 * t1, -1), np.sum(r1 * m, -1), np.sum(r1 * normal, -1),
-                             np.sum(r2 * t1, -1), np.sum(r2 * m, -1)], axis=-1)
-        values, first = complex_step_jet(components(u + 1j * COMPLEX_STEP))
+    @staticmethod
+    def _frame_samples(r1, r2, normal, t1):
+        """r1·t1, r1·m, r2·t1, r2·m, r1·n at the nodes (from u + ih), closed at u = 2π."""
+        m = np.cross(normal, t1)
+        components = np.stack([np.sum(r1 * t1, -1), np.sum(r1 * m, -1), np.sum(r2 * t1, -1),
+                               np.sum(r2 * m, -1), np.sum(r1 * normal, -1)], axis=-1)
+        values, first = complex_step_jet(components)
         second = spectral_derivative(first)
         return tuple(np.concatenate([x, x[:1]]) for x in (values, first, second))
+
+    @property
+    def cycle_sign(self):
+        """ε = ±1 with q_c(u + 2π) = ε q_c(u) (contact-frame quaternion, see :meth:`poses`).
+
+        The world quaternion then obeys q(u + 2π) = −ε R_z(T − 2π)·q(u), T the turn of one
+        cycle (T = 2π up to ~1e-11 for every shape: the heading turns once per cycle).
+        """
+        return self._cycle_sign
 
     def _split(self, u):
         u = np.asarray(u, dtype=float)
         cycles = np.floor(u / TWO_PI)
         return cycles, u - TWO_PI * cycles
 
+    def _cycle_terms(self, cycles):
+        """Per sample: e^{i k T}, the shift of k cycles, ε^k e^{i k T/2} and k T (k = cycles)."""
+        if cycles.size == 0:
+            empty = np.empty(cycles.shape, complex)
+            return empty, empty, empty, cycles
+        low, high = float(cycles.min()), float(cycles.max())
+        if high - low <= 4096:       # few distinct cycles: evaluate once each, then gather
+            index = (cycles - low).astype(np.intp)
+            return tuple(x[index] for x in self._cycle_terms_of(np.arange(low, high + 1.0)))
+        return self._cycle_terms_of(cycles)
+
+    def _cycle_terms_of(self, cycles):
+        turn, shift = self.displacement.power(cycles)
+        parity = np.where(np.mod(cycles, 2.0) == 0.0, 1.0, self._cycle_sign)
+        return np.exp(1j * turn), shift, parity * np.exp(0.5j * turn), turn
+
     # -- world positions ---------------------------------------------------------------------
+    def _blocks(self, u, evaluate, trailing):
+        """evaluate(flat block) → arrays (block, *trailing[j]); blocks of BLOCK samples."""
+        u = np.asarray(u, dtype=float)
+        flat = u.reshape(-1)
+        if flat.size <= self.BLOCK:
+            parts = evaluate(flat)
+        else:
+            parts = [np.empty((flat.size,) + shape) for shape in trailing]
+            for start in range(0, flat.size, self.BLOCK):
+                part = slice(start, start + self.BLOCK)
+                for array, block in zip(parts, evaluate(flat[part])):
+                    array[part] = block
+        return tuple(x.reshape(u.shape + shape) for x, shape in zip(parts, trailing))
+
     def positions(self, u):
         """World positions of G, A and B at phase(s) u (m): the fast path, from tables only.
 
-        Returns three arrays of shape u.shape + (3,). Agrees with :meth:`state` to the
+        Returns three arrays of shape u.shape + (3,). Agrees with the closed forms to the
         table's interpolation error (~1e-15 of the body size when resolved). Large inputs are
-        processed in blocks of 65536 samples (cache-friendly).
+        processed in blocks of :attr:`BLOCK` samples (cache-friendly).
         """
-        u = np.asarray(u, dtype=float)
-        if u.size > self.BLOCK:
-            flat = u.ravel()
-            out = [np.empty((flat.size, 3)) for _ in range(3)]
-            for start in range(0, flat.size, self.BLOCK):
-                part = slice(start, start + self.BLOCK)
-                for array, block in zip(out, self._positions(flat[part])):
-                    array[part] = block
-            return tuple(array.reshape(u.shape + (3,)) for array in out)
-        return self._positions(u)
+        return self._blocks(u, self._positions, [(3,)] * 3)
 
-    def _positions(self, u, with_heading=False):
+    def poses(self, u):
+        """Full poses at phase(s) u (rad, any real value), from the tables only: the fast path.
+
+        Parameters
+        ----------
+        u : array_like
+            Cycle phases (rad); negative values and many cycles ahead are fine.
+
+        Returns
+        -------
+        RollingPoses
+            G, A, B (world, m), the heading α (rad) and the orientation body → world as a unit
+            quaternion (x, y, z, w). Positions equal :meth:`positions`; the quaternion agrees
+            with the closed-form rotation of :meth:`state` to ~1e-15.
+
+        Notes
+        -----
+        The quaternion q(u) = q_z(α(u)) ⊗ q_c(u) is a continuous function of u with
+        w > 0 at u = 0 (:mod:`~twodisk_ros.physics.orientation`). Each sample's sign depends
+        on its phase only, never on the other samples of the call, so arrays computed in
+        blocks (as the node does), from any starting phase or in any order join continuously.
+        Consecutive samples satisfy q_k · q_{k+1} ≥ 0 whenever the body turns by less than π
+        (half a turn) between them, e.g. max |ω_u| · |Δu| < π. For coarser steps the product
+        may be negative: it is then the sign of the continuous lift along the path (after
+        whole cycles q(u + 2πk) = (−ε)^k q(u) up to the cycle's ~1e-11 rad excess turn about
+        Z, ε = :attr:`cycle_sign`); flip signs yourself if you need the shortest arcs.
+        """
+        parts = self._blocks(u, self._poses, [(3,), (3,), (3,), (4,), ()])
+        return RollingPoses(*parts)
+
+    def _evaluate(self, u):
         cycles, rest = self._split(u)
-        turn, shift = self.displacement.power(cycles)
-        f = self._table(rest)
-        spin = np.exp(1j * turn)
-        z_a = spin * (f[..., 1] + 1j * f[..., 2]) + shift
-        c = spin * np.exp(1j * f[..., 0])          # c_α as a complex number
+        spin, shift, half, turn = self._cycle_terms(cycles)
+        index, weights = self._table.weights(rest)
+        f = self._table.combine(index, weights)
+        pairs = f[:, :10].view(np.complex128)      # Z_A, r1, r2 (contact frame), q_c pairs
+        return f, pairs, spin, shift, half, turn
+
+    @staticmethod
+    def _world(f, pairs, spin, shift, c):
+        """G, A, B from the table's row f and c = c_α (complex, world)."""
         # R r = c_α (t1·r) + (e_z × c_α)(m·r) + e_z (n·r), and e_z × c_α = i c_α
-        z_g = z_a - c * (f[..., 3] + 1j * f[..., 4])
-        z_b = z_g + c * (f[..., 6] + 1j * f[..., 7])
-        zeros = np.zeros_like(turn)
-        result = (np.stack([z_g.real, z_g.imag, -f[..., 5]], -1),
-                  np.stack([z_a.real, z_a.imag, zeros], -1),
-                  np.stack([z_b.real, z_b.imag, zeros], -1))
-        return result + (f[..., 0] + turn,) if with_heading else result
+        size = f.shape[0]
+        g, a, b = (np.empty((size, 3)) for _ in range(3))
+        z_a = spin * pairs[:, 0] + shift
+        z_g = z_a - c * pairs[:, 1]
+        g[:, :2].view(np.complex128)[:, 0] = z_g
+        g[:, 2] = -f[:, 11]
+        a[:, :2].view(np.complex128)[:, 0] = z_a
+        a[:, 2] = 0.0
+        b[:, :2].view(np.complex128)[:, 0] = z_g + c * pairs[:, 2]
+        b[:, 2] = 0.0
+        return g, a, b
+
+    def _positions(self, u):
+        f, pairs, spin, shift, half, _ = self._evaluate(u)
+        half = half * np.exp(0.5j * f[:, 10])        # as in _poses: the same bits
+        return self._world(f, pairs, spin, shift, half * half)
+
+    def _poses(self, u):
+        f, pairs, spin, shift, half, turn = self._evaluate(u)
+        half = half * np.exp(0.5j * f[:, 10])        # ±e^{iα/2}: q_z(α) as a phasor
+        g, a, b = self._world(f, pairs, spin, shift, half * half)   # c_α = (±e^{iα/2})²
+        # q_z(α) ⊗ q_c with q_z = (0, 0, sin α/2, cos α/2): (x + iy) and (w + iz) turn by α/2
+        xy, wz = half * pairs[:, 3], half * pairs[:, 4]
+        scale = 1.0 / np.sqrt(xy.real**2 + xy.imag**2 + wz.real**2 + wz.imag**2)
+        q = np.empty((f.shape[0], 4))
+        q[:, :2].view(np.complex128)[:, 0] = xy * scale
+        q[:, 2] = wz.imag * scale
+        q[:, 3] = wz.real * scale
+        return g, a, b, q, f[:, 10] + turn
 
     def heading(self, u):
         """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
@@ -225,7 +341,7 @@ class RollingCycle:
         moves the opposite way.
         """
         cycles, rest = self._split(u)
-        return self._table(rest)[..., 0] + cycles * self.displacement.turn
+        return self._table(rest)[..., 10] + cycles * self.displacement.turn
 
     def trace_a(self, u):
         """World position of A at phase(s) u (m), shape u.shape + (3,)."""
@@ -237,14 +353,19 @@ class RollingCycle:
 
     # -- poses -------------------------------------------------------------------------------
     def state(self, u):
-        """The body's state at phase(s) u (rad, any real value, also many cycles ahead)."""
+        """The body's state at phase(s) u (rad, any real value, also many cycles ahead).
+
+        Angles and ``rotation`` from the closed forms; positions, heading and the continuous
+        ``quaternion`` as in :meth:`poses`.
+        """
         u = np.asarray(u, dtype=float)
         geo = self.body.phase_geometry(u)
-        g_world, a_world, b_world, alpha = self._positions(u, with_heading=True)
-        rotation = self._rotation(alpha, geo.tangent_a, geo.ground_normal)
+        poses = self.poses(u)
+        rotation = self._rotation(poses.heading, geo.tangent_a, geo.ground_normal)
         return RollingState(phase=u, theta=geo.theta, psi=geo.psi, branch=geo.branch,
-                            tilt=geo.tilt, heading=alpha, position_g=g_world,
-                            contact_a=a_world, contact_b=b_world, rotation=rotation)
+                            tilt=geo.tilt, heading=poses.heading, position_g=poses.position_g,
+                            contact_a=poses.contact_a, contact_b=poses.contact_b,
+                            rotation=rotation, quaternion=poses.quaternion)
 
     @staticmethod
     def _rotation(alpha, t1, n):
