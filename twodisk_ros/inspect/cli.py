@@ -8,6 +8,9 @@ import argparse
 import json
 import os
 import sys
+import warnings
+
+import numpy as np
 
 from ..io import RecordingError
 from ..io.errors import one_line
@@ -70,6 +73,14 @@ def main(argv=None):
     int
     """
     args = _parser().parse_args(argv)
+    # Values of a damaged file may overflow; the checks report non-finite results, so
+    # numpy's floating-point warnings would only add lines to stderr.
+    with warnings.catch_warnings(), np.errstate(all='ignore'):
+        warnings.simplefilter('ignore', RuntimeWarning)
+        return _run(args)
+
+
+def _run(args):
     if args.plot:
         refusal = _plot_refusal(args.plot)
         if refusal:

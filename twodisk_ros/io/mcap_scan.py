@@ -8,12 +8,14 @@ The recovery rule, modelled on ``mcap recover``:
   :attr:`Scan.damage`, and reading goes on with the next record.  So a corrupt chunk in the
   middle of a file loses that chunk's messages only, with or without footer.
 - When the framing is lost (an unknown opcode, a length past the end of the data section),
-  reading resumes at the next record that the summary section indexes (chunk and metadata
-  indexes), if the file ends with an intact footer and a summary whose CRC holds; otherwise it
-  stops there and keeps everything before, as for a file whose writer was killed.
+  reading resumes at the next chunk, found by its signature (opcode, a length that fits, a
+  known compression name and a records length consistent with both), or at the next record
+  the summary section indexes (chunk and metadata indexes, each checked to frame a record
+  there), whichever comes first.  With neither, reading stops there and keeps everything
+  before, as for a file whose writer was killed.
 - A file that does not end with a footer and the magic is *truncated* (:attr:`Scan.truncated`):
   a record running past its end, or zero bytes after the last complete record, is the cut and
-  not damage.
+  not damage (unless a chunk follows it: then it was damage).
 - CRCs are checked where the writer set them: a chunk's (the chunk is skipped), the data
   section's (``DataEnd``) and the summary's (``Footer``).  The summary's schemas and channels
   are used only when its CRC holds, and only for ids that the data section does not define
@@ -41,6 +43,7 @@ MAX_CHUNK_SIZE = 1 << 30
 _HEADER, _FOOTER, _SCHEMA, _CHANNEL, _MESSAGE, _CHUNK = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 _CHUNK_INDEX, _METADATA, _METADATA_INDEX, _DATA_END = 0x08, 0x0C, 0x0D, 0x0F
 _KNOWN_OPCODES = frozenset(range(0x01, 0x10))
+_COMPRESSIONS = (b'', b'zstd', b'lz4')
 _FOOTER_SIZE = 9 + 20           # opcode, length, summary_start, summary_offset_start, crc
 _MESSAGE_FIXED = 22             # channel id, sequence, log time, publish time
 
@@ -156,15 +159,21 @@ def _frame(data, pos, limit):
 
 
 def _footer(data):
-    """Position and fields ``(summary_start, summary_crc)`` of a footer, or None."""
+    """``(position, summary_start, summary_crc, end)`` of the last footer, or None.
+
+    ``end`` is where its closing magic ends: the file's size unless bytes follow it.
+    """
     size = len(data)
-    pos = size - len(MAGIC) - _FOOTER_SIZE
-    if pos < len(MAGIC) or data[size - len(MAGIC):] != MAGIC:
-        return None
-    opcode, length, summary_start, _, crc = struct.unpack_from('<BQQQI', data, pos)
-    if opcode != _FOOTER or length != _FOOTER_SIZE - 9:
-        return None
-    return pos, summary_start, crc
+    magic = data.rfind(MAGIC, len(MAGIC) + _FOOTER_SIZE)
+    while magic >= 0:
+        pos = magic - _FOOTER_SIZE
+        opcode, length, summary_start, _, crc = struct.unpack_from('<BQQQI', data, pos)
+        if opcode == _FOOTER and length == _FOOTER_SIZE - 9:
+            return pos, summary_start, crc, magic + len(MAGIC)
+        if size - magic > 1 << 20:   # only a little garbage after the end is looked through
+            return None
+        magic = data.rfind(MAGIC, len(MAGIC) + _FOOTER_SIZE, magic)
+    return None
 
 
 def _decompress(chunk):
@@ -235,8 +244,8 @@ def _add(record, scan, schemas, channels):
         channels.setdefault(record.id, record)
 
 
-def _read_summary(data, start, end, scan):
-    """Schemas, channels and resync offsets of a summary section (CRC already checked)."""
+def _read_summary(data, start, end, scan, trusted):
+    """Resync offsets of a summary section; its schemas and channels too if ``trusted``."""
     offsets = set()
     pos = start
     while pos < end:
@@ -255,7 +264,7 @@ def _read_summary(data, start, end, scan):
             offsets.add(record.chunk_start_offset)
         elif isinstance(record, MetadataIndex):
             offsets.add(record.offset)
-        else:
+        elif trusted:
             _add(record, scan, scan.summary_schemas, scan.summary_channels)
         pos = stop
     return sorted(o for o in offsets if len(MAGIC) <= o < start)
@@ -267,8 +276,11 @@ def _summary(data, scan):
     scan.truncated = footer is None
     if footer is None:
         return len(data), [], 0
-    footer_pos, summary_start, crc = footer
-    trailer = len(data) - footer_pos
+    footer_pos, summary_start, crc, end = footer
+    trailer = end - footer_pos
+    if end < len(data):
+        scan.damage.append(f'bytes {end}-{len(data)}: {len(data) - end} bytes after the end of '
+                           f'the MCAP file (footer and magic at byte {footer_pos}) ignored')
     if summary_start == 0:
         return footer_pos, [], trailer
     if not len(MAGIC) <= summary_start <= footer_pos:
@@ -276,13 +288,46 @@ def _summary(data, scan):
                            f'ignored')
         return footer_pos, [], trailer
     computed = zlib.crc32(memoryview(data)[summary_start:footer_pos + 9 + 16])
-    if crc != 0 and computed != crc:
+    trusted = crc == 0 or computed == crc
+    if not trusted:
         scan.damage.append(f'summary section (bytes {summary_start}-{footer_pos}): CRC '
-                           f'mismatch (0x{computed:08x}, 0x{crc:08x} recorded); summary '
-                           f'ignored')
-        return summary_start, [], trailer
-    offsets = _read_summary(data, summary_start, footer_pos, scan)
-    return summary_start, offsets, trailer + footer_pos - summary_start
+                           f'mismatch (0x{computed:08x}, 0x{crc:08x} recorded); its schemas '
+                           f'and channels ignored')
+    offsets = _read_summary(data, summary_start, footer_pos, scan, trusted)
+    return summary_start, offsets, trailer + (footer_pos - summary_start if trusted else 0)
+
+
+def _is_chunk(data, pos, limit):
+    """True if a chunk record's framing and fixed fields are consistent at ``pos``."""
+    fixed = 8 + 8 + 8 + 4 + 4
+    if pos + 9 + fixed > limit or data[pos] != _CHUNK:
+        return False
+    (length,) = struct.unpack_from('<Q', data, pos + 1)
+    (name_length,) = struct.unpack_from('<I', data, pos + 9 + fixed - 4)
+    start = pos + 9 + fixed
+    if pos + 9 + length > limit or name_length > 8 or start + name_length + 8 > limit:
+        return False
+    if bytes(data[start:start + name_length]) not in _COMPRESSIONS:
+        return False
+    (records,) = struct.unpack_from('<Q', data, start + name_length)
+    return records == length - fixed - name_length - 8
+
+
+def _resync(data, pos, limit, offsets):
+    """Where reading can resume after lost framing at ``pos`` (None: nowhere)."""
+    indexed = None
+    for offset in offsets:
+        opcode, end = _frame(data, offset, limit)
+        if offset > pos and end is not None and opcode in _KNOWN_OPCODES:
+            indexed = offset
+            break
+    k = pos
+    while True:
+        k = data.find(b'\x06', k + 1, indexed or limit)
+        if k < 0:
+            return indexed
+        if _is_chunk(data, k, limit):
+            return k
 
 
 def _record(opcode, data, pos, end, scan, in_summary):
@@ -326,17 +371,18 @@ def scan_mcap(data):
     while pos < limit:
         opcode, end = _frame(data, pos, limit)
         if end is None or opcode not in _KNOWN_OPCODES:
-            if scan.truncated and (opcode in _KNOWN_OPCODES or opcode is None
-                                   or not any(data[pos:])):
+            target = _resync(data, pos, limit, resync)
+            if target is None and scan.truncated and (
+                    opcode in _KNOWN_OPCODES or opcode is None or not any(data[pos:])):
                 break   # the cut of a killed writer
-            target = next((o for o in resync if o > pos), None)
             what = ('too short for a record header' if opcode is None
                     else f'opcode 0x{opcode:02x}' + (', length past the end' if end is None
                                                      and opcode in _KNOWN_OPCODES else ''))
             scan.damage.append(
                 f'bytes {pos}-{target or limit}: record framing lost ({what}); '
-                + ('resumed at the next record the summary indexes' if target
-                   else 'the rest of the data section is unreadable'))
+                + (f'resumed at the {"chunk" if data[target] == _CHUNK else "record"} at '
+                   f'byte {target}' if target else 'the rest of the data section is '
+                                                     'unreadable'))
             if target is None:
                 break
             pos = target

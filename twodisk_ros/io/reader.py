@@ -7,6 +7,8 @@ Needs only ``mcap`` and ``mcap-ros2-support``: no rclpy, so recordings are read 
 offline on any machine.
 """
 
+import contextlib
+import io
 import os
 from dataclasses import dataclass, field
 from typing import Any
@@ -179,9 +181,12 @@ def _decode(scan, recording, decode):
 
     def decoder_of(channel):
         if channel.id not in decoders:
+            printed = io.StringIO()   # the vendored msg parser prints its complaints
             try:
-                decoders[channel.id] = (factory.decoder_for(
-                    channel.message_encoding, schemas.get(channel.schema_id)), None)
+                with contextlib.redirect_stderr(printed), contextlib.redirect_stdout(printed):
+                    decoder = factory.decoder_for(channel.message_encoding,
+                                                  schemas.get(channel.schema_id))
+                decoders[channel.id] = (decoder, None)
             except Exception as error:  # noqa: BLE001 - a damaged schema text
                 decoders[channel.id] = (None, f'schema: {reason_of(error)}')
         return decoders[channel.id]
