@@ -45,6 +45,7 @@ _CHUNK_INDEX, _METADATA, _METADATA_INDEX, _DATA_END = 0x08, 0x0C, 0x0D, 0x0F
 _KNOWN_OPCODES = frozenset(range(0x01, 0x10))
 _COMPRESSIONS = (b'', b'zstd', b'lz4')
 _FOOTER_SIZE = 9 + 20           # opcode, length, summary_start, summary_offset_start, crc
+_READ_STEP = 1 << 20           # decompressed bytes asked for at a time (no huge buffers)
 _MESSAGE_FIXED = 22             # channel id, sequence, log time, publish time
 
 
@@ -187,7 +188,7 @@ def _decompress(chunk):
             with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(chunk.data)) as reader:
                 parts, total = [], 0
                 while total <= size:
-                    part = reader.read(size + 1 - total)
+                    part = reader.read(min(_READ_STEP, size + 1 - total))
                     if not part:
                         break
                     parts.append(part)

@@ -153,8 +153,8 @@ def read_recording(path, *, decode=None) -> Recording:
         with open(path, 'rb') as stream:
             data = stream.read()
     except OSError as error:
-        raise RecordingError(
-            f'cannot read recording {path}: {os_error_reason(path, error, writing=False)}') from None
+        reason = os_error_reason(path, error, writing=False)
+        raise RecordingError(f'cannot read recording {path}: {reason}') from None
     if not data.startswith(MAGIC):
         reason = ('empty file' if not data else
                   f'not an MCAP file (only {len(data)} bytes)' if MAGIC.startswith(data) else
