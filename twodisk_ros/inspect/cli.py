@@ -8,8 +8,12 @@ import argparse
 import json
 import os
 import sys
+import warnings
+
+import numpy as np
 
 from ..io import RecordingError
+from ..io.errors import one_line
 from .inspection import inspect_recording
 from .report import PROG, format_report
 
@@ -27,8 +31,22 @@ def _parser():
     parser.add_argument('--json', action='store_true',
                         help='print one JSON document (summary and checks) instead of text')
     parser.add_argument('--plot', metavar='PNG',
-                        help='write a figure: traces on the ground, height of G, energy')
+                        help='write a figure (a file name ending in .png): traces on the '
+                             'ground, height of G, energy')
     return parser
+
+
+def _plot_refusal(path):
+    """Why the figure cannot go to ``path`` (None if it can be tried).
+
+    The path must name a ``.png`` file: matplotlib would append ``.png`` to a path without
+    suffix, and the report must name the file actually written.
+    """
+    if os.path.isdir(path):
+        return 'it is a directory (give a file name ending in .png)'
+    if not os.fspath(path).lower().endswith('.png'):
+        return 'the file name must end in .png'
+    return None
 
 
 def _print(text):
@@ -55,10 +73,27 @@ def main(argv=None):
     int
     """
     args = _parser().parse_args(argv)
+    # Values of a damaged file may overflow; the checks report non-finite results, so
+    # numpy's floating-point warnings would only add lines to stderr.
+    with warnings.catch_warnings(), np.errstate(all='ignore'):
+        warnings.simplefilter('ignore', RuntimeWarning)
+        return _run(args)
+
+
+def _run(args):
+    if args.plot:
+        refusal = _plot_refusal(args.plot)
+        if refusal:
+            print(f'{PROG}: cannot write plot {args.plot}: {refusal}', file=sys.stderr)
+            return 2
     try:
         inspection = inspect_recording(args.file)
     except RecordingError as error:
-        print(f'{PROG}: {error}', file=sys.stderr)
+        print(f'{PROG}: {one_line(error) or "unreadable"}', file=sys.stderr)
+        return 2
+    except Exception as error:  # noqa: BLE001 - last resort: one line, never a traceback
+        print(f'{PROG}: cannot read recording {args.file}: internal error: '
+              f'{one_line(error) or "no message"} ({type(error).__name__})', file=sys.stderr)
         return 2
     if args.json:
         _print(json.dumps(inspection.as_dict(), indent=2, allow_nan=False, ensure_ascii=False))
@@ -68,9 +103,11 @@ def main(argv=None):
         try:
             from ..plotting.inspection import plot_inspection
             plot_inspection(inspection, args.plot)
-        except (OSError, ValueError) as error:
-            print(f'{PROG}: cannot write plot {args.plot}: {" ".join(str(error).split())}',
-                  file=sys.stderr)
+        except Exception as error:  # noqa: BLE001 - any failure to plot is one line
+            reason = one_line(error) or type(error).__name__
+            if not isinstance(error, (OSError, ValueError)):
+                reason = f'{reason} ({type(error).__name__})'
+            print(f'{PROG}: cannot write plot {args.plot}: {reason}', file=sys.stderr)
             return 2
         if not args.json:
             _print(f'plot: {args.plot}')

@@ -4,12 +4,17 @@
 reads an MCAP file written by the node (:mod:`twodisk_ros.io`), summarises it (topics,
 types, counts, duration, rates, recorded parameters) and runs the checks of
 :mod:`twodisk_ros.inspect.checks`. A truncated file (writer killed, no footer) is checked
-on the part that was recovered; the report says how many messages and bytes that is.
+on the part that was recovered; the report says how many messages and bytes that is.  A
+damaged file (corrupt chunks, CRC mismatches, lost framing: see
+:mod:`twodisk_ros.io.mcap_scan` for what is skipped) is checked on what could be read, and
+the damage, with messages that do not decode, are problems of the ``inputs`` check.  A file
+from which no channel, message or metadata can be read is not a recording
+(:class:`RecordingError`).
 """
 
 import numpy as np
 
-from ..io import read_recording
+from ..io import RecordingError, read_recording
 from .checks import run_checks
 from .differences import kinetic_energy
 from .model import build_model
@@ -20,6 +25,33 @@ from .series import (METADATA_NAME, TOPIC_TYPES, extract_series, join_samples, s
 __all__ = ['inspect_recording']
 
 _DECODED = frozenset(TOPIC_TYPES)
+_DAMAGE_LISTED = 5      # damaged parts named in the inputs check; the rest are counted
+
+
+def _nothing_recovered(recording):
+    """Why a recording from which nothing could be read is not a recording (one line)."""
+    if recording.damage:
+        more = len(recording.damage) - 1
+        return (f'no recording recovered: {recording.damage[0]}'
+                + (f' (and {more} more damaged parts)' if more else ''))
+    if recording.total_bytes <= 8:
+        return 'not a recording: the file ends after the MCAP magic'
+    where = (f'in {recording.recovered_bytes} readable of {recording.total_bytes} bytes'
+             if recording.truncated else f'in {recording.total_bytes} bytes')
+    return f'not a recording: no channel, message or metadata record {where}'
+
+
+def _input_problems(recording):
+    """The damage and the undecodable messages of a recording, as problems of ``inputs``."""
+    problems = [f'damaged: {line}' for line in recording.damage[:_DAMAGE_LISTED]]
+    if len(recording.damage) > _DAMAGE_LISTED:
+        problems.append(f'damaged: {len(recording.damage) - _DAMAGE_LISTED} more damaged '
+                        f'parts (see the summary)')
+    for topic, (count, reason) in sorted(recording.undecodable.items()):
+        problems.append(f'{count} messages of {topic} could not be decoded (first: {reason})')
+    if recording.orphans:
+        problems.append(f'{recording.orphans} messages on channels defined nowhere readable')
+    return problems
 
 
 def _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns):
@@ -47,6 +79,10 @@ def _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns):
         'profile': recording.profile,
         'library': recording.library,
         'truncated': truncated,
+        'damaged': recording.damaged,
+        'damage': list(recording.damage),
+        'undecodable': {topic: {'count': count, 'reason': reason}
+                        for topic, (count, reason) in sorted(recording.undecodable.items())},
         'recovered': {'messages': len(recording.messages), 'bytes': recording.recovered_bytes,
                       'total_bytes': size,
                       'fraction': recording.recovered_bytes / size if size else None},
@@ -80,7 +116,10 @@ def inspect_recording(path):
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
     """
     recording = read_recording(path, decode=lambda topic: topic_role(topic) in _DECODED)
-    problems = []
+    if recording.empty:
+        raise RecordingError(f'cannot read recording {recording.path}: '
+                             f'{_nothing_recovered(recording)}')
+    problems = _input_problems(recording)
     chosen = select_topics(recording.topics, problems)
     series = extract_series(recording, chosen, problems)
     parameters = recording.metadata.get(METADATA_NAME)

@@ -7,6 +7,7 @@ from .series import METADATA_NAME
 __all__ = ['PROG', 'format_report']
 
 PROG = 'twodisk-inspect'
+_DAMAGE_SHOWN = 10
 
 
 def _size(nbytes):
@@ -30,12 +31,25 @@ def format_report(inspection):
     lines = [f'{PROG}: {s["file"]}',
              f'  file: {_size(s["size_bytes"])}, MCAP profile {s["profile"]!r}, '
              f'written by {s["library"] or "?"}']
-    if s['truncated']:
-        rec = s['recovered']
-        fraction = rec['fraction'] if rec['fraction'] is not None else 0.0
-        lines.append(f'  TRUNCATED (no footer: the writer did not close it): recovered '
-                     f'{rec["messages"]} messages from {rec["bytes"]} of {rec["total_bytes"]} '
-                     f'bytes ({fraction:.1%}); the checks below are of that part')
+    rec = s['recovered']
+    fraction = rec['fraction'] if rec['fraction'] is not None else 0.0
+    recovered = (f'recovered {rec["messages"]} messages from {rec["bytes"]} of '
+                 f'{rec["total_bytes"]} bytes ({fraction:.1%}); the checks below are of that '
+                 f'part')
+    if s.get('damaged'):
+        cut = ', and TRUNCATED (no footer)' if s['truncated'] else ''
+        parts = f'{len(s["damage"])} damaged part' + ('s' if len(s['damage']) > 1 else '')
+        lines.append(f'  DAMAGED ({parts} skipped{cut}): {recovered}')
+        for line in s['damage'][:_DAMAGE_SHOWN]:
+            lines.extend(textwrap.wrap(line, 99, initial_indent='    - ',
+                                       subsequent_indent=' ' * 6))
+        if len(s['damage']) > _DAMAGE_SHOWN:
+            lines.append(f'    ... and {len(s["damage"]) - _DAMAGE_SHOWN} more (--json lists '
+                         f'them all)')
+    elif s['truncated']:
+        lines.append(f'  TRUNCATED (no footer: the writer did not close it): {recovered}')
+    for topic, bad in (s.get('undecodable') or {}).items():
+        lines.append(f'  UNDECODABLE: {bad["count"]} messages of {topic} ({bad["reason"]})')
     if s['duration_s'] is not None:
         lines.append(f'  duration: {s["duration_s"]:.3f} s, {s["message_count"]} messages on '
                      f'{len(s["topics"])} topics')

@@ -29,6 +29,7 @@ SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 METADATA_NAME = 'twodisk_ros'
 JOINT_NAMES = ('theta', 'psi', 'phase')
 STAMP_TOLERANCE = 0.01        # relative deviation of a stamp interval from 1/rate
+_MAX_NS = np.iinfo(np.int64).max    # MCAP times are uint64; the series hold int64
 
 
 @dataclass
@@ -128,10 +129,13 @@ def extract_series(recording, chosen, problems):
     """Collect the chosen topics' messages into :class:`Series`."""
     roles = {topic: role for role, topic in chosen.items()}
     rows = {role: ([], [], [], []) for role in chosen}
-    bad = {}
+    bad, late = {}, {}
     for message in recording.messages:
         role = roles.get(message.topic)
         if role is None:
+            continue
+        if max(message.log_time_ns, message.publish_time_ns) > _MAX_NS:
+            late[message.topic] = late.get(message.topic, 0) + 1
             continue
         try:
             values = _EXTRACT[role](message.msg)
@@ -146,6 +150,9 @@ def extract_series(recording, chosen, problems):
         value_rows.append(values)
     for topic, count in bad.items():
         problems.append(f'{count} messages of {topic} lack the expected fields')
+    for topic, count in late.items():
+        problems.append(f'{count} messages of {topic} have log or publish times beyond '
+                        f'2^63 ns (ignored)')
     series = {}
     for role, (stamps, logs, publishes, value_rows) in rows.items():
         keys = value_rows[0].keys() if value_rows else ()

@@ -1,26 +1,24 @@
-"""Reading MCAP recordings (rosbag2 layout), tolerant of files whose writer was killed.
+"""Reading MCAP recordings (rosbag2 layout), tolerant of cut and damaged files.
+
+The records are found by :func:`twodisk_ros.io.mcap_scan.scan_mcap` (its docstring states the
+recovery rule); here they become decoded messages, channels and metadata.
 
 Needs only ``mcap`` and ``mcap-ros2-support``: no rclpy, so recordings are read and checked
 offline on any machine.
 """
 
+import contextlib
 import io
 import os
-import struct
 from dataclasses import dataclass, field
 from typing import Any
 
-from mcap.exceptions import McapError
-from mcap.records import Channel, Header, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
-from .errors import RecordingError, one_line, os_error_reason
+from .errors import RecordingError, os_error_reason
+from .mcap_scan import MAGIC, reason_of, scan_mcap
 
 __all__ = ['RecordedMessage', 'Recording', 'TopicInfo', 'read_recording']
-
-_MAGIC = b'\x89MCAP0\r\n'
-_OPCODE_FOOTER = 0x02
 
 
 @dataclass(frozen=True)
@@ -77,8 +75,19 @@ class Recording:
     truncated : bool
         True if the file has no footer (the writer did not close it); every complete record
         before the cut has been read.
+    damage : list of str
+        One line per damaged part of the file that was skipped (a chunk that does not
+        decompress or fails its CRC, a record whose fields do not fit, lost framing, CRC
+        mismatches of the data section or summary; see :mod:`twodisk_ros.io.mcap_scan` for
+        the recovery rule).  Empty for an intact (possibly truncated) file.
+    undecodable : dict of str to tuple of (int, str)
+        Messages that could not be decoded, by topic: their count and the first reason.
+        They are not in ``messages``.
+    orphans : int
+        Messages whose channel is defined nowhere in the readable part (not in ``messages``).
     recovered_bytes : int
-        Bytes of the file read as complete records (``== total_bytes`` unless truncated).
+        Bytes of the file read as intact records (``== total_bytes`` unless truncated or
+        damaged).
     total_bytes : int
         Size of the file.
     profile : str
@@ -92,32 +101,28 @@ class Recording:
     metadata: dict = field(default_factory=dict)
     topics: dict = field(default_factory=dict)
     truncated: bool = False
+    damage: list = field(default_factory=list)
+    undecodable: dict = field(default_factory=dict)
+    orphans: int = 0
     recovered_bytes: int = 0
     total_bytes: int = 0
     profile: str = ''
     library: str = ''
 
+    @property
+    def damaged(self):
+        """True if part of the file was damaged (not merely cut)."""
+        return bool(self.damage)
 
-def _complete_prefix(stream, size):
-    """Return ``(end, has_footer)``: where the last complete top-level record ends."""
-    position = len(_MAGIC)
-    while position + 9 <= size:
-        stream.seek(position)
-        opcode, length = struct.unpack('<BQ', stream.read(9))
-        end = position + 9 + length
-        if end > size:
-            break
-        position = end
-        if opcode == _OPCODE_FOOTER:
-            stream.seek(position)
-            if stream.read(len(_MAGIC)) == _MAGIC:
-                return position + len(_MAGIC), True
-            break
-    return position, False
+    @property
+    def empty(self):
+        """True if nothing of a recording was recovered: no channel, message or metadata."""
+        return not (self.topics or self.messages or self.metadata or self.undecodable)
+
 
 
 def read_recording(path, *, decode=None) -> Recording:
-    """Read a recording written by :class:`McapRecorder` (or rosbag2), tolerating a cut file.
+    """Read a recording written by :class:`McapRecorder` (or rosbag2), tolerating damage.
 
     Parameters
     ----------
@@ -133,82 +138,82 @@ def read_recording(path, *, decode=None) -> Recording:
     Recording
         Messages decoded with ``mcap_ros2``, metadata records and channels.  A file without
         footer (writer killed) gives ``truncated=True`` and every message of its complete
-        chunks.  The file is read into memory, which suits recordings of simulation runs.
+        chunks; damaged parts are skipped and listed in ``damage`` (the recovery rule is
+        that of :mod:`twodisk_ros.io.mcap_scan`); messages that do not decode are counted in
+        ``undecodable``.  The file is read into memory, which suits recordings of simulation
+        runs.
 
     Raises
     ------
     RecordingError
-        If the file is missing, unreadable, not MCAP, or damaged before its end.
+        If the file is missing, unreadable or not MCAP (no magic).
     """
     path = os.fspath(path)
     try:
         with open(path, 'rb') as stream:
-            size = os.fstat(stream.fileno()).st_size
-            if stream.read(len(_MAGIC)) != _MAGIC:
-                raise RecordingError(f'cannot read recording {path}: not an MCAP file')
-            end, complete = _complete_prefix(stream, size)
-            stream.seek(0)
-            data = stream.read(end)
+            data = stream.read()
     except OSError as error:
-        raise RecordingError(
-            f'cannot read recording {path}: {os_error_reason(path, error, writing=False)}') from None
-    recording = Recording(path=path, truncated=not complete, recovered_bytes=end,
-                          total_bytes=size)
-    if complete:
-        reader = StreamReader(io.BytesIO(data), validate_crcs=True)
-    else:
-        reader = StreamReader(io.BytesIO(data[len(_MAGIC):]), skip_magic=True,
-                              validate_crcs=True)
-    try:
-        _collect(_records(reader, complete), recording, decode)
-    except (McapError, ValueError, KeyError, IndexError, struct.error) as error:
-        raise RecordingError(f'cannot read recording {path}: {one_line(error)}') from None
+        reason = os_error_reason(path, error, writing=False)
+        raise RecordingError(f'cannot read recording {path}: {reason}') from None
+    if not data.startswith(MAGIC):
+        reason = ('empty file' if not data else
+                  f'not an MCAP file (only {len(data)} bytes)' if MAGIC.startswith(data) else
+                  'not an MCAP file')
+        raise RecordingError(f'cannot read recording {path}: {reason}')
+    scan = scan_mcap(data)
+    recording = Recording(path=path, truncated=scan.truncated, damage=list(scan.damage),
+                          recovered_bytes=scan.recovered_bytes, total_bytes=len(data))
+    if scan.header is not None:
+        recording.profile, recording.library = scan.header.profile, scan.header.library
+    for record in scan.metadata:
+        recording.metadata[record.name] = dict(record.metadata)
+    _decode(scan, recording, decode)
     return recording
 
 
-def _records(reader, complete):
-    """Yield the records of ``reader``; for a cut file, stop quietly where reading fails."""
-    records = reader.records
-    while True:
-        try:
-            record = next(records)
-        except StopIteration:
-            return
-        except (McapError, ValueError, struct.error):
-            if complete:
-                raise
-            return  # EndOfFile at the cut, or a damaged last record of a killed writer
-        yield record
+def _decode(scan, recording, decode):
+    """Decode the scanned messages into ``recording``; failures are counted, not raised."""
+    schemas = {**scan.summary_schemas, **scan.schemas}
+    channels = {**scan.summary_channels, **scan.channels}
+    factory = DecoderFactory()
+    decoders = {}
+    counts = {channel.topic: 0 for channel in channels.values()}
 
+    def decoder_of(channel):
+        if channel.id not in decoders:
+            printed = io.StringIO()   # the vendored msg parser prints its complaints
+            try:
+                with contextlib.redirect_stderr(printed), contextlib.redirect_stdout(printed):
+                    decoder = factory.decoder_for(channel.message_encoding,
+                                                  schemas.get(channel.schema_id))
+                decoders[channel.id] = (decoder, None)
+            except Exception as error:  # noqa: BLE001 - a damaged schema text
+                decoders[channel.id] = (None, f'schema: {reason_of(error)}')
+        return decoders[channel.id]
 
-def _collect(records, recording, decode=None):
-    """Fill ``recording`` from a stream of MCAP records; ``decode(topic)`` selects topics."""
-    schemas: dict[int, Schema] = {}
-    channels: dict[int, Channel] = {}
-    decoders = DecoderFactory()
-    counts: dict[str, int] = {}
-    for record in records:
-        if isinstance(record, Message):
-            channel = channels[record.channel_id]
-            schema = schemas.get(channel.schema_id)
-            decoder = None
-            if decode is None or decode(channel.topic):
-                decoder = decoders.decoder_for(channel.message_encoding, schema)
-            msg = decoder(record.data) if decoder is not None else bytes(record.data)
-            recording.messages.append(RecordedMessage(
-                channel.topic, schema.name if schema else '', record.log_time,
-                record.publish_time, msg))
-            counts[channel.topic] = counts.get(channel.topic, 0) + 1
-        elif isinstance(record, Schema):
-            schemas[record.id] = record
-        elif isinstance(record, Channel):
-            channels[record.id] = record
-        elif isinstance(record, Metadata):
-            recording.metadata[record.name] = dict(record.metadata)
-        elif isinstance(record, Header):
-            recording.profile, recording.library = record.profile, record.library
+    for raw in scan.messages:
+        channel = channels.get(raw.channel_id)
+        if channel is None:
+            recording.orphans += 1
+            continue
+        schema = schemas.get(channel.schema_id)
+        msg = bytes(raw.data)
+        if decode is None or decode(channel.topic):
+            decoder, reason = decoder_of(channel)
+            try:
+                if decoder is not None:
+                    msg = decoder(raw.data)
+            except Exception as error:  # noqa: BLE001 - malformed CDR, any decoder failure
+                reason = reason_of(error)
+            if reason is not None:
+                count, first = recording.undecodable.get(channel.topic, (0, reason))
+                recording.undecodable[channel.topic] = (count + 1, first)
+                continue
+        recording.messages.append(RecordedMessage(
+            channel.topic, schema.name if schema else '', raw.log_time, raw.publish_time, msg))
+        counts[channel.topic] += 1
     for channel in channels.values():
         schema = schemas.get(channel.schema_id)
         recording.topics[channel.topic] = TopicInfo(
-            schema.name if schema else '', counts.get(channel.topic, 0),
+            schema.name if schema else '', counts[channel.topic],
             channel.metadata.get('offered_qos_profiles', ''))
