@@ -32,6 +32,10 @@ __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMo
            'simulate', 'simulate_phase']
 
 METHODS = ('direct', 'table')
+#: |E − max V| (× M g L) below which the table method integrates the tabulated equation
+SEPARATRIX_BAND = 1e-6
+#: amplitudes up to this fraction of the local well's radius use the local well model
+LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
 #: names of the solvers whose motion is known at any time without stepping (for reports)
 CLOSED_FORM_SOLVERS = tuple(kind.name for kind in (QuadratureSolution, LibrationSolution,
@@ -230,46 +234,108 @@ def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
 
 
 def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
+    if dynamics.flat:
+        return _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance)
+    small = _small_libration(dynamics, u0, u_dot0)
+    if small is not None:
+        return _motion(dynamics, 'dynamic', method, t_eval, small)
     if u_dot0 == 0 and dynamics.is_equilibrium(u0):
         return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+    f0 = dynamics.tabulated(u0)
+    energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
+    margin = energy - dynamics.potential_range[1]
+    band = SEPARATRIX_BAND * dynamics.energy_scale
+    n = dynamics.table_size
+    centre = dynamics.well(u0)[0] if margin < 0 else None
     if method == 'table':
-        f0 = dynamics.tabulated(u0)
-        energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
-        v_max = dynamics.potential_range[1]
-        margin = energy - v_max
-        n = dynamics.table_size
-        if u_dot0 != 0 and margin > 1e-6 * dynamics.energy_scale:
+        if u_dot0 != 0 and margin > band:
             def inverse_speed(u):
                 f = dynamics.tabulated(u)
                 return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
             quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed, n)
             return _motion(dynamics, 'dynamic', method, t_eval, quad)
-        if margin < -1e-6 * dynamics.energy_scale:
-            libration = LibrationSolution(dynamics, u0, u_dot0, n)
+        if margin < -band:
+            libration = LibrationSolution(dynamics.tabulated_well(centre), u0 - centre,
+                                          u_dot0, n)
             return _motion(dynamics, 'dynamic', method, t_eval, libration)
 
         def rhs(t, y):
             f = dynamics.tabulated(y[0])
             df = dynamics.tabulated(y[0], derivative=1)
             return [y[1], -(df[1] + 0.5 * df[0] * y[1] ** 2) / f[0]]
+        rate_scale = max(abs(u_dot0), 1.0)
+        sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
+        return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+    offset = 0.0 if centre is None else centre
+
+    def rhs(t, y):
+        u = offset + y[0]
+        m = float(dynamics.effective_mass(u))
+        dm = float(dynamics.effective_mass_slope(u))
+        dv = float(dynamics.potential_slope(u))
+        return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
+    if centre is None:
+        sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
     else:
-        def rhs(t, y):
-            m = float(dynamics.effective_mass(y[0]))
-            dm = float(dynamics.effective_mass_slope(y[0]))
-            dv = float(dynamics.potential_slope(y[0]))
-            return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
-    rate_scale = max(abs(u_dot0), 1.0)
-    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
+        # an oscillation: integrate δ = u − u*, so that rtol and atol act on the displacement
+        frequency = math.sqrt(dynamics.potential_curvature(centre) / float(f0[0]))
+        delta0 = u0 - centre
+        amplitude = math.hypot(delta0, u_dot0 / frequency)
+        sol, nfev = _solve(rhs, t_eval, [delta0, u_dot0], tolerance,
+                           np.array([amplitude, amplitude * frequency]), centre=centre)
     return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
 
 
-def _solve(rhs, t_eval, y0, tolerance, scale, rate=None):
+def _small_libration(dynamics, u0, u_dot0):
+    """The solution of a small oscillation (or rest) about a stable equilibrium, else None.
+
+    Small: within LOCAL_FRACTION of the radius of the equilibrium's
+    :class:`~twodisk_ros.physics.wells.LocalWell`, for both methods.
+    """
+    if not dynamics.has_wells:
+        return None
+    centre = dynamics.well(u0)[0]
+    delta0 = u0 - centre
+    if delta0 == 0 and u_dot0 == 0:
+        return RestSolution(u0)
+    local = dynamics.local_well(centre)
+    if abs(delta0) > local.radius:
+        return None
+    amplitude = math.hypot(delta0, u_dot0 * math.sqrt(float(local.mass(delta0))
+                                                      / local.stiffness))
+    if amplitude > LOCAL_FRACTION * local.radius:
+        return None
+    return LibrationSolution(local, delta0, u_dot0, dynamics.table_size)
+
+
+def _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance):
+    """V constant (g = 0 or z_G constant): ½ m(u) u̇² is conserved, the body rolls on."""
+    if u_dot0 == 0:
+        return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+    if method == 'table':
+        m0 = float(dynamics.tabulated(u0)[0])
+
+        def inverse_speed(u):
+            return np.sqrt(dynamics.tabulated(u)[..., 0] / m0) / abs(u_dot0)
+        quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed,
+                                  dynamics.table_size)
+        return _motion(dynamics, 'dynamic', method, t_eval, quad)
+
+    def rhs(t, y):
+        m = float(dynamics.effective_mass(y[0]))
+        dm = float(dynamics.effective_mass_slope(y[0]))
+        return [y[1], -0.5 * dm * y[1] ** 2 / m]
+    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
+    return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+
+
+def _solve(rhs, t_eval, y0, tolerance, scale, rate=None, centre=None):
     """DOP853 over [0, t_eval[-1]]: (OdeSolution, right-hand-side evaluations)."""
     t_end = float(t_eval[-1])
     if t_end == 0.0:
-        return OdeSolution(None, y0, t_end, rate), 0
+        return OdeSolution(None, y0, t_end, rate, centre), 0
     result = solve_ivp(rhs, (0.0, t_end), y0, method='DOP853', rtol=tolerance,
                        atol=tolerance * scale, dense_output=True)
     if not result.success:
         raise RuntimeError(f'integration failed: {result.message}')
-    return OdeSolution(result.sol, y0, t_end, rate), result.nfev
+    return OdeSolution(result.sol, y0, t_end, rate, centre), result.nfev
