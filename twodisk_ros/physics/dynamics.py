@@ -94,10 +94,15 @@ class RollingDynamics:
         The step is 1e-3 rad times the width of the sharpest feature of the body's functions
         of u, min(1, b/a, a/b, 2√(Δ/a)) (body module docstring).
         """
+        return self.effective_mass_jet(u)[1]
+
+    def effective_mass_jet(self, u):
+        """(m, dm/du) at u: :meth:`effective_mass` and its 5-point slope, in one evaluation."""
         u = np.asarray(u, dtype=float)
         h = _FD_STEP * self._feature_width
-        m = [self.effective_mass(u + k * h) for k in (-2, -1, 1, 2)]
-        return (m[0] - 8 * m[1] + 8 * m[2] - m[3]) / (12 * h)
+        m = self.effective_mass(u[..., None] + h * np.arange(-2.0, 3.0))
+        m = np.moveaxis(m, -1, 0)
+        return m[2], (m[0] - 8 * m[1] + 8 * m[3] - m[4]) / (12 * h)
 
     # -- tables (the table method) ----------------------------------------------------------
     def _build_tables(self, n):

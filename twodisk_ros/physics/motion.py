@@ -34,6 +34,9 @@ __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMo
 METHODS = ('direct', 'table')
 #: |E − max V| (× M g L) below which the table method integrates the tabulated equation
 SEPARATRIX_BAND = 1e-6
+#: E below max V by more than this (× M g L): the table method's libration tables; closer,
+#: their grid in φ would need > 10⁴ nodes, and the tabulated equation is integrated
+LIBRATION_MARGIN = 3e-4
 #: amplitudes up to this fraction of the local well's radius use the local well model
 LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
@@ -254,7 +257,7 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
                 return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
             quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed, n)
             return _motion(dynamics, 'dynamic', method, t_eval, quad)
-        if margin < -band:
+        if margin < -LIBRATION_MARGIN * dynamics.energy_scale:
             libration = LibrationSolution(dynamics.tabulated_well(centre), u0 - centre,
                                           u_dot0, n)
             return _motion(dynamics, 'dynamic', method, t_eval, libration)
@@ -270,8 +273,7 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
 
     def rhs(t, y):
         u = offset + y[0]
-        m = float(dynamics.effective_mass(u))
-        dm = float(dynamics.effective_mass_slope(u))
+        m, dm = (float(x) for x in dynamics.effective_mass_jet(u))
         dv = float(dynamics.potential_slope(u))
         return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
     if centre is None:
@@ -322,8 +324,7 @@ def _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance):
         return _motion(dynamics, 'dynamic', method, t_eval, quad)
 
     def rhs(t, y):
-        m = float(dynamics.effective_mass(y[0]))
-        dm = float(dynamics.effective_mass_slope(y[0]))
+        m, dm = (float(x) for x in dynamics.effective_mass_jet(y[0]))
         return [y[1], -0.5 * dm * y[1] ** 2 / m]
     sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
     return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)

@@ -221,6 +221,9 @@ class LibrationSolution(PhaseSolution):
     """
 
     name = 'libration'
+    #: spectral tail at which u(φ) and t(φ) count as resolved: above the noise plateau of
+    #: the tabulated V′ (~1e-13 of its peak), far below any truncation that matters
+    TAIL = 1e-11
     _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(20)
 
     def __init__(self, well, delta0, u_dot0, max_nodes):
@@ -239,7 +242,8 @@ class LibrationSolution(PhaseSolution):
         def sample(n):
             x, dx_dphi, dt_dphi = self._samples(n)
             return max(spectral_tail(dx_dphi), spectral_tail(dt_dphi)), (x, dx_dphi, dt_dphi)
-        n, (x, dx_dphi, dt_dphi) = refine_grid(sample, 128, max(128, max_nodes // 4))
+        n, (x, dx_dphi, dt_dphi) = refine_grid(sample, 128, max(128, max_nodes),
+                                           tolerance=self.TAIL)
         x, dx_dphi, dt_dphi = (upsample(f, 4) for f in (x, dx_dphi, dt_dphi))
         n *= 4
         self._x = HermiteTable.periodic(x, dx_dphi, spectral_derivative(dx_dphi))
@@ -280,23 +284,31 @@ class LibrationSolution(PhaseSolution):
         """y = |x| ≥ 0 with rise(side·y) = level (rise increases with y on each side).
 
         Safeguarded Newton from the linear guess √(2 level / V″), bisection when a step
-        leaves the bracket; converged when every step is below 1e-15 y. 0 at ``centre``.
+        leaves the bracket; converged when each step is below 1e-15 y or the residual below
+        4e-15 of the level (its rounding). 0 at ``centre``.
         """
-        low = np.zeros_like(level)
-        high = np.where(side > 0, self._bounds[1], -self._bounds[0])
-        y = np.minimum(np.sqrt(2 * level / self._well.stiffness), 0.5 * high)
-        active = ~centre
+        level, side = np.asarray(level, dtype=float), np.asarray(side, dtype=float)
+        y = np.zeros_like(level)
+        todo = np.nonzero(~np.asarray(centre))[0]          # points still iterating
+        lev, sid = level[todo], side[todo]
+        low = np.zeros_like(lev)
+        high = np.where(sid > 0, self._bounds[1], -self._bounds[0])
+        guess = np.minimum(np.sqrt(2 * lev / self._well.stiffness), 0.5 * high)
         for _ in range(200):
-            g = self._rise(side * y) - level
-            dg = side * self._slope(side * y)
-            low, high = np.where(g < 0, y, low), np.where(g > 0, y, high)
-            newton = y - g / np.where(dg > 0, dg, 1.0)
-            inside = (dg > 0) & (newton >= low) & (newton <= high)
-            y_new = np.where(inside, newton, 0.5 * (low + high))
-            step = np.where(active, np.abs(y_new - y), 0.0)
-            y = np.where(active, y_new, 0.0)
-            if np.all((step <= 1e-15 * y) | (high - low <= 1e-15 * y)):
+            if todo.size == 0:
                 break
+            g = self._rise(sid * guess) - lev
+            dg = sid * self._slope(sid * guess)
+            low, high = np.where(g < 0, guess, low), np.where(g > 0, guess, high)
+            newton = guess - g / np.where(dg > 0, dg, 1.0)
+            inside = (dg > 0) & (newton >= low) & (newton <= high)
+            new = np.where(inside, newton, 0.5 * (low + high))
+            done = ((np.abs(new - guess) <= 1e-15 * new) | (high - low <= 1e-15 * new)
+                    | (np.abs(g) <= 4e-15 * lev))
+            y[todo] = new
+            keep = ~done
+            todo, lev, sid, low, high, guess = (a[keep] for a in
+                                                (todo, lev, sid, low, high, new))
         return y
 
     def _evaluate(self, t):
