@@ -189,6 +189,17 @@ class RollingDynamics:
         return self.gravity == 0 or all(eq.stability == NEUTRAL
                                         for eq, _ in self.equilibria_with_periods())
 
+    @property
+    def barrier(self):
+        """max V (J): V at the highest maximum among the equilibria (the separatrix energy).
+
+        The maximum over the table nodes (``potential_range``) falls short of it by up to
+        ½ V″ h² (h the node spacing: ~2e-6 M g L for b/a = 2).
+        """
+        tops = [eq.phase for eq, _ in self.equilibria_with_periods() if eq.stability != STABLE]
+        top = float(np.max(self.tabulated_potential(np.array(tops)))) if tops else -math.inf
+        return max(top, self.potential_range[1])
+
     def local_well(self, u_star):
         """The :class:`~twodisk_ros.physics.wells.LocalWell` about the stable equilibrium u*.
 

@@ -32,11 +32,13 @@ __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMo
            'simulate', 'simulate_phase']
 
 METHODS = ('direct', 'table')
-#: |E − max V| (× M g L) below which the table method integrates the tabulated equation
-SEPARATRIX_BAND = 1e-6
-#: E below max V by more than this (× M g L): the table method's libration tables; closer,
-#: their grid in φ would need > 10⁴ nodes, and the tabulated equation is integrated
+#: The table method's closed-form solutions need E away from the separatrix E = max V,
+#: where t(u) is logarithmically singular: below max V by more than LIBRATION_MARGIN
+#: (× M g L) the libration tables (closer, their grid in φ would need > 10⁴ nodes), above
+#: it by more than ROLLING_MARGIN the quadrature (closer, 1/|u̇| is not resolved by the
+#: table grid: energy drift 2e-7 M g L at 1e-4 above); in between, DOP853 on the tables.
 LIBRATION_MARGIN = 3e-4
+ROLLING_MARGIN = 1e-3
 #: amplitudes up to this fraction of the local well's radius use the local well model
 LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
@@ -246,12 +248,11 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
         return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
     f0 = dynamics.tabulated(u0)
     energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
-    margin = energy - dynamics.potential_range[1]
-    band = SEPARATRIX_BAND * dynamics.energy_scale
+    margin = energy - dynamics.barrier
     n = dynamics.table_size
     centre = dynamics.well(u0)[0] if margin < 0 else None
     if method == 'table':
-        if u_dot0 != 0 and margin > band:
+        if u_dot0 != 0 and margin > ROLLING_MARGIN * dynamics.energy_scale:
             def inverse_speed(u):
                 f = dynamics.tabulated(u)
                 return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
@@ -263,19 +264,16 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
             return _motion(dynamics, 'dynamic', method, t_eval, libration)
 
         def rhs(t, y):
-            f = dynamics.tabulated(y[0])
-            df = dynamics.tabulated(y[0], derivative=1)
+            u = y[0] if centre is None else centre + y[0]
+            f = dynamics.tabulated(u)
+            df = dynamics.tabulated(u, derivative=1)
             return [y[1], -(df[1] + 0.5 * df[0] * y[1] ** 2) / f[0]]
-        rate_scale = max(abs(u_dot0), 1.0)
-        sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
-        return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
-    offset = 0.0 if centre is None else centre
-
-    def rhs(t, y):
-        u = offset + y[0]
-        m, dm = (float(x) for x in dynamics.effective_mass_jet(u))
-        dv = float(dynamics.potential_slope(u))
-        return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
+    else:
+        def rhs(t, y):
+            u = y[0] if centre is None else centre + y[0]
+            m, dm = (float(x) for x in dynamics.effective_mass_jet(u))
+            dv = float(dynamics.potential_slope(u))
+            return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
     if centre is None:
         sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
     else:
