@@ -11,11 +11,15 @@ u̇ = Ω / |ω_u(u)|). Two methods (docs/physics.md#the-two-methods-direct-and-t
     when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
     t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
     bracketed Newton (no time stepping, no drift); when it oscillates in a well (E < max V),
-    the same in the angle φ of V(u(φ)) = V* + (E − V*) sin²φ. Only within 1e-6 M g L of the
-    separatrix E = max V is DOP853 run on the tabulated right-hand side, with ``tolerance``
-    as its rtol.
+    the same in the angle φ of V(u* + δ(φ)) = V* + (E − V*) sin²φ, in the displacement δ.
+    Only near the separatrix E = max V (LIBRATION_MARGIN below to ROLLING_MARGIN above) is
+    DOP853 run on the tabulated right-hand side, with ``tolerance`` as its rtol.
 
-A body exactly at an equilibrium with u̇ = 0 stays there (the exact solution). Every motion
+Small oscillations (amplitude ≤ LOCAL_FRACTION of the equilibrium's LocalWell radius) use
+the same closed-form LibrationSolution with the local well model in both methods; above it,
+the direct method integrates δ = u − u* inside a well. A body exactly at an equilibrium with
+u̇ = 0 stays there (the exact solution); at a stable one, any other start oscillates. If V is
+flat (g = 0 or z_G constant) ½ m u̇² is conserved and V′ is not evaluated. Every motion
 carries its solution as ``sol``, a :class:`~twodisk_ros.physics.solvers.PhaseSolution`.
 """
 

@@ -103,7 +103,7 @@ class OdeSolution(PhaseSolution):
 
     def _displace(self, t):
         if self.centre is None:
-            return PhaseSolution._displace(self, t)
+            return super()._displace(t)
         return self._integrated(t)
 
     def _integrated(self, t):
@@ -252,7 +252,7 @@ class LibrationSolution(PhaseSolution):
         self._phase = QuadratureSolution(math.atan2(sin0, cos0), 1.0, lambda _: dt_dphi, n)
         self.period = self._phase.cycle_time
         #: the turning displacements (rad): δ at φ = −π/2 and π/2
-        self.turning_points = (s * float(self._x(1.5 * math.pi)), s * float(self._x(0.5 * math.pi)))
+        self.turning_points = tuple(s * float(self._x(p)) for p in (1.5 * math.pi, 0.5 * math.pi))
 
     def _slope(self, x):
         """V′(u* + s x) / s (J/rad)."""
