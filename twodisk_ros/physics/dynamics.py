@@ -20,10 +20,11 @@ import numpy as np
 from .analytic import complex_step
 from .body import TwoDiskBody
 from .cycle import RollingCycle, TWO_PI
-from .equilibria import equilibria, STABLE
+from .equilibria import equilibria, NEUTRAL, STABLE
 from .mass_models import MassProperties
 from .spectral import spectral_derivative
 from .tables import HermiteTable
+from .wells import LocalWell, TabulatedWell
 
 __all__ = ['RollingDynamics']
 
@@ -62,6 +63,7 @@ class RollingDynamics:
                                   2 * math.sqrt(body.delta / body.a))
         self._build_tables(4 * self.cycle.resolution)
         self._equilibria = None
+        self._local_wells = {}
 
     # -- closed forms (the direct method) ---------------------------------------------------
     def effective_mass(self, u):
@@ -92,10 +94,15 @@ class RollingDynamics:
         The step is 1e-3 rad times the width of the sharpest feature of the body's functions
         of u, min(1, b/a, a/b, 2√(Δ/a)) (body module docstring).
         """
+        return self.effective_mass_jet(u)[1]
+
+    def effective_mass_jet(self, u):
+        """(m, dm/du) at u: :meth:`effective_mass` and its 5-point slope, in one evaluation."""
         u = np.asarray(u, dtype=float)
         h = _FD_STEP * self._feature_width
-        m = [self.effective_mass(u + k * h) for k in (-2, -1, 1, 2)]
-        return (m[0] - 8 * m[1] + 8 * m[2] - m[3]) / (12 * h)
+        m = self.effective_mass(u[..., None] + h * np.arange(-2.0, 3.0))
+        m = np.moveaxis(m, -1, 0)
+        return m[2], (m[0] - 8 * m[1] + 8 * m[3] - m[4]) / (12 * h)
 
     # -- tables (the table method) ----------------------------------------------------------
     def _build_tables(self, n):
@@ -169,6 +176,44 @@ class RollingDynamics:
         centres = np.concatenate([minima - TWO_PI, minima, minima + TWO_PI]) + base
         inside = centres[(centres > low) & (centres < high)]
         return float(inside[0]), float(low), float(high)
+
+    @property
+    def has_wells(self):
+        """True if V has wells: g > 0 and some equilibrium is stable."""
+        return self.gravity > 0 and any(eq.stability == STABLE
+                                        for eq, _ in self.equilibria_with_periods())
+
+    @property
+    def flat(self):
+        """True if V is constant: g = 0, or z_G constant (every equilibrium neutral)."""
+        return self.gravity == 0 or all(eq.stability == NEUTRAL
+                                        for eq, _ in self.equilibria_with_periods())
+
+    @property
+    def barrier(self):
+        """max V (J): V at the highest maximum among the equilibria (the separatrix energy).
+
+        The maximum over the table nodes (``potential_range``) falls short of it by up to
+        ½ V″ h² (h the node spacing: ~2e-6 M g L for b/a = 2).
+        """
+        tops = [eq.phase for eq, _ in self.equilibria_with_periods() if eq.stability != STABLE]
+        top = float(np.max(self.tabulated_potential(np.array(tops)))) if tops else -math.inf
+        return max(top, self.potential_range[1])
+
+    def local_well(self, u_star):
+        """The :class:`~twodisk_ros.physics.wells.LocalWell` about the stable equilibrium u*.
+
+        Built once per equilibrium from the closed forms (both methods use it for small
+        amplitudes).
+        """
+        key = round(float(u_star), 12)
+        if key not in self._local_wells:
+            self._local_wells[key] = LocalWell(self, u_star)
+        return self._local_wells[key]
+
+    def tabulated_well(self, u_star):
+        """The :class:`~twodisk_ros.physics.wells.TabulatedWell` about u* (the tables)."""
+        return TabulatedWell(self, u_star, self.potential_curvature(u_star))
 
     def potential_curvature(self, u):
         """d²V/du² (J/rad²) at an equilibrium phase u (spectral, as in the equilibria)."""

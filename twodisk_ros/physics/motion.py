@@ -11,11 +11,15 @@ u̇ = Ω / |ω_u(u)|). Two methods (docs/physics.md#the-two-methods-direct-and-t
     when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
     t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
     bracketed Newton (no time stepping, no drift); when it oscillates in a well (E < max V),
-    the same in the angle φ of V(u(φ)) = V* + (E − V*) sin²φ. Only within 1e-6 M g L of the
-    separatrix E = max V is DOP853 run on the tabulated right-hand side, with ``tolerance``
-    as its rtol.
+    the same in the angle φ of V(u* + δ(φ)) = V* + (E − V*) sin²φ, in the displacement δ.
+    Only near the separatrix E = max V (LIBRATION_MARGIN below to ROLLING_MARGIN above) is
+    DOP853 run on the tabulated right-hand side, with ``tolerance`` as its rtol.
 
-A body exactly at an equilibrium with u̇ = 0 stays there (the exact solution). Every motion
+Small oscillations (amplitude ≤ LOCAL_FRACTION of the equilibrium's LocalWell radius) use
+the same closed-form LibrationSolution with the local well model in both methods; above it,
+the direct method integrates δ = u − u* inside a well. A body exactly at an equilibrium with
+u̇ = 0 stays there (the exact solution); at a stable one, any other start oscillates. If V is
+flat (g = 0 or z_G constant) ½ m u̇² is conserved and V′ is not evaluated. Every motion
 carries its solution as ``sol``, a :class:`~twodisk_ros.physics.solvers.PhaseSolution`.
 """
 
@@ -32,6 +36,15 @@ __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMo
            'simulate', 'simulate_phase']
 
 METHODS = ('direct', 'table')
+#: The table method's closed-form solutions need E away from the separatrix E = max V,
+#: where t(u) is logarithmically singular: below max V by more than LIBRATION_MARGIN
+#: (× M g L) the libration tables (closer, their grid in φ would need > 10⁴ nodes), above
+#: it by more than ROLLING_MARGIN the quadrature (closer, 1/|u̇| is not resolved by the
+#: table grid: energy drift 2e-7 M g L at 1e-4 above); in between, DOP853 on the tables.
+LIBRATION_MARGIN = 3e-4
+ROLLING_MARGIN = 1e-3
+#: amplitudes up to this fraction of the local well's radius use the local well model
+LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
 #: names of the solvers whose motion is known at any time without stepping (for reports)
 CLOSED_FORM_SOLVERS = tuple(kind.name for kind in (QuadratureSolution, LibrationSolution,
@@ -230,46 +243,102 @@ def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
 
 
 def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
+    if dynamics.flat:
+        return _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance)
+    small = _small_libration(dynamics, u0, u_dot0)
+    if small is not None:
+        return _motion(dynamics, 'dynamic', method, t_eval, small)
     if u_dot0 == 0 and dynamics.is_equilibrium(u0):
         return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+    f0 = dynamics.tabulated(u0)
+    energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
+    margin = energy - dynamics.barrier
+    n = dynamics.table_size
+    centre = dynamics.well(u0)[0] if margin < 0 else None
     if method == 'table':
-        f0 = dynamics.tabulated(u0)
-        energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
-        v_max = dynamics.potential_range[1]
-        margin = energy - v_max
-        n = dynamics.table_size
-        if u_dot0 != 0 and margin > 1e-6 * dynamics.energy_scale:
+        if u_dot0 != 0 and margin > ROLLING_MARGIN * dynamics.energy_scale:
             def inverse_speed(u):
                 f = dynamics.tabulated(u)
                 return np.sqrt(f[..., 0] / (2.0 * (energy - f[..., 1])))
             quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed, n)
             return _motion(dynamics, 'dynamic', method, t_eval, quad)
-        if margin < -1e-6 * dynamics.energy_scale:
-            libration = LibrationSolution(dynamics, u0, u_dot0, n)
+        if margin < -LIBRATION_MARGIN * dynamics.energy_scale:
+            libration = LibrationSolution(dynamics.tabulated_well(centre), u0 - centre,
+                                          u_dot0, n)
             return _motion(dynamics, 'dynamic', method, t_eval, libration)
 
         def rhs(t, y):
-            f = dynamics.tabulated(y[0])
-            df = dynamics.tabulated(y[0], derivative=1)
+            u = y[0] if centre is None else centre + y[0]
+            f = dynamics.tabulated(u)
+            df = dynamics.tabulated(u, derivative=1)
             return [y[1], -(df[1] + 0.5 * df[0] * y[1] ** 2) / f[0]]
     else:
         def rhs(t, y):
-            m = float(dynamics.effective_mass(y[0]))
-            dm = float(dynamics.effective_mass_slope(y[0]))
-            dv = float(dynamics.potential_slope(y[0]))
+            u = y[0] if centre is None else centre + y[0]
+            m, dm = (float(x) for x in dynamics.effective_mass_jet(u))
+            dv = float(dynamics.potential_slope(u))
             return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
-    rate_scale = max(abs(u_dot0), 1.0)
-    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, rate_scale)
+    if centre is None:
+        sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
+    else:
+        # an oscillation: integrate δ = u − u*, so that rtol and atol act on the displacement
+        frequency = math.sqrt(dynamics.potential_curvature(centre) / float(f0[0]))
+        delta0 = u0 - centre
+        amplitude = math.hypot(delta0, u_dot0 / frequency)
+        sol, nfev = _solve(rhs, t_eval, [delta0, u_dot0], tolerance,
+                           np.array([amplitude, amplitude * frequency]), centre=centre)
     return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
 
 
-def _solve(rhs, t_eval, y0, tolerance, scale, rate=None):
+def _small_libration(dynamics, u0, u_dot0):
+    """The solution of a small oscillation (or rest) about a stable equilibrium, else None.
+
+    Small: within LOCAL_FRACTION of the radius of the equilibrium's
+    :class:`~twodisk_ros.physics.wells.LocalWell`, for both methods.
+    """
+    if not dynamics.has_wells:
+        return None
+    centre = dynamics.well(u0)[0]
+    delta0 = u0 - centre
+    if delta0 == 0 and u_dot0 == 0:
+        return RestSolution(u0)
+    local = dynamics.local_well(centre)
+    if abs(delta0) > local.radius:
+        return None
+    amplitude = math.hypot(delta0, u_dot0 * math.sqrt(float(local.mass(delta0))
+                                                      / local.stiffness))
+    if amplitude > LOCAL_FRACTION * local.radius:
+        return None
+    return LibrationSolution(local, delta0, u_dot0, dynamics.table_size)
+
+
+def _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance):
+    """V constant (g = 0 or z_G constant): ½ m(u) u̇² is conserved, the body rolls on."""
+    if u_dot0 == 0:
+        return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+    if method == 'table':
+        m0 = float(dynamics.tabulated(u0)[0])
+
+        def inverse_speed(u):
+            return np.sqrt(dynamics.tabulated(u)[..., 0] / m0) / abs(u_dot0)
+        quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed,
+                                  dynamics.table_size)
+        return _motion(dynamics, 'dynamic', method, t_eval, quad)
+
+    def rhs(t, y):
+        m, dm = (float(x) for x in dynamics.effective_mass_jet(y[0]))
+        return [y[1], -0.5 * dm * y[1] ** 2 / m]
+    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
+    return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+
+
+def _solve(rhs, t_eval, y0, tolerance, scale, rate=None, centre=None):
     """DOP853 over [0, t_eval[-1]]: (OdeSolution, right-hand-side evaluations)."""
     t_end = float(t_eval[-1])
     if t_end == 0.0:
-        return OdeSolution(None, y0, t_end, rate), 0
+        return OdeSolution(None, y0, t_end, rate, centre), 0
     result = solve_ivp(rhs, (0.0, t_end), y0, method='DOP853', rtol=tolerance,
                        atol=tolerance * scale, dense_output=True)
     if not result.success:
         raise RuntimeError(f'integration failed: {result.message}')
-    return OdeSolution(result.sol, y0, t_end, rate), result.nfev
+    return OdeSolution(result.sol, y0, t_end, rate, centre), result.nfev

@@ -29,14 +29,33 @@ class PhaseSolution:
     closed_form = True
     #: the last time (s) at which the solution is defined
     t_end = math.inf
+    #: the equilibrium u* (rad) the motion oscillates about (or rests at), else None
+    centre = None
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
         u, u_dot = self._evaluate(t.ravel())
         return np.stack([u, u_dot]).reshape((2,) + t.shape)
 
+    def displacement(self, t):
+        """Array (2, ...) of δ = u − ``centre`` (rad) and u̇ (rad/s) at times t (s).
+
+        For a motion about an equilibrium, δ is computed as such (not as a difference of
+        phases), so it keeps its relative precision however small the amplitude: u itself
+        is rounded to its ulp (~1e-16 rad), δ is not.
+        """
+        if self.centre is None:
+            raise ValueError(f'a {self.name!r} solution has no centre')
+        t = np.asarray(t, dtype=float)
+        delta, u_dot = self._displace(t.ravel())
+        return np.stack([delta, u_dot]).reshape((2,) + t.shape)
+
     def _evaluate(self, t):
         raise NotImplementedError
+
+    def _displace(self, t):
+        u, u_dot = self._evaluate(t)
+        return u - self.centre, u_dot
 
 
 class RestSolution(PhaseSolution):
@@ -45,7 +64,7 @@ class RestSolution(PhaseSolution):
     name = 'rest'
 
     def __init__(self, u0):
-        self.u0 = float(u0)
+        self.u0 = self.centre = float(u0)
 
     def _evaluate(self, t):
         return np.full_like(t, self.u0), np.zeros_like(t)
@@ -65,16 +84,29 @@ class OdeSolution(PhaseSolution):
         End of the span (s).
     rate : callable, optional
         u̇ as a function of u (kinematic mode, where only u is integrated).
+    centre : float, optional
+        If given, the integrated variable is the displacement δ = u − centre (an oscillation
+        about the equilibrium ``centre``), and u = centre + δ.
     """
 
     name = 'DOP853'
     closed_form = False
 
-    def __init__(self, dense, y0, t_end, rate=None):
+    def __init__(self, dense, y0, t_end, rate=None, centre=None):
         self._dense, self._y0, self._rate = dense, np.asarray(y0, dtype=float), rate
         self.t_end = float(t_end)
+        self.centre = None if centre is None else float(centre)
 
     def _evaluate(self, t):
+        y0, y1 = self._integrated(t)
+        return (y0 if self.centre is None else self.centre + y0), y1
+
+    def _displace(self, t):
+        if self.centre is None:
+            return super()._displace(t)
+        return self._integrated(t)
+
+    def _integrated(self, t):
         if t.size == 0:
             return np.zeros(0), np.zeros(0)
         if self._dense is None:
@@ -164,103 +196,127 @@ class QuadratureSolution(PhaseSolution):
 
 
 class LibrationSolution(PhaseSolution):
-    """Oscillation in a well of V, in closed form from tables (no time stepping).
+    """Oscillation in a well of V, in closed form (no time stepping), in the displacement.
 
-    The angle φ is defined by V(u(φ)) = V* + (E − V*) sin²φ with sign(u − u*) = sign(sin φ),
-    u* the minimum of the well; then u̇ = √(2(E − V*)/m) cos φ and
-    dt/dφ = √(2 m (E − V*)) sin φ / V′(u), smooth, positive and 2π-periodic
-    (√(m/V″) at φ = 0, π). φ(t) comes from :class:`QuadratureSolution`, u(φ) from a table.
+    With δ = u − u* from the well's minimum u* and depth D = E − V*, the angle φ is defined by
+    V(u* + δ(φ)) − V* = D sin²φ with sign(δ) = sign(sin φ); then u̇ = √(2D/m) cos φ and
+    dt/dφ = √(2 m D) sin φ / V′, smooth, positive and 2π-periodic (√(m/V″) at φ = 0, π).
+    φ(t) comes from :class:`QuadratureSolution`, δ(φ) from a table.
+
+    Everything is computed in x = δ/s, s the linear amplitude estimate √(δ₀² + m u̇₀²/V″),
+    from the well's ``ratio(δ)`` = V′/δ (``physics.wells``): V′ = s x ratio(s x) and
+    V − V* = s² x² ∫₀¹ τ ratio(s x τ) dτ (20-point Gauss), so every quantity keeps its
+    relative precision at any amplitude, 1e-300 rad as well as 1 rad. The level equation is
+    solved by safeguarded Newton in |x| with a relative tolerance.
 
     Parameters
     ----------
-    dynamics : RollingDynamics
-    u0, u_dot0 : float
-        Initial phase (rad) and rate (rad/s), inside a well of V.
+    well : LocalWell or TabulatedWell
+        Centre u* (rad), bounds ``low`` < 0 < ``high`` of δ (rad), ``stiffness`` V″(u*),
+        ``ratio(δ)`` and ``mass(δ)``.
+    delta0, u_dot0 : float
+        Initial displacement u0 − u* (rad) and rate (rad/s), not both zero.
     max_nodes : int
         Largest number of nodes of the tables in φ.
     """
 
     name = 'libration'
-    _GAUSS = np.polynomial.legendre.leggauss(20)
+    #: spectral tail at which u(φ) and t(φ) count as resolved: above the noise plateau of
+    #: the tabulated V′ (~1e-13 of its peak), far below any truncation that matters
+    TAIL = 1e-11
+    _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(20)
 
-    def __init__(self, dynamics, u0, u_dot0, max_nodes):
-        self._dynamics = dynamics
-        u_min, self._u_low, self._u_high = dynamics.well(u0)
-        self._u_min = u_min
-        f0 = dynamics.tabulated(u0)
-        rise0 = float(self._rise(np.array(u0)))
-        self._depth = depth = 0.5 * f0[0] * u_dot0**2 + rise0   # E − V*, no cancellation
-        self._stiffness = dynamics.potential_curvature(u_min)
-        # resolve u(φ) spectrally on few nodes, then upsample ×4 for the Hermite tables
+    def __init__(self, well, delta0, u_dot0, max_nodes):
+        self._well = well
+        self.centre = well.centre
+        delta0, u_dot0 = float(delta0), float(u_dot0)
+        m0, k = float(well.mass(delta0)), well.stiffness
+        self._scale = s = math.hypot(delta0, u_dot0 * math.sqrt(m0 / k))
+        if not s > 0:
+            raise ValueError('a libration needs a displacement or a rate (else: rest)')
+        x0, v0 = delta0 / s, u_dot0 / s
+        rise0 = float(self._rise(np.array(x0)))
+        self._depth = depth = 0.5 * m0 * v0**2 + rise0     # (E − V*) / s², no cancellation
+        self._bounds = (well.low / s, well.high / s)
+
         def sample(n):
-            u, du_dphi, dt_dphi = self._samples(n)
-            return max(spectral_tail(du_dphi), spectral_tail(dt_dphi)), (u, du_dphi, dt_dphi)
-        n, (u, du_dphi, dt_dphi) = refine_grid(sample, 128, max(128, max_nodes // 4))
-        u = u_min + upsample(u - u_min, 4)
-        du_dphi, dt_dphi = upsample(du_dphi, 4), upsample(dt_dphi, 4)
+            x, dx_dphi, dt_dphi = self._samples(n)
+            return max(spectral_tail(dx_dphi), spectral_tail(dt_dphi)), (x, dx_dphi, dt_dphi)
+        n, (x, dx_dphi, dt_dphi) = refine_grid(sample, 128, max(128, max_nodes),
+                                           tolerance=self.TAIL)
+        x, dx_dphi, dt_dphi = (upsample(f, 4) for f in (x, dx_dphi, dt_dphi))
         n *= 4
-        self._u = HermiteTable.periodic(u, du_dphi, spectral_derivative(du_dphi))
-        sin0 = math.copysign(math.sqrt(min(1.0, max(0.0, rise0 / depth))), u0 - u_min)
-        cos0 = u_dot0 / math.sqrt(2 * depth / f0[0])
-        self._phase = QuadratureSolution(math.atan2(sin0, cos0), 1.0, lambda x: dt_dphi, n)
+        self._x = HermiteTable.periodic(x, dx_dphi, spectral_derivative(dx_dphi))
+        sin0 = math.copysign(math.sqrt(min(1.0, max(0.0, rise0 / depth))), x0)
+        cos0 = v0 / math.sqrt(2 * depth / m0)
+        self._phase = QuadratureSolution(math.atan2(sin0, cos0), 1.0, lambda _: dt_dphi, n)
         self.period = self._phase.cycle_time
+        #: the turning displacements (rad): δ at φ = −π/2 and π/2
+        self.turning_points = tuple(s * float(self._x(p)) for p in (1.5 * math.pi, 0.5 * math.pi))
+
+    def _slope(self, x):
+        """V′(u* + s x) / s (J/rad)."""
+        return x * self._well.ratio(self._scale * x)
+
+    def _rise(self, x):
+        """(V(u* + s x) − V*) / s² (J) = x² ∫₀¹ τ ratio(s x τ) dτ: no cancellation near u*."""
+        tau = 0.5 * (1 + self._NODES)
+        ratio = self._well.ratio(self._scale * np.asarray(x)[..., None] * tau)
+        return np.asarray(x) ** 2 * np.sum(0.5 * self._WEIGHTS * tau * ratio, axis=-1)
 
     def _samples(self, n):
-        """u, du/dφ and dt/dφ at φ_j = 2πj/n."""
-        dynamics, u_min, depth = self._dynamics, self._u_min, self._depth
+        """x, dx/dφ and dt/dφ at φ_j = 2πj/n."""
+        depth, k = self._depth, self._well.stiffness
         phi = TWO_PI * np.arange(n) / n
         sin_phi, cos_phi = np.sin(phi), np.cos(phi)
-        u = self._solve_rise(depth * sin_phi**2, np.where(sin_phi >= 0, u_min, self._u_low),
-                             np.where(sin_phi >= 0, self._u_high, u_min))
-        centre = np.isclose(np.abs(sin_phi), 0.0, atol=1e-12)
-        u = np.where(centre, u_min, u)
-        m = dynamics.tabulated(u)[..., 0]
-        slope = dynamics.tabulated(u, derivative=1)[..., 1]
-        safe = np.where(centre, 1.0, slope)
-        amplitude = math.sqrt(2 * depth / self._stiffness)
-        du_dphi = np.where(centre, amplitude * cos_phi, 2 * depth * sin_phi * cos_phi / safe)
-        dt_dphi = np.where(centre, math.sqrt(dynamics.tabulated(u_min)[0] / self._stiffness),
-                           np.sqrt(2 * m * depth) * sin_phi / safe)
-        return u, du_dphi, dt_dphi
+        side = np.where(sin_phi >= 0, 1.0, -1.0)
+        centre = np.abs(sin_phi) < 1e-12
+        x = side * self._solve_level(depth * sin_phi**2, side, centre)
+        m = self._well.mass(self._scale * x)
+        slope = np.where(centre, 1.0, self._slope(x))
+        dx_dphi = np.where(centre, math.sqrt(2 * depth / k) * cos_phi,
+                           2 * depth * sin_phi * cos_phi / slope)
+        dt_dphi = np.where(centre, math.sqrt(float(self._well.mass(0.0)) / k),
+                           np.sqrt(2 * m * depth) * sin_phi / slope)
+        return x, dx_dphi, dt_dphi
 
-    def _rise(self, u):
-        """V(u) − V(u*) (J) as ∫ V′ from u* (20-point Gauss): no cancellation near u*."""
-        nodes, weights = self._GAUSS
-        half = 0.5 * (np.asarray(u) - self._u_min)
-        points = self._u_min + half[..., None] * (1 + nodes)
-        slopes = self._dynamics.tabulated_potential(points, derivative=1)
-        return half * np.sum(weights * slopes, axis=-1)
+    def _solve_level(self, level, side, centre):
+        """y = |x| ≥ 0 with rise(side·y) = level (rise increases with y on each side).
 
-    def _solve_rise(self, level, low, high):
-        """u in [low, high] with V(u) − V* = level, V monotone there.
-
-        Safeguarded Newton (bisection when a step leaves the bracket) on the tabulated V,
-        then two Newton steps on the Gauss-integrated rise (accurate near u*).
+        Safeguarded Newton from the linear guess √(2 level / V″), bisection when a step
+        leaves the bracket; converged when each step is below 1e-15 y or the residual below
+        4e-15 of the level (its rounding). 0 at ``centre``.
         """
-        dynamics, u_min = self._dynamics, self._u_min
-        v_star = float(dynamics.tabulated_potential(u_min))
-        lo, hi = np.minimum(low, high).astype(float), np.maximum(low, high).astype(float)
-        orient = np.where(np.asarray(high) > u_min + 1e-15, 1.0, -1.0)   # g increasing in u
-        u = 0.5 * (lo + hi)
-        for _ in range(100):
-            g = orient * (dynamics.tabulated_potential(u) - v_star - level)
-            dg = orient * dynamics.tabulated_potential(u, derivative=1)
-            lo, hi = np.where(g < 0, u, lo), np.where(g > 0, u, hi)
-            newton = u - g / np.where(dg > 0, dg, 1.0)
-            inside = (dg > 0) & (newton > lo) & (newton < hi)
-            u_new = np.where(inside, newton, 0.5 * (lo + hi))
-            done = np.max(np.abs(u_new - u), initial=0.0) <= 1e-14
-            u = u_new
-            if done:
+        level, side = np.asarray(level, dtype=float), np.asarray(side, dtype=float)
+        y = np.zeros_like(level)
+        todo = np.nonzero(~np.asarray(centre))[0]          # points still iterating
+        lev, sid = level[todo], side[todo]
+        low = np.zeros_like(lev)
+        high = np.where(sid > 0, self._bounds[1], -self._bounds[0])
+        guess = np.minimum(np.sqrt(2 * lev / self._well.stiffness), 0.5 * high)
+        for _ in range(200):
+            if todo.size == 0:
                 break
-        for _ in range(2):
-            slope = dynamics.tabulated_potential(u, derivative=1)
-            step = np.where(slope == 0, 0.0, (self._rise(u) - level)
-                            / np.where(slope == 0, 1.0, slope))
-            u = np.clip(u - step, lo - 1e-12, hi + 1e-12)
-        return u
+            g = self._rise(sid * guess) - lev
+            dg = sid * self._slope(sid * guess)
+            low, high = np.where(g < 0, guess, low), np.where(g > 0, guess, high)
+            newton = guess - g / np.where(dg > 0, dg, 1.0)
+            inside = (dg > 0) & (newton >= low) & (newton <= high)
+            new = np.where(inside, newton, 0.5 * (low + high))
+            done = ((np.abs(new - guess) <= 1e-15 * new) | (high - low <= 1e-15 * new)
+                    | (np.abs(g) <= 4e-15 * lev))
+            y[todo] = new
+            keep = ~done
+            todo, lev, sid, low, high, guess = (a[keep] for a in
+                                                (todo, lev, sid, low, high, new))
+        return y
 
     def _evaluate(self, t):
+        delta, rate = self._displace(t)
+        return self.centre + delta, rate
+
+    def _displace(self, t):
         phi, phi_dot = self._phase(t)
         rest = np.mod(phi, TWO_PI)
-        return self._u(rest), self._u(rest, derivative=1) * phi_dot
+        s = self._scale
+        return s * self._x(rest), s * self._x(rest, derivative=1) * phi_dot
