@@ -385,7 +385,7 @@ def test_extreme_shapes_are_finite(shape):
     assert 0 < speed < np.inf
 
 
-@settings(max_examples=int(os.environ.get("FORCE_EXAMPLES", 8)), deadline=None)
+@settings(max_examples=int(os.environ.get('FORCE_EXAMPLES', 8)), deadline=None)
 @given(b_over_a=st.floats(0.05, 20.0), delta_over_a=st.floats(0.01, 0.99),
        omega0=st.floats(0.5, 5.0), theta0=st.floats(-1.0, 1.0))
 def test_force_balance_over_shapes(b_over_a, delta_over_a, omega0, theta0):

@@ -74,7 +74,7 @@ def check_validity(times, forces, mu=math.inf):
 
 
 def motion_validity(model, motion, mu=math.inf):
-    """:func:`check_validity` along a simulated :class:`RollingMotion`; returns (report, forces)."""
+    """:func:`check_validity` along a simulated :class:`RollingMotion`: (report, forces)."""
     forces = model.along(motion)
     return check_validity(motion.t, forces, mu), forces
 
