@@ -13,8 +13,15 @@ Newton-Euler with both contacts at rest (no slip), in the body frame, per unit o
 n the ground normal, r1 = GA, r2 = GB (paper eq. (2)), d = r2 − r1 = |AB| ê. Moments about A:
 d × F_B + τ ê = L_G − r1 × (F_A + F_B) =: L_A, so F_B⊥ = (L_A × d)/|d|² and τ = ê·L_A (the
 drive torque; zero along a free motion, where it is the residual of m ü + ½ m′ u̇² + V′ = 0).
-Only the sum S of the components along ê is determined (the squeeze). Every output is linear
-in (1, u̇², ü) with coefficients that depend on u only: they are tabulated once per cycle.
+Only the sum S of the components along ê is determined (the squeeze, resolved by
+:func:`squeeze_split`). Every output is linear in (1, u̇², ü) with coefficients that depend on
+u only: they are tabulated once per cycle (quintic Hermite, spectral derivatives), so 10⁶
+states take ~0.4 s (benchmarks/contact_forces_rate.py). V = M g z_G is the paper's section 4;
+the heading of the trace of A, which orients ê in the world, solves its eqs. (4)-(6).
+
+Public API: :class:`ContactForceModel` (``forces``, ``dynamic``, ``kinematic``, ``along``,
+``coefficients``), :class:`ContactForces`, :func:`squeeze_split`. Validity checks and
+speed sweeps are in :mod:`contact_validity` (same folder).
 """
 
 from dataclasses import dataclass
@@ -315,18 +322,37 @@ class ContactForceModel:
             name: value.reshape(shape + value.shape[1:]) for name, value in out.items()})
 
     def forces(self, u, u_dot, u_ddot):
-        """Contact forces for given u (rad), u̇ (rad/s) and ü (rad/s²), arrays broadcast.
+        """Contact forces for any state (u, u̇, ü), with the drive moment that ü needs.
 
-        The drive torque τ (N m) is the external pure moment τ ê the body needs for this ü;
-        ê points from A to B and τ > 0 turns the body positively about ê (its power is
-        τ ê·ω). ``phase_rate`` is reported as |u̇| (no force depends on the sign of u̇).
+        Parameters
+        ----------
+        u, u_dot, u_ddot : array_like
+            Phase (rad, any real value), its rate (rad/s) and acceleration (rad/s²),
+            broadcast together.
+
+        Returns
+        -------
+        ContactForces
+            World-frame forces (N) over the broadcast shape. ``drive_torque`` τ (N m) is the
+            external pure moment τ ê the body needs for this ü: ê points from A to B and
+            τ > 0 turns the body positively about ê (its power is τ ê·ω). ``phase_rate`` is
+            |u̇| (no force depends on the sign of u̇).
         """
         return self._evaluate('general', u, np.square(u_dot), u_ddot)
 
     def dynamic(self, u, u_dot):
         """Forces along a free motion (gravity only): ü = −(V′ + ½ m′ u̇²)/m.
 
-        τ is then the residual of the equation of motion (~1e-13 M g L).
+        Parameters
+        ----------
+        u, u_dot : array_like
+            Phase (rad) and its rate (rad/s), broadcast together (e.g. a
+            :class:`~twodisk_ros.dynamics.RollingMotion`'s ``phase`` and ``phase_rate``).
+
+        Returns
+        -------
+        ContactForces
+            ``drive_torque`` is the residual of the equation of motion (~1e-13 M g L).
         """
         forces = self._evaluate('dynamic', u, np.square(u_dot))
         forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
@@ -334,10 +360,19 @@ class ContactForceModel:
         return forces
 
     def kinematic(self, u, omega):
-        """Forces when a drive holds |ω| = Ω (rad/s): u̇ = Ω/|ω_u|, ü = −Ω² |ω_u|′/|ω_u|³.
+        """Forces when a drive holds |ω| = Ω: u̇ = Ω/|ω_u|, ü = −Ω² |ω_u|′/|ω_u|³.
 
-        Forces are N0(u) + Ω² N2(u); τ (N m) is the drive's moment τ ê about AB (see
-        :meth:`forces`). u̇ is reported ≥ 0; reversing the motion changes no force.
+        Parameters
+        ----------
+        u, omega : array_like
+            Phase (rad) and the angular speed held Ω (rad/s), broadcast together.
+
+        Returns
+        -------
+        ContactForces
+            Every component is Q0(u) + Ω² Q2(u); ``drive_torque`` τ (N m) is the drive's
+            moment τ ê about AB (convention of :meth:`forces`). u̇ is reported ≥ 0:
+            reversing the motion changes no force.
         """
         return self._evaluate('kinematic', u, np.square(omega))
 
