@@ -1,0 +1,386 @@
+"""Ground contact forces of the rolling two-disk body, and where the rolling model holds.
+
+Frames and units: world frame with z up (the ground is z = 0); body frame ``G e1 e2 e3`` as in
+:mod:`twodisk_ros.body`. Forces in N, moments in N m, speeds in rad/s. The derivation is in
+docs/physics.md, section "Contact forces".
+
+Newton-Euler with both contacts at rest (no slip), in the body frame, per unit of the phase u:
+ω = ω_u u̇, ω̇ = ω_u′ u̇² + ω_u ü, v_G = u̇ c with c = −ω_u × r1, hence
+
+    a_G = u̇² (ω_u × c + c′) + ü c,          (c′ = dc/du: A moves along the boundary)
+    F_A + F_B = M a_G + M g n,                L_G = u̇² (I ω_u′ + ω_u × I ω_u) + ü I ω_u,
+
+n the ground normal, r1 = GA, r2 = GB (paper eq. (2)), d = r2 − r1 = |AB| ê. Moments about A:
+d × F_B + τ ê = L_G − r1 × (F_A + F_B) =: L_A, so F_B⊥ = (L_A × d)/|d|² and τ = ê·L_A (the
+drive torque; zero along a free motion, where it is the residual of m ü + ½ m′ u̇² + V′ = 0).
+Only the sum S of the components along ê is determined (the squeeze, resolved by
+:func:`squeeze_split`). Every output is linear in (1, u̇², ü) with coefficients that depend on
+u only: they are tabulated once per cycle (quintic Hermite, spectral derivatives), so 10⁶
+states take ~0.4 s (benchmarks/contact_forces_rate.py). V = M g z_G is the paper's section 4;
+the heading of the trace of A, which orients ê in the world, solves its eqs. (4)-(6).
+
+Public API: :class:`ContactForceModel` (``forces``, ``dynamic``, ``kinematic``, ``along``,
+``coefficients``), :class:`ContactForces`, :func:`squeeze_split`. Validity checks and
+speed sweeps are in :mod:`contact_validity` (same folder).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from twodisk_ros.body import complex_step
+from twodisk_ros.cycle import TWO_PI
+from twodisk_ros.dynamics import RollingDynamics
+from twodisk_ros.tables import spectral_tail
+
+__all__ = ['ContactForceModel', 'ContactForces', 'squeeze_split', 'QUANTITIES']
+
+#: the determinate scalar outputs (N, N, N, N, N, N m), in the order of the tables' columns
+QUANTITIES = ('normal_a', 'normal_b', 'tangential_a', 'tangential_b', 'along_ab',
+              'drive_torque')
+_K = len(QUANTITIES)
+_SPLIT = ('along_a', 'ratio_a', 'ratio_b', 'mu_required')
+BLOCK = 8192   # states per block (keeps the temporaries in cache)
+
+
+def _spectral_derivative(samples):
+    n = samples.shape[0]
+    k = np.fft.fftfreq(n, d=1.0 / n).reshape((n,) + (1,) * (samples.ndim - 1))
+    k[n // 2] = 0.0
+    return np.real(np.fft.ifft(1j * k * np.fft.fft(samples, axis=0), axis=0))
+
+
+def _dot(x, y):
+    return np.sum(x * y, axis=-1)
+
+
+class _PeriodicTable:
+    """Quintic Hermite interpolation of 2π-periodic columns, stored per interval as monomials.
+
+    The interpolant of :class:`twodisk_ros.tables.HermiteTable` (values, first and second
+    derivatives at the nodes; here the derivatives are spectral), laid out as one contiguous
+    array per power of t and evaluated by Horner's rule in place: ~2× faster for many columns.
+    """
+
+    def __init__(self, values):
+        n = values.shape[0]
+        self.step = TWO_PI / n
+        first = _spectral_derivative(values) * self.step
+        second = _spectral_derivative(first) * self.step
+        y0, d0, s0 = values, first, second
+        y1, d1, s1 = (np.roll(x, -1, axis=0) for x in (values, first, second))
+        self.powers = [   # coefficients of t⁵ … t⁰ on each interval
+            6 * (y1 - y0) - 3 * (d0 + d1) - 0.5 * (s0 - s1),
+            15 * (y0 - y1) + 8 * d0 + 7 * d1 + 1.5 * s0 - s1,
+            10 * (y1 - y0) - 6 * d0 - 4 * d1 - 1.5 * s0 + 0.5 * s1,
+            0.5 * s0, d0, y0]
+        self.n = n
+
+    def __call__(self, rest):
+        """Columns at phases ``rest`` in [0, 2π] (rad), shape rest.shape + (columns,)."""
+        s = np.asarray(rest, dtype=float) / self.step
+        i = np.minimum(s.astype(np.intp), self.n - 1)
+        t = (s - i)[..., None]
+        out = np.take(self.powers[0], i, axis=0) * t
+        for power in self.powers[1:-1]:
+            out += np.take(power, i, axis=0)
+            out *= t
+        out += np.take(self.powers[-1], i, axis=0)
+        return out
+
+
+def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
+    """The split of the total along AB that needs the least friction coefficient.
+
+    With x the component along ê taken by A (B takes S − x), the friction ratios are
+    f_A(x) = √(T_A² + x²)/N_A and f_B(x) = √(T_B² + (S − x)²)/N_B, convex with minima at x = 0
+    and x = S. μ_required = min_x max(f_A, f_B) is reached at x = 0 if f_A(0) ≥ f_B(0), at
+    x = S if f_B(S) ≥ f_A(S), else at the one root of f_A² = f_B² between 0 and S (a quadratic,
+    solved in cancellation-free form). The minimiser is unique. Where N_A ≤ 0 or N_B ≤ 0
+    (lift-off) the split is x = S/2, a lifted contact's ratio is inf and μ_required is inf.
+
+    Parameters
+    ----------
+    normal_a, normal_b, tangential_a, tangential_b, along_ab : array_like
+        N_A, N_B, T_A, T_B, S (N), broadcast together.
+
+    Returns
+    -------
+    along_a, ratio_a, ratio_b, mu_required : ndarray
+        x (N), f_A(x), f_B(x) and max(f_A, f_B) = μ_required at the split.
+    """
+    n_a, n_b, t_a, t_b, s = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
+        normal_a, normal_b, tangential_a, tangential_b, along_ab)))
+    contact = (n_a > 0) & (n_b > 0)
+    inv_a = 1.0 / np.where(n_a > 0, n_a, np.nan)
+    inv_b = 1.0 / np.where(n_b > 0, n_b, np.nan)
+    ta2, tb2, s2 = t_a * t_a, t_b * t_b, s * s
+    # f_A² = f_B² ⇔ α x² + 2β x + γ = 0; q = −(β + sign β √(β² − αγ)), roots γ/q and q/α
+    na2, nb2 = n_a * n_a, n_b * n_b
+    alpha, beta = nb2 - na2, na2 * s
+    gamma = nb2 * ta2 - na2 * (tb2 + s2)
+    q = -(beta + np.copysign(np.sqrt(np.maximum(beta * beta - alpha * gamma, 0.0)), beta))
+    low, high = np.minimum(s, 0.0), np.maximum(s, 0.0)
+    with np.errstate(divide='ignore', invalid='ignore'):
+        root = gamma / q
+        root = np.where((root >= low) & (root <= high), root, q / alpha)
+        root = np.clip(np.where(np.isfinite(root), root, 0.0), low, high)
+        at_a = np.sqrt(ta2) * inv_a >= np.sqrt(tb2 + s2) * inv_b      # f_A(0) ≥ f_B(0)
+        at_b = np.sqrt(tb2) * inv_b >= np.sqrt(ta2 + s2) * inv_a      # f_B(S) ≥ f_A(S)
+    x = np.where(contact, np.where(at_a, 0.0, np.where(at_b, s, root)), 0.5 * s)
+    y = s - x
+    ratio_a = np.where(n_a > 0, np.sqrt(ta2 + x * x) * inv_a, np.inf)
+    ratio_b = np.where(n_b > 0, np.sqrt(tb2 + y * y) * inv_b, np.inf)
+    return x, ratio_a, ratio_b, np.maximum(ratio_a, ratio_b)
+
+
+@dataclass
+class ContactForces:
+    """Ground forces on the body at A and at B, arrays over states (world frame, N).
+
+    ê is the horizontal unit vector from A to B, p = e_z × ê; the split of the total along ê
+    is the one needing the least friction (:func:`squeeze_split`).
+    """
+
+    phase: np.ndarray               #: u (rad)
+    phase_rate: np.ndarray          #: u̇ (rad/s)
+    phase_acceleration: np.ndarray  #: ü (rad/s²)
+    force_a: np.ndarray             #: F_A (N, world frame), shape (..., 3)
+    force_b: np.ndarray             #: F_B (N, world frame), shape (..., 3)
+    direction_ab: np.ndarray        #: ê (unit, world frame), shape (..., 3)
+    normal_a: np.ndarray            #: N_A = F_A·e_z (N)
+    normal_b: np.ndarray            #: N_B = F_B·e_z (N)
+    tangential_a: np.ndarray        #: T_A = F_A·p (N), determinate
+    tangential_b: np.ndarray        #: T_B = F_B·p (N), determinate
+    along_ab: np.ndarray            #: S = (F_A + F_B)·ê (N), determinate
+    along_a: np.ndarray             #: F_A·ê (N) of the chosen split (F_B·ê = S − F_A·ê)
+    ratio_a: np.ndarray             #: |F_A tangential|/N_A at the split (inf if N_A ≤ 0)
+    ratio_b: np.ndarray             #: |F_B tangential|/N_B at the split (inf if N_B ≤ 0)
+    mu_required: np.ndarray         #: least friction coefficient for rolling (inf on lift-off)
+    drive_torque: np.ndarray        #: τ (N m): external moment τ ê on the body (≈ 0 if free)
+    weight: float                   #: M g (N)
+
+    @property
+    def along_b(self):
+        """F_B·ê (N) of the chosen split."""
+        return self.along_ab - self.along_a
+
+    @property
+    def normal_a_per_weight(self):
+        """N_A / (M g)."""
+        return self.normal_a / self.weight
+
+    @property
+    def normal_b_per_weight(self):
+        """N_B / (M g)."""
+        return self.normal_b / self.weight
+
+    @property
+    def lift_off(self):
+        """True where a contact would need the ground to pull (N_A < 0 or N_B < 0)."""
+        return (self.normal_a < 0) | (self.normal_b < 0)
+
+
+class ContactForceModel:
+    """Contact forces of one body with one mass model, from per-cycle tables.
+
+    Parameters
+    ----------
+    dynamics : RollingDynamics
+        Body, mass properties (kg, kg m² about G in the body frame), gravity (m/s²) and the
+        cycle (world poses).
+    nodes : int, optional
+        Table nodes per cycle (default: 4 × the cycle's resolution).
+
+    Attributes
+    ----------
+    weight : float
+        M g (N).
+    spectral_tail : float
+        Relative size of the unresolved spectrum of the coefficient tables (~1e-13 or less
+        when resolved).
+    """
+
+    def __init__(self, dynamics, nodes=None):
+        if not isinstance(dynamics, RollingDynamics):
+            raise TypeError(f'dynamics must be a RollingDynamics, got {type(dynamics).__name__}')
+        self.dynamics = dynamics
+        self.body, self.cycle = dynamics.body, dynamics.cycle
+        self.mass = dynamics.mass.mass
+        self.weight = self.mass * dynamics.gravity
+        self.nodes = int(nodes) if nodes is not None else 4 * self.cycle.resolution
+        self._build(self.nodes)
+
+    # -- tables ------------------------------------------------------------------------------
+    def _build(self, n):
+        u = TWO_PI * np.arange(n) / n
+        geo = self.body.phase_geometry(u)
+        r1, r2, normal, t1 = geo.contact_a, geo.contact_b, geo.ground_normal, geo.tangent_a
+        inertia, mass, g = self.dynamics.mass.inertia, self.mass, self.dynamics.gravity
+        w = self.body.phase_angular_velocity(u)                  # ω_u, body frame
+        c = -np.cross(w, r1)                                     # dG/du, body frame
+        k = np.cross(w, c) + _spectral_derivative(c)             # a_G per u̇² (body frame)
+        iw = w @ inertia
+        d = r2 - r1
+        length2 = _dot(d, d)
+        e = d / np.sqrt(length2)[:, None]
+        p = np.cross(normal, e)
+        # coefficient sets (gravity, u̇², ü) of the total force and of the moment about G
+        force = (mass * g * normal, mass * k, mass * c)
+        moment = (np.zeros_like(w), _spectral_derivative(w) @ inertia + np.cross(w, iw), iw)
+        coef = np.empty((n, 3, _K))
+        for j, (f, m) in enumerate(zip(force, moment)):
+            moment_a = m - np.cross(r1, f)
+            f_b = np.cross(moment_a, d) / length2[:, None]
+            coef[:, j] = np.stack([_dot(f, normal) - _dot(f_b, normal), _dot(f_b, normal),
+                                   _dot(f, p) - _dot(f_b, p), _dot(f_b, p), _dot(f, e),
+                                   _dot(moment_a, e)], axis=-1)
+        # world direction of ê: heading α of t1 (paper eqs. (4)-(6)) plus the angle of ê from
+        # t1, stored as a periodic part plus slope·u (the cycle's turn, plus any winding)
+        gamma = np.unwrap(np.arctan2(_dot(e, np.cross(normal, t1)), _dot(e, t1)))
+        self._turn = self.cycle.displacement.turn
+        periodic = self.cycle.heading(u) + gamma - self._turn / TWO_PI * u
+        winding = round((2 * periodic[-1] - periodic[-2] - periodic[0]) / TWO_PI)
+        self._slope = self._turn / TWO_PI + winding
+        heading = periodic - winding * u
+        # the modes: ü = −(V′ + ½ m′ u̇²)/m (dynamic); u̇ = Ω/w, ü = −Ω² w′/w³ (kinematic)
+        m_u = _dot(w, iw) + mass * _dot(c, c)
+        speed = np.linalg.norm(w, axis=-1)
+        dv = mass * g * complex_step(self.body.phase_height, u)
+        dyn0, dyn2 = -dv / m_u, -0.5 * _spectral_derivative(m_u) / m_u
+        kin2 = -_spectral_derivative(speed) / speed**3
+        self._columns = {
+            'general': np.column_stack([coef.reshape(n, 3 * _K), heading]),
+            'dynamic': np.column_stack([coef[:, 0] + dyn0[:, None] * coef[:, 2], dyn0,
+                                        coef[:, 1] + dyn2[:, None] * coef[:, 2], dyn2,
+                                        heading]),
+            'kinematic': np.column_stack([coef[:, 0], np.zeros(n), coef[:, 1] / speed[:, None]**2
+                                          + kin2[:, None] * coef[:, 2], kin2, 1.0 / speed,
+                                          heading])}
+        self.spectral_tail = max(spectral_tail(x) for x in self._columns.values())
+        self._tables = {}
+
+    def _table(self, kind):
+        if kind not in self._tables:
+            self._tables[kind] = _PeriodicTable(self._columns[kind])
+        return self._tables[kind]
+
+    def coefficients(self, u, kind='kinematic'):
+        """The tabulated coefficients at phase(s) u (rad), shape u.shape + (columns,).
+
+        ``'kinematic'``: Q0 (7 columns) then Q2 (7) with Q = Q0 + Ω² Q2 for each of
+        :data:`QUANTITIES` and ü, then 1/|ω_u|; ``'dynamic'``: Q0, Q2 with Q = Q0 + u̇² Q2
+        along a free motion; ``'general'``: (Q_g, Q_u̇², Q_ü), 6 each, for a given ü. The last
+        column is the periodic part of the heading of ê (rad).
+        """
+        u = np.asarray(u, dtype=float)
+        return self._table(kind)(np.mod(u, TWO_PI))
+
+    # -- forces ------------------------------------------------------------------------------
+    def _evaluate(self, kind, u, a, b=None):
+        """States in blocks: u (rad), a = u̇² or Ω², b = ü (general only)."""
+        arrays = [np.asarray(x, dtype=float) for x in (u, a) + ((b,) if b is not None else ())]
+        shape = np.broadcast_shapes(*(x.shape for x in arrays))
+        u, a, *b = (np.broadcast_to(x, shape).ravel() for x in arrays)
+        names = QUANTITIES + _SPLIT + ('phase_rate', 'phase_acceleration')
+        out = {name: np.empty(u.size) for name in names}
+        for name in ('force_a', 'force_b', 'direction_ab'):
+            out[name] = np.empty((u.size, 3))
+        table = self._table(kind)
+        width = _K if kind == 'general' else _K + 1
+        for start in range(0, u.size, BLOCK):
+            part = slice(start, start + BLOCK)
+            cycles = np.floor(u[part] / TWO_PI)
+            rest = u[part] - TWO_PI * cycles
+            f = table(rest)
+            values = f[:, :width] + a[part, None] * f[:, width:2 * width]
+            if kind == 'general':
+                values += b[0][part, None] * f[:, 2 * width:3 * width]
+                out['phase_acceleration'][part] = b[0][part]
+            else:
+                out['phase_acceleration'][part] = values[:, _K]
+            out['phase_rate'][part] = np.sqrt(a[part]) * (f[:, -2] if kind == 'kinematic'
+                                                          else 1.0)
+            for j, name in enumerate(QUANTITIES):
+                out[name][part] = values[:, j]
+            split = squeeze_split(*values[:, :5].T)
+            for name, x in zip(_SPLIT, split):
+                out[name][part] = x
+            heading = f[:, -1] + self._slope * rest + cycles * self._turn
+            cos_h, sin_h = np.cos(heading), np.sin(heading)
+            e = out['direction_ab'][part]
+            e[:, 0], e[:, 1], e[:, 2] = cos_h, sin_h, 0.0
+            along = (split[0], values[:, 4] - split[0])
+            for name, x, tangential, normal in zip(('force_a', 'force_b'), along,
+                                                   values[:, 2:4].T, values[:, :2].T):
+                vector = out[name][part]
+                vector[:, 0] = x * cos_h - tangential * sin_h
+                vector[:, 1] = x * sin_h + tangential * cos_h
+                vector[:, 2] = normal
+        out['phase'] = u
+        return ContactForces(weight=self.weight, **{
+            name: value.reshape(shape + value.shape[1:]) for name, value in out.items()})
+
+    def forces(self, u, u_dot, u_ddot):
+        """Contact forces for any state (u, u̇, ü), with the drive moment that ü needs.
+
+        Parameters
+        ----------
+        u, u_dot, u_ddot : array_like
+            Phase (rad, any real value), its rate (rad/s) and acceleration (rad/s²),
+            broadcast together.
+
+        Returns
+        -------
+        ContactForces
+            World-frame forces (N) over the broadcast shape. ``drive_torque`` τ (N m) is the
+            external pure moment τ ê the body needs for this ü: ê points from A to B and
+            τ > 0 turns the body positively about ê (its power is τ ê·ω). ``phase_rate`` is
+            |u̇| (no force depends on the sign of u̇).
+        """
+        return self._evaluate('general', u, np.square(u_dot), u_ddot)
+
+    def dynamic(self, u, u_dot):
+        """Forces along a free motion (gravity only): ü = −(V′ + ½ m′ u̇²)/m.
+
+        Parameters
+        ----------
+        u, u_dot : array_like
+            Phase (rad) and its rate (rad/s), broadcast together (e.g. a
+            :class:`~twodisk_ros.dynamics.RollingMotion`'s ``phase`` and ``phase_rate``).
+
+        Returns
+        -------
+        ContactForces
+            ``drive_torque`` is the residual of the equation of motion (~1e-13 M g L).
+        """
+        forces = self._evaluate('dynamic', u, np.square(u_dot))
+        forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
+                                            forces.phase.shape).copy()
+        return forces
+
+    def kinematic(self, u, omega):
+        """Forces when a drive holds |ω| = Ω: u̇ = Ω/|ω_u|, ü = −Ω² |ω_u|′/|ω_u|³.
+
+        Parameters
+        ----------
+        u, omega : array_like
+            Phase (rad) and the angular speed held Ω (rad/s), broadcast together.
+
+        Returns
+        -------
+        ContactForces
+            Every component is Q0(u) + Ω² Q2(u); ``drive_torque`` τ (N m) is the drive's
+            moment τ ê about AB (convention of :meth:`forces`). u̇ is reported ≥ 0:
+            reversing the motion changes no force.
+        """
+        return self._evaluate('kinematic', u, np.square(omega))
+
+    def along(self, motion):
+        """Forces at the samples of a :class:`~twodisk_ros.dynamics.RollingMotion`."""
+        if motion.mode == 'dynamic':
+            return self.dynamic(motion.phase, motion.phase_rate)
+        omega = abs(motion.phase_rate[0]) * float(self.dynamics.tabulated(motion.phase[0])[2])
+        forces = self.kinematic(motion.phase, omega)
+        forces.phase_rate = np.asarray(motion.phase_rate, dtype=float).copy()
+        return forces

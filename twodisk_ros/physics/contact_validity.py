@@ -1,0 +1,163 @@
+"""Where the rolling model of the two-disk body holds: lift-off and slip.
+
+The model assumes both contacts stay on the ground without slipping. It fails where a normal
+force would have to pull (N_A < 0 or N_B < 0: lift-off) or where the ground's friction
+coefficient μ is below μ_required (slip). Forces come from
+:class:`twodisk_ros.physics.contact_forces.ContactForceModel`; units are SI (s, rad/s, N, J).
+The derivation is in docs/physics.md, section "Contact forces".
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from twodisk_ros.cycle import TWO_PI
+from twodisk_ros.physics.contact_forces import QUANTITIES
+
+__all__ = ['ValidityReport', 'check_validity', 'motion_validity', 'liftoff_speed',
+           'mu_required_kinematic', 'mu_required_dynamic']
+
+_STRIDE = len(QUANTITIES) + 1   # kinematic columns: Q0 (6 + ü) then Q2 (6 + ü)
+
+
+@dataclass(frozen=True)
+class ValidityReport:
+    """Where the rolling model first fails along a motion (or that it never does)."""
+
+    valid: bool
+    time: float     #: time of the first failing sample (s); nan if valid
+    index: int      #: its sample index; −1 if valid
+    kind: str       #: 'lift-off A', 'lift-off B', 'slip' or ''
+    reason: str     #: one sentence, e.g. 'contact B would lift off at t = 2.31 s: N_B = -0.4 N'
+
+
+def check_validity(times, forces, mu=math.inf):
+    """First sample at which a contact lifts off (N < 0) or slips (μ_required > μ).
+
+    Parameters
+    ----------
+    times : array_like
+        Sample times (s), one per state of ``forces`` (flattened in the same order).
+    forces : ContactForces
+    mu : float
+        Friction coefficient of the ground, ≥ 0 (inf: no slip ever).
+
+    Returns
+    -------
+    ValidityReport
+        The time resolution is the sampling: the reported time is the first bad sample's.
+        Lift-off is reported before slip at the same sample (μ_required is inf there).
+    """
+    mu = float(mu)
+    if not mu >= 0:
+        raise ValueError(f'mu must be >= 0 (inf allowed), got {mu!r}')
+    t = np.asarray(times, dtype=float).ravel()
+    n_a, n_b = forces.normal_a.ravel(), forces.normal_b.ravel()
+    need = forces.mu_required.ravel()
+    if not (t.size == n_a.size):
+        raise ValueError(f'times has {t.size} samples, forces {n_a.size}')
+    bad = (n_a < 0) | (n_b < 0) | (need > mu)
+    if not np.any(bad):
+        return ValidityReport(True, math.nan, -1, '', f'rolling holds for t in '
+                              f'[{t[0]:.6g}, {t[-1]:.6g}] s (mu = {mu:g})')
+    i = int(np.argmax(bad))
+    if n_a[i] < 0 or n_b[i] < 0:
+        name, value = ('A', n_a[i]) if n_a[i] <= n_b[i] else ('B', n_b[i])
+        return ValidityReport(False, float(t[i]), i, f'lift-off {name}',
+                              f'contact {name} would lift off at t = {t[i]:.6g} s: '
+                              f'N_{name} = {value:.4g} N')
+    return ValidityReport(False, float(t[i]), i, 'slip',
+                          f'the body would slip at t = {t[i]:.6g} s: mu_required = '
+                          f'{need[i]:.4g} > mu = {mu:g}')
+
+
+def motion_validity(model, motion, mu=math.inf):
+    """:func:`check_validity` along a simulated :class:`RollingMotion`: (report, forces)."""
+    forces = model.along(motion)
+    return check_validity(motion.t, forces, mu), forces
+
+
+def liftoff_speed(model):
+    """Critical |ω| (rad/s) above which a contact lifts off in kinematic motion.
+
+    In kinematic mode N(u; Ω) = N0(u) + Ω² N2(u) exactly, so Ω_c² = min over u and both
+    contacts of −N0/N2 where N2 < 0 (Ω_c = 0 if N0 ≤ 0 somewhere: the drive holding the body
+    at rest already lifts a contact). The minimum is located on the table nodes and refined
+    by bounded Brent on the interpolated tables (to ~1e-12 rad in u).
+
+    Parameters
+    ----------
+    model : ContactForceModel
+
+    Returns
+    -------
+    speed : float
+        Ω_c (rad/s); inf if no speed lifts a contact off.
+    phase : float
+        u (rad, in [0, 2π)) where the first contact lifts off.
+    contact : str
+        'A' or 'B' ('' if never).
+    """
+    u = TWO_PI * np.arange(model.nodes) / model.nodes
+    cols = model.coefficients(u)
+    step = TWO_PI / model.nodes
+    best = (math.inf, math.nan, '')
+    for j, name in ((0, 'A'), (1, 'B')):
+        n0, n2 = cols[:, j], cols[:, _STRIDE + j]
+        if np.any(n0 <= 0):
+            return 0.0, float(u[np.argmin(n0)]), name
+        ratio = np.where(n2 < 0, -n0 / np.where(n2 < 0, n2, -1.0), np.inf)
+        i = int(np.argmin(ratio))
+        if not np.isfinite(ratio[i]):
+            continue
+
+        def square(x, j=j):
+            c = model.coefficients(x)
+            return -c[j] / c[_STRIDE + j] if c[_STRIDE + j] < 0 else math.inf
+        res = minimize_scalar(square, bounds=(u[i] - step, u[i] + step), method='bounded',
+                              options={'xatol': 1e-12})
+        value, phase = (float(res.fun), float(res.x)) if res.fun <= ratio[i] else (
+            float(ratio[i]), float(u[i]))
+        if value < best[0] ** 2:
+            best = (math.sqrt(value), phase % TWO_PI, name)
+    return best
+
+
+def mu_required_kinematic(model, omega, samples=2048):
+    """max over one cycle of μ_required at each kinematic speed Ω (rad/s, array_like).
+
+    Sampled at ``samples`` phases; inf at and above the lift-off speed.
+    """
+    omega = np.asarray(omega, dtype=float)
+    u = TWO_PI * np.arange(samples) / samples
+    return model.kinematic(u, omega[..., None]).mu_required.max(axis=-1)
+
+
+def mu_required_dynamic(model, energy, u0=None, samples=2048):
+    """μ_required over the phases a free motion of energy E (J) reaches.
+
+    Rolling over (E above every maximum of V) reaches the whole cycle; otherwise the well of
+    V holding ``u0`` (rad) if given, else every u with V(u) ≤ E. u̇² = 2(E − V)/m.
+
+    Returns
+    -------
+    peak : float
+        max μ_required over the reached phases (inf if a contact lifts off; nan if none).
+    u : ndarray
+        The sampled phases (rad).
+    mu : ndarray
+        μ_required(u), nan where not reached.
+    """
+    dynamics = model.dynamics
+    u = TWO_PI * np.arange(samples) / samples
+    if u0 is not None and energy < dynamics.potential_range[1]:
+        _, low, high = dynamics.well(float(u0))
+        u = low + (high - low) * (np.arange(samples) + 0.5) / samples
+    f = dynamics.tabulated(u)
+    rate2 = 2 * (energy - f[..., 1]) / f[..., 0]
+    reached = rate2 >= 0
+    mu = np.where(reached, model.dynamic(u, np.sqrt(np.maximum(rate2, 0.0))).mu_required,
+                  np.nan)
+    return (float(np.nanmax(mu)) if np.any(reached) else math.nan), u, mu
