@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from twodisk_ros.body import TwoDiskBody
-from twodisk_ros.dynamics import RollingDynamics, simulate
-from twodisk_ros.mass_models import mass_properties
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics import RollingDynamics, simulate
+from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.contact_forces import ContactForceModel
 
 STATES = 10**6

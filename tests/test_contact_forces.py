@@ -31,10 +31,10 @@ from numpy.testing import assert_allclose
 from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
-from twodisk_ros.body import TwoDiskBody
-from twodisk_ros.dynamics import RollingDynamics, simulate
-from twodisk_ros.equilibria import STABLE, equilibria
-from twodisk_ros.mass_models import mass_properties
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics import RollingDynamics, simulate
+from twodisk_ros.physics.equilibria import STABLE, equilibria
+from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.contact_forces import ContactForceModel, squeeze_split
 from twodisk_ros.physics.contact_validity import (
     check_validity, liftoff_speed, motion_validity, mu_required_dynamic, mu_required_kinematic)

@@ -100,6 +100,31 @@ def test_signal_at_a_random_moment_leaves_a_complete_recording(tmp_path, mode, p
     assert_complete(target, detail)
 
 
+HAMMER = [(signal.SIGTERM, 0.3), (signal.SIGTERM, 1.2), (signal.SIGTERM, 1.6),
+          (signal.SIGTERM, 2.0), (signal.SIGINT, 1.4), (signal.SIGINT, 1.8)]
+
+
+@pytest.mark.parametrize('sig, delay', HAMMER, ids=[f'{s.name}-{d}s' for s, d in HAMMER])
+def test_a_signal_every_few_milliseconds_until_the_process_ends(tmp_path, sig, delay):
+    """From ``delay`` on, a signal every 5 ms: start-up, run, close and shutdown alike."""
+    target = tmp_path / 'hammered.mcap'
+    process = roller('-p', 'realtime:=false', '-p', 'rate:=1000.0', '-p', 'duration:=3.0',
+                     '-p', f'record:={target}')
+    time.sleep(delay)
+    while process.poll() is None:
+        try:
+            process.send_signal(sig)
+        except ProcessLookupError:
+            break
+        time.sleep(0.005)
+    code, _, err = finish(process)
+    assert code == 0 and 'Traceback' not in err, err
+    if target.exists():
+        assert_complete(target, err)
+    else:
+        assert 'no recording written' in err, err
+
+
 def test_existing_record_file_is_refused_unless_overwrite(tmp_path):
     target = tmp_path / 'kept.mcap'
     target.write_bytes(b'precious')

@@ -38,11 +38,12 @@ def _internal(error):
     return EXIT_INTERNAL
 
 
-def _start(argv):
+def _start(argv, stop):
     """rclpy and the node, or (None, exit code) after one line on stderr."""
     from .roller import Roller   # after the arguments are known to be well formed
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+        stop.install()
     except Exception as error:  # noqa: BLE001 - rclpy's argument errors are RCLError
         _say(f'invalid ROS arguments: {error}')
         return None, EXIT_INPUT
@@ -88,6 +89,13 @@ def main(args=None, stop=None):
     argv = list(sys.argv if args is None else args)
     stop = stop if stop is not None else StopRequest()
     try:
+        return _main(argv, stop)
+    finally:
+        stop.ignore_from_now()
+
+
+def _main(argv, stop):
+    try:
         for warning in check_arguments(argv):
             _say(f'warning: {warning}')
     except ArgumentError as error:
@@ -98,7 +106,7 @@ def main(args=None, stop=None):
         return EXIT_OK
     node, status = None, EXIT_OK
     try:
-        node, status = _start(argv)
+        node, status = _start(argv, stop)
         if node is not None and not stop:
             _run(node, stop)
     except RecordingError as error:
@@ -119,6 +127,7 @@ def main(args=None, stop=None):
                     status = EXIT_IO
             node.destroy_node()
         rclpy.try_shutdown()
+        stop.install()   # rclpy's shutdown restored the default handlers: a late signal is ours
     return status
 
 

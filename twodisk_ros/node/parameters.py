@@ -274,13 +274,22 @@ def markdown_table():
     for p in PARAMETERS:
         default = (f"'{p.default}'" if p.kind is str
                    else str(list(p.default)) if p.kind is tuple
-                   else str(p.default).lower() if p.kind is bool else f'{p.default:g}')
+                   else str(p.default).lower() if p.kind is bool else repr(p.default))
         rows.append(f'| `{p.name}` | {kinds[p.kind]} | {default} | {p.unit or "-"} | '
-                    f'{p.rule.replace("|", "/")} | {"yes" if p.read_only else "no"} | '
-                    f'{p.description.replace("|", "/")} |')
+                    f'{_cell(p.rule)} | {"yes" if p.read_only else "no"} | '
+                    f'{_cell(p.description)} |')
     return '\n'.join(rows)
+
+
+def _cell(text):
+    """Text for a Markdown table cell (a literal | escaped)."""
+    return text.replace('|', '\\|')
 
 
 def field_names():
     """The parameter names in contract order (the fields of :class:`RollerSettings`)."""
     return [f.name for f in fields(RollerSettings)]
+
+
+if __name__ == '__main__':
+    print(markdown_table())   # the README's table

@@ -95,15 +95,15 @@ class Simulation:
         """Everything published at simulated times t (s, increasing array, after earlier ones)."""
         t = np.asarray(t, dtype=float)
         u, u_dot = self.stream.sample(t)
-        state = self.dynamics.cycle.state(u)
-        quaternion = continuous_quaternions(state.quaternion, self._last_quaternion)
+        poses = self.dynamics.cycle.poses(u)
+        quaternion = continuous_quaternions(poses.quaternion, self._last_quaternion)
         if len(quaternion):
             self._last_quaternion = quaternion[-1]
-        dtheta, dpsi = self.body.phase_angle_rates(u)
-        return Sample(t=t, phase=u, phase_rate=u_dot, theta=state.theta, psi=state.psi,
+        theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
+        return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,
-                      position_g=state.position_g, contact_a=state.contact_a,
-                      contact_b=state.contact_b, quaternion=quaternion)
+                      position_g=poses.position_g, contact_a=poses.contact_a,
+                      contact_b=poses.contact_b, quaternion=quaternion)
 
     def invariant(self, sample, i):
         """(name, value, relative drift) of the conserved quantity at sample i.

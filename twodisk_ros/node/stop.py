@@ -19,6 +19,10 @@ class StopRequest:
 
     def __init__(self):
         self.requested = None
+        self.install()
+
+    def install(self):
+        """(Re)install the handlers: rclpy's shutdown resets SIGINT and SIGTERM to default."""
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, self._handle)
         if hasattr(signal, 'SIGXFSZ'):
@@ -29,3 +33,12 @@ class StopRequest:
 
     def __bool__(self):
         return self.requested is not None
+
+    def ignore_from_now(self):
+        """Ignore further SIGINT and SIGTERM: the run is over and its recording finished.
+
+        Python's finalization resets signals that have Python handlers to their default
+        action (a SIGTERM would then kill the exiting process); ignored ones stay ignored.
+        """
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)

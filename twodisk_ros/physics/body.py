@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from .analytic import COMPLEX_STEP, complex_step, sinc
+from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 
 __all__ = ['TwoDiskBody', 'PhaseGeometry']
 
@@ -392,16 +392,23 @@ class TwoDiskBody:
         """z_G(u) (m), analytic in u."""
         return self.phase_vectors(u)[4]
 
+    def _psi_half_angle(self, u):
+        """ψ(u) = 2 arctan(sin ψ / (1 + cos ψ)), analytic in u (|ψ| < π over the cycle)."""
+        _, cos_t, _, _ = self.phase_angles(u)
+        sq = self.phase_signed_sqrt_q(u)
+        norm = np.sqrt(sq * sq + self.a**4 * cos_t * cos_t)
+        return 2 * np.arctan(sq / (norm - self.a * self.a * cos_t))
+
+    def phase_angles_with_rates(self, u):
+        """(θ, ψ, dθ/du, dψ/du) at phase u (rad and rad per rad), one complex step each."""
+        uc = np.asarray(u, dtype=float) + 1j * COMPLEX_STEP
+        (theta, dtheta), (psi, dpsi) = complex_step_jet(
+            (self.phase_theta(uc), self._psi_half_angle(uc)))
+        return theta, psi, dtheta, dpsi
+
     def phase_angle_rates(self, u):
         """(dθ/du, dψ/du) at phase u, by complex step (ψ = 2 arctan(sin ψ / (1 + cos ψ)))."""
-        a = self.a
-
-        def psi(x):
-            _, cos_t, _, _ = self.phase_angles(x)
-            sq = self.phase_signed_sqrt_q(x)
-            norm = np.sqrt(sq * sq + a**4 * cos_t * cos_t)
-            return 2 * np.arctan(sq / (norm - a * a * cos_t))
-        return complex_step(self.phase_theta, u), complex_step(psi, u)
+        return self.phase_angles_with_rates(u)[2:]
 
     def phase_rates(self, u):
         """Rates per unit u̇ at phase u: returns (ds/du, dα/du) of the trace of A.

@@ -28,10 +28,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twodisk_ros.body import complex_step
-from twodisk_ros.cycle import TWO_PI
-from twodisk_ros.dynamics import RollingDynamics
-from twodisk_ros.tables import spectral_tail
+from .analytic import complex_step
+from .cycle import TWO_PI
+from .dynamics import RollingDynamics
+from .spectral import spectral_derivative, spectral_tail
+from .tables import HermiteTable
 
 __all__ = ['ContactForceModel', 'ContactForces', 'squeeze_split', 'QUANTITIES']
 
@@ -43,50 +44,14 @@ _SPLIT = ('along_a', 'ratio_a', 'ratio_b', 'mu_required')
 BLOCK = 8192   # states per block (keeps the temporaries in cache)
 
 
-def _spectral_derivative(samples):
-    n = samples.shape[0]
-    k = np.fft.fftfreq(n, d=1.0 / n).reshape((n,) + (1,) * (samples.ndim - 1))
-    k[n // 2] = 0.0
-    return np.real(np.fft.ifft(1j * k * np.fft.fft(samples, axis=0), axis=0))
-
-
 def _dot(x, y):
     return np.sum(x * y, axis=-1)
 
 
-class _PeriodicTable:
-    """Quintic Hermite interpolation of 2π-periodic columns, stored per interval as monomials.
-
-    The interpolant of :class:`twodisk_ros.tables.HermiteTable` (values, first and second
-    derivatives at the nodes; here the derivatives are spectral), laid out as one contiguous
-    array per power of t and evaluated by Horner's rule in place: ~2× faster for many columns.
-    """
-
-    def __init__(self, values):
-        n = values.shape[0]
-        self.step = TWO_PI / n
-        first = _spectral_derivative(values) * self.step
-        second = _spectral_derivative(first) * self.step
-        y0, d0, s0 = values, first, second
-        y1, d1, s1 = (np.roll(x, -1, axis=0) for x in (values, first, second))
-        self.powers = [   # coefficients of t⁵ … t⁰ on each interval
-            6 * (y1 - y0) - 3 * (d0 + d1) - 0.5 * (s0 - s1),
-            15 * (y0 - y1) + 8 * d0 + 7 * d1 + 1.5 * s0 - s1,
-            10 * (y1 - y0) - 6 * d0 - 4 * d1 - 1.5 * s0 + 0.5 * s1,
-            0.5 * s0, d0, y0]
-        self.n = n
-
-    def __call__(self, rest):
-        """Columns at phases ``rest`` in [0, 2π] (rad), shape rest.shape + (columns,)."""
-        s = np.asarray(rest, dtype=float) / self.step
-        i = np.minimum(s.astype(np.intp), self.n - 1)
-        t = (s - i)[..., None]
-        out = np.take(self.powers[0], i, axis=0) * t
-        for power in self.powers[1:-1]:
-            out += np.take(power, i, axis=0)
-            out *= t
-        out += np.take(self.powers[-1], i, axis=0)
-        return out
+def _periodic_table(values):
+    """Quintic Hermite table over one cycle of columns sampled at u_j = 2πj/N (spectral f′, f″)."""
+    first = spectral_derivative(values)
+    return HermiteTable.periodic(values, first, spectral_derivative(first))
 
 
 def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
@@ -219,7 +184,7 @@ class ContactForceModel:
         inertia, mass, g = self.dynamics.mass.inertia, self.mass, self.dynamics.gravity
         w = self.body.phase_angular_velocity(u)                  # ω_u, body frame
         c = -np.cross(w, r1)                                     # dG/du, body frame
-        k = np.cross(w, c) + _spectral_derivative(c)             # a_G per u̇² (body frame)
+        k = np.cross(w, c) + spectral_derivative(c)             # a_G per u̇² (body frame)
         iw = w @ inertia
         d = r2 - r1
         length2 = _dot(d, d)
@@ -227,7 +192,7 @@ class ContactForceModel:
         p = np.cross(normal, e)
         # coefficient sets (gravity, u̇², ü) of the total force and of the moment about G
         force = (mass * g * normal, mass * k, mass * c)
-        moment = (np.zeros_like(w), _spectral_derivative(w) @ inertia + np.cross(w, iw), iw)
+        moment = (np.zeros_like(w), spectral_derivative(w) @ inertia + np.cross(w, iw), iw)
         coef = np.empty((n, 3, _K))
         for j, (f, m) in enumerate(zip(force, moment)):
             moment_a = m - np.cross(r1, f)
@@ -247,8 +212,8 @@ class ContactForceModel:
         m_u = _dot(w, iw) + mass * _dot(c, c)
         speed = np.linalg.norm(w, axis=-1)
         dv = mass * g * complex_step(self.body.phase_height, u)
-        dyn0, dyn2 = -dv / m_u, -0.5 * _spectral_derivative(m_u) / m_u
-        kin2 = -_spectral_derivative(speed) / speed**3
+        dyn0, dyn2 = -dv / m_u, -0.5 * spectral_derivative(m_u) / m_u
+        kin2 = -spectral_derivative(speed) / speed**3
         self._columns = {
             'general': np.column_stack([coef.reshape(n, 3 * _K), heading]),
             'dynamic': np.column_stack([coef[:, 0] + dyn0[:, None] * coef[:, 2], dyn0,
@@ -262,7 +227,7 @@ class ContactForceModel:
 
     def _table(self, kind):
         if kind not in self._tables:
-            self._tables[kind] = _PeriodicTable(self._columns[kind])
+            self._tables[kind] = _periodic_table(self._columns[kind])
         return self._tables[kind]
 
     def coefficients(self, u, kind='kinematic'):
@@ -292,7 +257,7 @@ class ContactForceModel:
             part = slice(start, start + BLOCK)
             cycles = np.floor(u[part] / TWO_PI)
             rest = u[part] - TWO_PI * cycles
-            f = table(rest)
+            f = table.combine(*table.weights(rest))
             values = f[:, :width] + a[part, None] * f[:, width:2 * width]
             if kind == 'general':
                 values += b[0][part, None] * f[:, 2 * width:3 * width]

@@ -13,8 +13,8 @@ import math
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from twodisk_ros.cycle import TWO_PI
-from twodisk_ros.physics.contact_forces import QUANTITIES
+from .cycle import TWO_PI
+from .contact_forces import QUANTITIES
 
 __all__ = ['ValidityReport', 'check_validity', 'motion_validity', 'liftoff_speed',
            'mu_required_kinematic', 'mu_required_dynamic']

@@ -13,9 +13,9 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from twodisk_ros.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.dynamics import RollingDynamics  # noqa: E402
-from twodisk_ros.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.dynamics import RollingDynamics  # noqa: E402
+from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
 from twodisk_ros.physics.contact_forces import ContactForceModel  # noqa: E402
 from twodisk_ros.physics.contact_validity import (  # noqa: E402
     liftoff_speed, mu_required_kinematic)
