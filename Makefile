@@ -28,9 +28,10 @@ demo: venv
 	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap
 	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png
 
-## The paper's figures, whole cycles, the height of G and the stability map (PNG).
+## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
 figures: venv
 	$(PY) -m twodisk_ros.plotting.figures --out docs/figures
+	$(PY) -m twodisk_ros.plotting.contact_forces docs/figures
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
 bench: venv

@@ -294,7 +294,11 @@ def test_path_as_the_vectorised_encoder(stamp, frame, data):
 @given(st.builds(WrenchStamped, header=headers,
                  wrench=st.builds(Wrench, force=vectors, torque=vectors)))
 def test_wrench_stamped(msg):
-    check(msg)
+    ours = check(msg)
+    stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+    f, t = msg.wrench.force, msg.wrench.torque
+    assert ours == cdr.encode_wrench_stamped([stamp], msg.header.frame_id, [[f.x, f.y, f.z]],
+                                             [[t.x, t.y, t.z]])[0]
 
 
 def _covariance(n):

@@ -115,3 +115,10 @@ def test_plot_functions_return_their_axes():
         assert np.isfinite(_line(axes[1], 'height Fig. 4').get_ydata()).all()
     finally:
         plt.close(fig)
+
+
+def test_contact_force_figures_are_written(tmp_path):
+    from twodisk_ros.plotting import contact_forces
+    contact_forces.main(str(tmp_path))
+    for name in ('contact_forces_cycle.png', 'contact_forces_speed.png'):
+        assert (tmp_path / name).stat().st_size > 20_000

@@ -62,7 +62,7 @@ def test_descriptors_follow_the_contract():
         d = _descriptor(p)
         assert d.read_only == p.read_only
         assert p.description in d.description and p.rule in d.description
-        if p.kind is float:
+        if p.kind is float and p.high < float('inf'):
             (r,) = d.floating_point_range
             assert (r.from_value, r.to_value) == (p.low, p.high)
     assert isinstance(DEFAULTS, RollerSettings)

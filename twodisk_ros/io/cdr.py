@@ -37,6 +37,7 @@ __all__ = [
     'encode_path',
     'encode_point_stamped',
     'encode_pose_stamped',
+    'encode_wrench_stamped',
     'serialize',
     'split_rows',
 ]
@@ -198,6 +199,35 @@ def encode_point_stamped(stamps_ns, frame_id, points):
     layout.field('point', '<f8', 3)
     return split_rows(layout.fill(len(points), stamp=_stamps(stamps_ns, len(points)),
                                   point=points))
+
+
+def encode_wrench_stamped(stamps_ns, frame_id, forces, torques=None):
+    """Encode a batch of ``geometry_msgs/msg/WrenchStamped``.
+
+    Parameters
+    ----------
+    stamps_ns : array_like of int, shape (n,)
+        Header stamps, integer nanoseconds.
+    frame_id : str
+        Header frame id (the axes of force and torque), the same for the whole batch.
+    forces : array_like of float, shape (n, 3)
+        Force (N).
+    torques : array_like of float, shape (n, 3), optional
+        Torque (N m); zero if omitted.
+
+    Returns
+    -------
+    list of bytes
+        One CDR message (with encapsulation header) per sample.
+    """
+    forces = _float_array(forces, 3, 'forces')
+    n = len(forces)
+    torques = np.zeros((n, 3)) if torques is None else _float_array(torques, 3, 'torques')
+    layout = _header_only(frame_id)
+    layout.field('force', '<f8', 3)
+    layout.field('torque', '<f8', 3)
+    return split_rows(layout.fill(n, stamp=_stamps(stamps_ns, n), force=forces,
+                                  torque=torques))
 
 
 def encode_joint_state(stamps_ns, names, positions, velocities=None, frame_id=''):

@@ -83,8 +83,9 @@ def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size):
 
 
 def diagnostics(time_ns, name, level, message, values):
-    """DiagnosticArray with one status; ``values`` is a list of (key, value) pairs."""
-    status = DiagnosticStatus(level=level, name=name, message=message,
+    """DiagnosticArray with one status; ``level`` is :data:`OK`, :data:`WARN` or :data:`ERROR`
+    and ``values`` a list of (key, value) pairs."""
+    status = DiagnosticStatus(level=bytes([level]), name=name, message=message,
                               hardware_id='twodisk_ros',
                               values=[KeyValue(key=k, value=_text(v)) for k, v in values])
     return DiagnosticArray(header=header('', time_ns), status=[status])
@@ -98,4 +99,30 @@ def _text(value):
     return str(value)
 
 
-OK, WARN = DiagnosticStatus.OK, DiagnosticStatus.WARN
+#: diagnostic levels as integers (DiagnosticStatus stores them as one byte)
+OK, WARN, ERROR = (ord(level) for level in (DiagnosticStatus.OK, DiagnosticStatus.WARN,
+                                            DiagnosticStatus.ERROR))
+#: marker ids of the two force arrows (the body's markers use the ids below them)
+FORCE_ARROW_IDS = (100, 101)
+
+
+def force_arrows(frame_id, time_ns, points, forces, weight, size):
+    """ARROW markers of the ground's forces on the body at A and B (world frame).
+
+    Each arrow starts at its contact point and is ``force / (M g) × size`` long, so the
+    weight M g itself would be one body size; red when the force pulls (N < 0).
+    """
+    scale = size / weight if weight > 0 else 0.0
+    markers = []
+    for marker_id, point_xyz, force in zip(FORCE_ARROW_IDS, points, forces):
+        start = np.asarray(point_xyz, dtype=float)
+        marker = Marker(header=header(frame_id, time_ns), ns='twodisk_forces', id=marker_id,
+                        type=Marker.ARROW, action=Marker.ADD)
+        marker.pose.orientation.w = 1.0
+        marker.points = [point(start), point(start + scale * np.asarray(force, dtype=float))]
+        marker.scale.x, marker.scale.y, marker.scale.z = 0.01 * size, 0.02 * size, 0.03 * size
+        pulling = force[2] < 0
+        marker.color = ColorRGBA(r=0.9 if pulling else 0.2, g=0.1 if pulling else 0.6, b=0.1,
+                                 a=1.0)
+        markers.append(marker)
+    return markers

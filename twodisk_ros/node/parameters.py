@@ -61,7 +61,7 @@ class Parameter:
 
 
 def _number(value):
-    return f'{value:g}'
+    return 'inf' if value == math.inf else f'{value:g}'
 
 
 PARAMETERS = (
@@ -87,6 +87,9 @@ PARAMETERS = (
               'of the cycle', choices=(-1, 1), physics=True),
     Parameter('omega0', float, 3.0, 'rad/s', 'initial signed angular speed; + means theta '
               'increasing on branch +1', -1e3, 1e3, physics=True),
+    Parameter('friction', float, 0.5, '', 'friction coefficient mu between body and ground '
+              '(.inf: no limit); slip where the motion needs more is outside the rolling '
+              'model', 0.0, math.inf),
     Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
     Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
               read_only=True),
@@ -134,7 +137,8 @@ def _check_one(parameter, value):
         raise ValueError(f'{p.name} must be {p.rule}, got {value!r}')
     if p.choices is not None and value not in p.choices:
         raise ValueError(f'{p.name} must be {p.rule}, got {value!r}')
-    if p.low is not None and not (math.isfinite(value) and p.low <= value <= p.high):
+    if p.low is not None and not (p.low <= value <= p.high and not math.isinf(value)
+                                  or value == p.high == math.inf):
         raise ValueError(f'{p.name} must satisfy {p.rule}, got {value!r}')
     return value
 

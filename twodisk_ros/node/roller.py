@@ -2,8 +2,9 @@
 
 Topics (relative names, so namespaces work), frames per REP-103, SI units:
 ``pose`` (PoseStamped, body frame at G), ``contact_a`` / ``contact_b`` (PointStamped),
-``rolling_state`` (JointState: theta, psi, phase), ``path_a`` / ``path_b`` / ``path_g``
-(Path, ≤ 2 Hz), ``markers`` (MarkerArray, ≤ 10 Hz) and ``/diagnostics`` (1 Hz).
+``rolling_state`` (JointState: theta, psi, phase), ``wrench_a`` / ``wrench_b``
+(WrenchStamped: the ground's force on the body at A / B), ``path_a`` / ``path_b`` /
+``path_g`` (Path, ≤ 2 Hz), ``markers`` (MarkerArray, ≤ 10 Hz) and ``/diagnostics`` (1 Hz).
 Run: ``ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml``.
 
 States are computed in blocks ahead of time and encoded to CDR in one vectorised step
@@ -21,7 +22,7 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
                                 SetParametersResult)
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PointStamped, PoseStamped
+from geometry_msgs.msg import PointStamped, PoseStamped, WrenchStamped
 from nav_msgs.msg import Path
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
@@ -42,12 +43,14 @@ AHEAD = 0.05             # s: realtime states are computed this far ahead, in on
 MAX_LAG = 0.1            # s: a realtime node further behind drops samples to catch up
 QOS_DEPTH = 10
 MIN_SAMPLES = 5          # a stopped run that began publishing ends with at least this many
-SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 TOPIC_TYPES = {
     'pose': PoseStamped, 'contact_a': PointStamped, 'contact_b': PointStamped,
-    'rolling_state': JointState, 'path_a': Path, 'path_b': Path, 'path_g': Path,
-    'markers': MarkerArray, '/diagnostics': DiagnosticArray,
+    'rolling_state': JointState, 'wrench_a': WrenchStamped, 'wrench_b': WrenchStamped,
+    'path_a': Path, 'path_b': Path, 'path_g': Path, 'markers': MarkerArray,
+    '/diagnostics': DiagnosticArray,
 }
+#: topics that need the contact forces of every sample
+NEED_FORCES = ('wrench_a', 'wrench_b', 'markers', '/diagnostics')
 
 
 def _descriptor(p):
@@ -62,7 +65,7 @@ def _descriptor(p):
     elif p.kind is int:
         descriptor.integer_range = [IntegerRange(from_value=int(p.low), to_value=int(p.high),
                                                  step=1)]
-    elif p.kind is float:
+    elif p.kind is float and math.isfinite(p.high):
         descriptor.floating_point_range = [FloatingPointRange(from_value=float(p.low),
                                                               to_value=float(p.high))]
     if p.choices is not None and p.kind is str:
@@ -164,7 +167,14 @@ class Roller(Node):
         """Sample and encode ``count`` samples from global tick ``first``."""
         rate = self.settings.rate
         ticks = np.arange(first, first + count)
-        sample = self.simulation.sample((ticks - self._motion_tick) / rate)
+        invalid_before = self.simulation.invalid
+        sample = self.simulation.sample((ticks - self._motion_tick) / rate,
+                                        forces=any(self._wanted(t) for t in NEED_FORCES),
+                                        time_offset=self._motion_tick / rate)
+        if invalid_before is None and self.simulation.invalid is not None:
+            self.get_logger().error(f'outside the rolling model: '
+                                    f'{self.simulation.invalid.reason}; the rolling solution '
+                                    'is published on, marked invalid in /diagnostics')
         stamps = self._start_ns + np.round(ticks * (1e9 / rate)).astype(np.int64)
         frame = self.settings.frame_id
         encoders = {
@@ -176,6 +186,8 @@ class Roller(Node):
                 stamps, messages.JOINT_NAMES,
                 np.column_stack([sample.theta, sample.psi, sample.phase]),
                 np.column_stack([sample.theta_rate, sample.psi_rate, sample.phase_rate])),
+            'wrench_a': lambda: cdr.encode_wrench_stamped(stamps, frame, sample.forces.force_a),
+            'wrench_b': lambda: cdr.encode_wrench_stamped(stamps, frame, sample.forces.force_b),
         }
         encoded = {topic: encode() for topic, encode in encoders.items() if self._wanted(topic)}
         for topic, column in encoded.items():
@@ -241,6 +253,11 @@ class Roller(Node):
         message = messages.body_markers(self.settings.frame_id, time_ns, disk1, disk2,
                                         sample.contact_a[i], sample.contact_b[i],
                                         self.simulation.body.size)
+        if sample.forces is not None:
+            message.markers.extend(messages.force_arrows(
+                self.settings.frame_id, time_ns, (sample.contact_a[i], sample.contact_b[i]),
+                (sample.forces.force_a[i], sample.forces.force_b[i]), self.simulation.weight,
+                self.simulation.body.size))
         self._send('markers', cdr.serialize(message), time_ns)
 
     def achieved_rate(self):
@@ -260,16 +277,21 @@ class Roller(Node):
             level, message = messages.WARN, (f'{name} drift {drift:.2e} exceeds tolerance '
                                               f'{s.tolerance:.1e}')
         achieved = self.achieved_rate()
-        if s.realtime and achieved is not None and achieved < 0.95 * s.rate:
+        if s.realtime and achieved is not None and achieved < 0.95 * s.rate \
+                and level < messages.ERROR:
             level = messages.WARN
             message = (f'cannot hold rate {s.rate:g} Hz: achieved {achieved:.4g} Hz, '
                        f'{self.samples_dropped} samples dropped to keep real time')
+        contact_level, contact_message, contact_values = self.simulation.contact_status(
+            sample, i)
+        if contact_level > level:
+            level, message = contact_level, contact_message
         values = [(name, value), (f'{name}_drift', drift),
                   ('energy', self.simulation.energy(sample, i)),
                   ('tilt', float(self.simulation.dynamics.cycle.state(sample.phase[i]).tilt)),
                   ('phase', float(sample.phase[i])), ('mode', s.mode), ('method', s.method),
                   ('rate', s.rate), ('achieved_rate', achieved if achieved else s.rate),
-                  ('samples_dropped', self.samples_dropped)]
+                  ('samples_dropped', self.samples_dropped)] + contact_values
         if name != 'energy':
             values = [v for v in values if v[0] != 'energy'] + [
                 ('energy', self.simulation.energy(sample, i))]

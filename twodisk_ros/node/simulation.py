@@ -10,10 +10,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..physics.body import TwoDiskBody
+from ..physics.contact_forces import ContactForceModel
+from ..physics.contact_validity import check_validity
 from ..physics.dynamics import RollingDynamics
 from ..physics.motion import MotionStream
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
+
+#: Diagnostics turn to WARN when μ_required exceeds this share of μ, or N < this share of M g.
+MARGIN_WARN = 0.1
 
 
 def continuous_quaternions(quaternions, previous=None):
@@ -59,6 +64,7 @@ class Sample:
     contact_a: np.ndarray
     contact_b: np.ndarray
     quaternion: np.ndarray
+    forces: object = None      #: ContactForces of the block (None if not asked for)
 
     def __len__(self):
         return len(self.t)
@@ -89,10 +95,18 @@ class Simulation:
         self.equilibria = self.dynamics.equilibria_with_periods()
         self.energy0 = self.stream.initial_energy
         self.angular_speed0 = abs(s.omega0)
+        self.forces = ContactForceModel(self.dynamics)
+        self.weight = self.dynamics.mass.mass * self.dynamics.gravity   # M g (N)
+        self.invalid = None        # ValidityReport of the first sample outside the model
         self._last_quaternion = None
 
-    def sample(self, t):
-        """Everything published at simulated times t (s, increasing array, after earlier ones)."""
+    def sample(self, t, forces=False, time_offset=0.0):
+        """Everything published at simulated times t (s, increasing array, after earlier ones).
+
+        With ``forces`` the contact forces are computed too and the first sample outside the
+        rolling model (lift-off, or μ_required > friction) is kept in :attr:`invalid`, its
+        time reported as ``t + time_offset`` (s, the node's simulated time).
+        """
         t = np.asarray(t, dtype=float)
         u, u_dot = self.stream.sample(t)
         poses = self.dynamics.cycle.poses(u)
@@ -100,10 +114,37 @@ class Simulation:
         if len(quaternion):
             self._last_quaternion = quaternion[-1]
         theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
+        contact = None
+        if forces:
+            contact = (self.forces.kinematic(u, self.angular_speed0)
+                       if self.settings.mode == 'kinematic' else self.forces.dynamic(u, u_dot))
+            if self.invalid is None and len(t):
+                report = check_validity(t + time_offset, contact, self.settings.friction)
+                if not report.valid:
+                    self.invalid = report
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,
                       position_g=poses.position_g, contact_a=poses.contact_a,
-                      contact_b=poses.contact_b, quaternion=quaternion)
+                      contact_b=poses.contact_b, quaternion=quaternion, forces=contact)
+
+    def contact_status(self, sample, i):
+        """(level, message, values) of the contact forces at sample i, for the diagnostics.
+
+        level: 0 OK, 1 WARN (margin to slip or lift-off below :data:`MARGIN_WARN`), 2 ERROR
+        (the motion has left the rolling model: it is published on, marked as invalid).
+        """
+        f, mu = sample.forces, self.settings.friction
+        normal_a, normal_b = float(f.normal_a[i]), float(f.normal_b[i])
+        required = float(f.mu_required[i])
+        lift = min(normal_a, normal_b) / self.weight if self.weight > 0 else float('inf')
+        values = [('normal_a', normal_a), ('normal_b', normal_b), ('mu_required', required),
+                  ('friction', mu), ('slip_margin', mu - required), ('lift_off_margin', lift)]
+        if self.invalid is not None:
+            return 2, f'outside the rolling model: {self.invalid.reason}', values
+        if required > (1 - MARGIN_WARN) * mu or lift < MARGIN_WARN:
+            return 1, (f'close to the limits of the rolling model: mu_required {required:.3g} '
+                       f'of friction {mu:.3g}, min N / (M g) = {lift:.3g}'), values
+        return 0, 'rolling', values
 
     def invariant(self, sample, i):
         """(name, value, relative drift) of the conserved quantity at sample i.

@@ -7,6 +7,7 @@ The bodies are those of config/*.yaml (mass 1 kg, laminae, g = 9.81 m/s²).
 
 import math
 import os
+import sys
 
 import matplotlib
 matplotlib.use('Agg')
@@ -106,4 +107,4 @@ def main(directory=FIGURES):
 
 
 if __name__ == '__main__':
-    main()
+    main(*sys.argv[1:2])
