@@ -37,7 +37,7 @@ from reference import ReferenceBody  # noqa: E402
 
 from twodisk_ros import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
-from recording_rate import recording_throughput  # noqa: E402
+import ros_layer  # noqa: E402
 
 
 def _run(cmd):
@@ -226,10 +226,8 @@ def main(argv=None):
 
     ratios = speed_ratios(results)
 
-    log('recording: messages per second in a batch run of the node')
-    recording = recording_throughput(duration=2.0 if args.quick else 20.0)
-    log(f'   {recording.messages} messages, {recording.per_second:.0f} per s '
-        f'(start-up {recording.startup:.2f} s excluded)')
+    log('the node and the capabilities on the physics: poses, recording, real time, forces')
+    ros = ros_layer.measure(builds, quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
 
     # why a target was missed
@@ -296,7 +294,8 @@ def main(argv=None):
                reference_check_rtol=REFERENCE_CHECK_RTOL, closed_form_check=check_text,
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
-               recording=recording, elapsed=elapsed)
+               ros_layer=ros, commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
+               elapsed=elapsed)
     write_report(args.out, ctx)
     data = dict(date=date, machine=machine, elapsed=elapsed, quick=args.quick,
                 scenarios=[asdict(s) for s in scs],
@@ -310,7 +309,7 @@ def main(argv=None):
                 throughput=[t.as_dict() for t in throughput],
                 hours=[h.as_dict() for h in hours],
                 ratios=[r.as_dict() for r in ratios],
-                recording=recording.as_dict(),
+                ros_layer=ros_layer.as_dict(ros),
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))

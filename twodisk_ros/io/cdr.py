@@ -399,6 +399,11 @@ def _write_value(out, kind, value):
             _write_uint32(out, len(value))
         item = kind.value_type
         if type(item).__name__ != 'BasicType':
+            packed = _pack_uniform(value) if type(item).__name__ == 'NamespacedType' else None
+            if packed is not None:      # e.g. geometry_msgs/Point: one block of float64
+                _align(out, packed.dtype.itemsize)
+                out += packed.tobytes()
+                return
             for element in value:
                 _write_value(out, item, element)
         elif len(value):     # Fast-CDR aligns an array of primitives only if it is not empty
@@ -412,6 +417,24 @@ def _write_value(out, kind, value):
                 out += np.asarray(value, np.dtype('<' + fmt)).tobytes()
     else:
         raise TypeError(f'unsupported field type {kind_name}')
+
+
+def _pack_uniform(elements):
+    """Messages whose fields are all float64 (or all float32) as one array, else None.
+
+    Such elements follow each other without padding (every field has the element's
+    alignment), so the sequence is the array's bytes: one call instead of one per field.
+    """
+    if not len(elements):
+        return None
+    kinds = type(elements[0]).SLOT_TYPES
+    names = {getattr(k, 'typename', None) for k in kinds}
+    if not kinds or len(names) != 1 or not {'double', 'float'} >= names \
+            or any(type(k).__name__ != 'BasicType' for k in kinds):
+        return None
+    fields = list(elements[0].get_fields_and_field_types())
+    dtype = '<f8' if names == {'double'} else '<f4'
+    return np.array([[getattr(e, f) for f in fields] for e in elements], dtype=dtype)
 
 
 def _write_uint32(out, count):

@@ -321,14 +321,13 @@ class McapRecorder:
         if not stamps or not states:
             return
         channels = [state.channel_id for state in states]
-        rows = list(zip(channels, messages))
         add = self._writer.add_message
         with self._lock:
             self._check_open()
             with self._io('write'):
-                for i, stamp in enumerate(stamps):
-                    for channel, column in rows:
-                        add(channel, log_time=stamp, data=column[i], publish_time=stamp)
+                for stamp, row in zip(stamps, zip(*messages)):
+                    for channel, data in zip(channels, row):
+                        add(channel, stamp, data, stamp)
             for state in states:
                 state.message_count += len(stamps)
             self._message_count += len(stamps) * len(states)

@@ -67,7 +67,7 @@ def _line_marker(frame_id, time_ns, marker_id, kind, points, rgba, width):
     marker.pose.orientation.w = 1.0
     marker.scale.x = float(width)
     marker.color = ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
-    marker.points = [point(p) for p in points]
+    marker.points = [Point(x=x, y=y, z=z) for x, y, z in np.asarray(points, float).tolist()]
     return marker
 
 

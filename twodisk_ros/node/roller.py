@@ -103,7 +103,7 @@ class Roller(Node):
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
         self.messages_built = {topic: 0 for topic in TOPIC_TYPES}
-        self._paths = {key: deque(maxlen=self.settings.path_length) for key in 'abg'}
+        self._history = _PathHistory(self.settings.path_length)
         self._tick = 0                  # global sample index: simulated time tick / rate
         self._motion_tick = 0           # tick at which the motion (re)started
         self._next = {'path': 0.0, 'marker': 0.0, 'diagnostics': 0.0}
@@ -111,7 +111,8 @@ class Roller(Node):
         self._block = None              # realtime: (first tick, Sample, encoded messages)
         self._start_ns = self.get_clock().now().nanoseconds
         self._wall_start = time.monotonic()
-        self._rate_window = deque(maxlen=64)   # (wall time, tick) for the achieved rate
+        self._rate_window = deque(maxlen=64)   # (wall time, samples) for the achieved rate
+        self._lag = deque(maxlen=1000)          # s: wall clock minus the last sample's time
         self.finished = False
         self.add_on_set_parameters_callback(self._on_set_parameters)
         if self.settings.realtime:
@@ -147,14 +148,12 @@ class Roller(Node):
     def _apply_pending(self):
         (candidate, simulation), self._pending = self._pending, None
         self.settings = candidate
-        for key in 'abg':
-            self._paths[key] = deque(self._paths[key], maxlen=candidate.path_length)
+        self._history.length = candidate.path_length
         if simulation is not None:
             self.simulation = simulation
             self._motion_tick = self._tick
             self._block = None
-            for path in self._paths.values():
-                path.clear()
+            self._history.clear()
             self._next['diagnostics'] = self._tick / self.settings.rate
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
@@ -206,26 +205,29 @@ class Roller(Node):
             self._recorder.write_interleaved(
                 [self._pubs[t].topic_name for t in topics],
                 [encoded[t][start:stop] for t in topics], stamps[start:stop])
-        for i in range(start, stop):
-            self._after_sample(sample, stamps, i)
+        self._low_rate_topics(sample, stamps, start, stop)
+        self._history.extend(stamps[start:stop], sample.contact_a[start:stop],
+                             sample.contact_b[start:stop], sample.position_g[start:stop])
         self._tick += stop - start
         self.samples_published += stop - start
 
-    def _after_sample(self, sample, stamps, i):
-        """Paths, markers and diagnostics at their lower rates; the validity of the motion."""
-        time_s = sample.t[i] + self._motion_tick / self.settings.rate
-        for key, points in (('a', sample.contact_a), ('b', sample.contact_b),
-                            ('g', sample.position_g)):
-            self._paths[key].append((int(stamps[i]), points[i]))
-        if time_s + 1e-12 >= self._next['path']:
-            self._next['path'] = time_s + 1.0 / PATH_RATE
-            self._publish_paths(int(stamps[i]))
-        if time_s + 1e-12 >= self._next['marker']:
-            self._next['marker'] = time_s + 1.0 / MARKER_RATE
-            self._publish_markers(sample, i, int(stamps[i]))
-        if time_s + 1e-12 >= self._next['diagnostics']:
-            self._next['diagnostics'] = time_s + 1.0 / DIAGNOSTICS_RATE
-            self._publish_diagnostics(sample, i, int(stamps[i]))
+    def _low_rate_topics(self, sample, stamps, start, stop):
+        """Paths, markers and diagnostics of samples [start, stop), each at its own rate."""
+        times = sample.t[start:stop] + self._motion_tick / self.settings.rate
+        for kind, rate in (('path', PATH_RATE), ('marker', MARKER_RATE),
+                           ('diagnostics', DIAGNOSTICS_RATE)):
+            while True:
+                j = int(np.searchsorted(times, self._next[kind] - 1e-12))
+                if j >= len(times):
+                    break
+                self._next[kind] = times[j] + 1.0 / rate
+                i = start + j
+                if kind == 'path':
+                    self._publish_paths(sample, stamps, start, i)
+                elif kind == 'marker':
+                    self._publish_markers(sample, i, int(stamps[i]))
+                else:
+                    self._publish_diagnostics(sample, i, int(stamps[i]))
 
     def _send(self, topic, data, time_ns):
         self.messages_built[topic] += 1
@@ -234,16 +236,17 @@ class Roller(Node):
         if self._recorder is not None:
             self._recorder.write_serialized(self._pubs[topic].topic_name, data, time_ns)
 
-    def _publish_paths(self, time_ns):
-        frame = self.settings.frame_id
+    def _publish_paths(self, sample, stamps, start, i):
+        """The three paths up to sample i of the block (the block's [start, i] and before)."""
+        frame, time_ns = self.settings.frame_id, int(stamps[i])
+        points = {'a': sample.contact_a, 'b': sample.contact_b, 'g': sample.position_g}
         for key in 'abg':
             topic = 'path_' + key
             if self._wanted(topic):
-                entries = self._paths[key]
-                stamps = np.array([s for s, _ in entries], dtype=np.int64)
-                points = np.array([p for _, p in entries], dtype=float).reshape(-1, 3)
-                self._send(topic, cdr.encode_path(time_ns, frame, points, stamps_ns=stamps),
-                           time_ns)
+                past_stamps, past_points = self._history.tail(
+                    key, stamps[start:i + 1], points[key][start:i + 1])
+                self._send(topic, cdr.encode_path(time_ns, frame, past_points,
+                                                  stamps_ns=past_stamps), time_ns)
 
     def _publish_markers(self, sample, i, time_ns):
         if not self._wanted('markers'):
@@ -291,6 +294,7 @@ class Roller(Node):
                   ('tilt', float(self.simulation.dynamics.cycle.state(sample.phase[i]).tilt)),
                   ('phase', float(sample.phase[i])), ('mode', s.mode), ('method', s.method),
                   ('rate', s.rate), ('achieved_rate', achieved if achieved else s.rate),
+                  ('clock_lag', float(np.mean(self._lag)) if self._lag else 0.0),
                   ('samples_dropped', self.samples_dropped)] + contact_values
         if name != 'energy':
             values = [v for v in values if v[0] != 'energy'] + [
@@ -337,7 +341,9 @@ class Roller(Node):
             start = self._tick - first
             stop = min(len(sample), due - first)
             self._emit(sample, stamps, encoded, start, stop)
-        self._rate_window.append((now, self._tick))
+        self._rate_window.append((now, self.samples_published))
+        if self._tick:   # how far the newest published sample's time trails the wall clock
+            self._lag.append(now - self._wall_start - (self._tick - 1) / rate)
         if limit is not None and self._tick >= limit:
             self.finished = True
 
@@ -389,3 +395,26 @@ class Roller(Node):
             os.remove(self._recorder.path)
             return False
         return True
+
+
+class _PathHistory:
+    """The last ``length`` samples of A, B and G (stamps in ns, world positions in m)."""
+
+    def __init__(self, length):
+        self.length = length
+        self.clear()
+
+    def clear(self):
+        self._stamps = np.zeros(0, dtype=np.int64)
+        self._points = {key: np.zeros((0, 3)) for key in 'abg'}
+
+    def tail(self, key, stamps, points):
+        """The last ``length`` stamps and points of ``key`` followed by the given ones."""
+        n = self.length
+        return (np.concatenate([self._stamps, stamps])[-n:],
+                np.concatenate([self._points[key], points])[-n:])
+
+    def extend(self, stamps, a, b, g):
+        self._stamps = np.concatenate([self._stamps, stamps])[-self.length:]
+        for key, points in zip('abg', (a, b, g)):
+            self._points[key] = np.concatenate([self._points[key], points])[-self.length:]

@@ -1,0 +1,148 @@
+"""Benchmarks of the node and of the capabilities built on the physics (part of ``make bench``).
+
+- full poses and positions per second against the independent reference (``targets.py``);
+- batch recording: the node's messages/s against the ``mcap`` writer's and rclpy's floors,
+  measured side by side in one run (``node_rates.py``);
+- real time at 100 Hz, 1 kHz and 10 kHz (``node_rates.py``);
+- contact forces per second, and the cost of the solid mass model.
+"""
+
+from dataclasses import asdict
+import time
+
+import numpy as np
+
+from node_rates import batch_rate, realtime_rate
+from targets import poses_throughput
+
+from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
+from twodisk_ros.physics.contact_forces import ContactForceModel
+from twodisk_ros.physics.mass_models import mass_properties, solid_hull
+
+TARGET_POSES, TARGET_POSITIONS, TARGET_FLOOR_SHARE = 1.5e6, 3e6, 0.6
+
+
+def _best(function, repeats=3):
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        walls.append(time.perf_counter() - start)
+    return min(walls)
+
+
+def contact_force_rate(states=10**6):
+    """States per second of ContactForceModel.dynamic along a motion of the oloid (0.1 m)."""
+    body = TwoDiskBody.oloid(0.1)
+    dynamics = RollingDynamics(body, mass_properties('laminae', 0.1, 0.1, 0.05, 1.0))
+    build = _best(lambda: ContactForceModel(dynamics), repeats=2)
+    model = ContactForceModel(dynamics)
+    motion = simulate(dynamics, np.linspace(0.0, 1000.0, states), omega0=6.0)
+    wall = _best(lambda: model.dynamic(motion.phase, motion.phase_rate))
+    return {'states': states, 'wall': wall, 'rate': states / wall, 'build': build}
+
+
+def solid_hull_cost():
+    """Seconds per call of the solid mass model (the old unit test's wall-clock bound)."""
+    cases = {'oloid': (1.0, 1.0, 0.5), 'delta/a = 1e-3': (1.0, 1.0, 1e-3),
+             'b/a = 0.01': (1.0, 0.01, 0.5)}
+    return {name: _best(lambda args=args: solid_hull(*args, 1.0, rtol=1e-9))
+            for name, args in cases.items()}
+
+
+def measure(builds, quick=False, log=print):
+    """Every measurement of this module; ``builds`` are the benchmark bodies of run_all."""
+    n = 10**5 if quick else 10**6
+    out = {'poses': []}
+    for built in builds:
+        p = poses_throughput(built, n=n)
+        out['poses'].append(p)
+        log(f'   poses {built.name}: {p.rate_poses / 1e6:.2f} M/s, positions '
+            f'{p.rate_positions / 1e6:.2f} M/s, error {p.position_error:.1e}')
+    runs = [batch_rate(duration=20.0 if quick else 300.0) for _ in range(1 if quick else 2)]
+    out['batch'] = max(runs, key=lambda r: r.per_second / r.floor_rate)
+    log(f'   batch: {out["batch"].per_second:.0f} messages/s, floor '
+        f'{out["batch"].floor_rate:.0f}')
+    out['realtime'] = [realtime_rate(hz, seconds=3.0 if quick else 8.0)
+                       for hz in (100.0, 1000.0, 10000.0)]
+    for r in out['realtime']:
+        log(f'   realtime {r.rate_hz:g} Hz: node {r.node_achieved_hz:.0f} Hz, lag '
+            f'{r.node_lag_ms:.2f} ms, dropped {r.dropped}')
+    out['forces'] = contact_force_rate(10**5 if quick else 10**6)
+    out['solid'] = solid_hull_cost()
+    return out
+
+
+def as_dict(out):
+    return {'poses': [asdict(p) for p in out['poses']], 'batch': out['batch'].as_dict(),
+            'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
+            'solid': out['solid']}
+
+
+def _status(ok):
+    return 'PASS' if ok else 'MISSED'
+
+
+def report_lines(out):
+    """The report's sections for these measurements (Markdown lines)."""
+    w = []
+    w.append('## Full poses and positions (the node\'s source)\n')
+    w.append('`RollingCycle.poses(u)` (G, A, B and the quaternion from the tables) and '
+             '`positions(u)` on 10⁶ phases over three cycles, best of 5; errors against the '
+             'independent reference (orientation as an angle). Targets: full poses '
+             f'≥ {TARGET_POSES / 1e6:g} M/s, positions ≥ {TARGET_POSITIONS / 1e6:g} M/s, '
+             '≤ 1e-10 of the size.\n')
+    w.append('| body | full poses (M/s) | positions (M/s) | position error / size | '
+             'orientation error (rad) | reference\'s own error | sign flips |')
+    w.append('|---|---|---|---|---|---|---|')
+    for p in out['poses']:
+        w.append(f'| {p.body} | {p.rate_poses / 1e6:.2f} | {p.rate_positions / 1e6:.2f} | '
+                 f'{p.position_error:.1e} | {p.orientation_error:.1e} | '
+                 f'{p.reference_error:.1e} | {p.sign_flips} |')
+    ok = all(p.rate_poses >= TARGET_POSES and p.rate_positions >= TARGET_POSITIONS
+             and p.position_error <= 1e-10 for p in out['poses'])
+    w.append(f'\n**{_status(ok)}** (the machine is shared: rates vary by up to 2× between '
+             'runs).\n')
+    b = out['batch']
+    share = b.per_second / b.floor_rate
+    w.append('## Batch recording against the file format\n')
+    w.append(f'`roller` in process, `realtime:=false`, `rate:={b.rate_hz:g}`, '
+             f'`duration:={b.duration:g}`, every topic recorded (pose, contacts, rolling_state, '
+             'wrenches at the rate; paths at 2 Hz with up to 1000 poses; markers at 10 Hz; '
+             'diagnostics at 1 Hz); `run_batch` is timed, start-up excluded. In the same run, '
+             'on the same messages: `mcap.Writer.add_message` alone (zstd, 256 KiB chunks, '
+             'as the node writes) and `rclpy.serialization.serialize_message` of pre-built '
+             'PoseStamped (the per-message path the node used before).\n')
+    w('| messages | node (messages/s) | add_message floor (messages/s) | node / floor | '
+      'serialize_message (messages/s) | an hour at 1 kHz (extrapolated) |')
+    w('|---|---|---|---|---|---|')
+    w(f'| {b.messages} | {b.per_second:.0f} | {b.floor_rate:.0f} | {share:.2f} | '
+      f'{b.serialize_rate:.0f} | {b.hour_estimate:.0f} s (linear from {b.duration:g} s) |')
+    w(f'\n**{_status(share >= TARGET_FLOOR_SHARE)}** (target: node ≥ '
+      f'{TARGET_FLOOR_SHARE:.0%} of the floor).\n')
+    w('## Real time\n')
+    w('`roller` as a process with `config/oloid.yaml`, recording on, every topic subscribed '
+      'by a listener process (raw subscriptions, so that the listener\'s own decoding is not '
+      'measured). Node: its achieved rate, its lag (wall clock minus the time of the last '
+      'sample it published, mean) and the samples it dropped, from its `/diagnostics`. '
+      'Listener: inter-arrival times of `/pose` (p50, p99) and the mean arrival time minus '
+      'stamp; on this 2-core machine the Python listener shares the cores with the node, so '
+      'its numbers include its own backlog.\n')
+    w('| rate (Hz) | node achieved (Hz) | node lag (ms) | dropped | diagnostics | '
+      'listener p50 (ms) | listener p99 (ms) | listener lag (ms) |')
+    w('|---|---|---|---|---|---|---|---|')
+    levels = {0: 'OK', 1: 'WARN', 2: 'ERROR', -1: 'none'}
+    for r in out['realtime']:
+        w(f'| {r.rate_hz:g} | {r.node_achieved_hz:.0f} | {r.node_lag_ms:.2f} | {r.dropped} | '
+          f'{levels.get(r.level, r.level)} | {r.p50_ms:.2f} | {r.p99_ms:.2f} | '
+          f'{r.lag_ms:.1f} |')
+    w('')
+    f = out['forces']
+    w('## Contact forces\n')
+    w(f'`ContactForceModel.dynamic` along a motion of the oloid: {f["states"]} states in '
+      f'{f["wall"]:.3f} s ({f["rate"] / 1e6:.2f} M states/s); table build '
+      f'{f["build"] * 1e3:.0f} ms per body.\n')
+    w('## Solid mass model\n')
+    w('`solid_hull(..., rtol=1e-9)`, best of 3: ' + ', '.join(
+        f'{name} {wall * 1e3:.1f} ms' for name, wall in out['solid'].items()) + '.\n')
+    return w
