@@ -2,11 +2,12 @@
 
 Both derivatives use the five samples t − 2h ... t + 2h (fourth order). For the rotation
 the differenced quantity is φ(τ) = log(R(t + τ) R(t)ᵀ), the rotation vector of the turn
-from t to t + τ (world frame). With R(t + τ) = exp([φ(τ)]×) R(t) the world angular velocity
-is ω(t + τ) = J(φ) φ′(τ), J(φ) = I + ½ [φ]× + O(|φ|²) the left Jacobian of SO(3); at τ = 0,
-φ = 0, so ω(t) = φ′(0) and, differentiating once more, ω̇(t) = φ″(0) + ½ φ′(0) × φ′(0) =
-φ″(0). Both are the derivatives at 0 of one smooth vector function: the five-point first
-and second differences of φ give ω and ω̇ to fourth order.
+from t to t + τ (world frame). With R(t + τ) = exp([φ(τ)]×) R(t) the world angular
+velocity is ω(t + τ) = J(φ) φ′(τ), J(φ) = I + ½ [φ]× + O(|φ|²) the left Jacobian of
+SO(3); at τ = 0, φ = 0, so ω(t) = φ′(0) and, differentiating once more,
+ω̇(t) = φ″(0) + ½ φ′(0) × φ′(0) = φ″(0). Both are derivatives at 0 of one smooth vector
+function, so the five-point first and second differences of φ give ω and ω̇ to fourth
+order (tests/test_inspect_forces.py checks this against R = Rz(α) Ry(β) Rx(γ)).
 """
 
 from dataclasses import dataclass

@@ -76,8 +76,8 @@ def _friction(parameters):
     if text is None:
         return math.inf, 'friction not recorded (older recording): mu = inf assumed', None
     try:
-        mu = float(text)
-    except ValueError:
+        mu = float(text[1:] if text.strip().lower() in ('.inf', '+.inf') else text)
+    except (ValueError, AttributeError):
         mu = math.nan
     if not mu >= 0:
         return None, '', f'recorded friction {text!r} is not a number >= 0'

@@ -44,7 +44,8 @@ def _force_lines(info):
                                    subsequent_indent='    '))
         poses = info.get('from_poses')
         if poses:
-            lines.append(f'  from the poses (information): {_extremes(poses)}')
+            lines.extend(textwrap.wrap(f'from the poses (information): {_extremes(poses)}', 99,
+                                       initial_indent='  ', subsequent_indent='    '))
             for stretch in poses['stretches'][:_DAMAGE_SHOWN]:
                 lines.append(f'    - t = {stretch["start_s"]:.6g} … {stretch["end_s"]:.6g} s: '
                              f'{stretch["reason"]}')
