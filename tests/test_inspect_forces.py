@@ -96,9 +96,10 @@ def vector(xyz):
     return Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2]))
 
 
-def write_run(path, run, params, *, wrenches=True):
+def write_run(path, run, params, *, wrenches=True, chunk_size=None):
     """Record ``run`` as the node does, with the wrenches at A and B if ``wrenches``."""
-    with McapRecorder(path, metadata=params) as rec:
+    options = {} if chunk_size is None else {'chunk_size': chunk_size}
+    with McapRecorder(path, metadata=params, **options) as rec:
         topics = {'pose': PoseStamped, 'contact_a': PointStamped, 'contact_b': PointStamped,
                   'rolling_state': JointState}
         if wrenches:
@@ -373,3 +374,15 @@ def test_plot_shows_the_forces(capsys, tmp_path, dynamic_file):
     assert inspect_cli.main([str(dynamic_file), '--plot', str(png)]) == 0
     capsys.readouterr()
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n' and png.stat().st_size > 20_000
+
+
+def test_truncated_recording_with_wrenches_checks_the_rest(tmp_path, dynamic_run):
+    path = write_run(tmp_path / 'whole.mcap', dynamic_run, BASE, chunk_size=8 * 1024)
+    data = path.read_bytes()
+    cut = tmp_path / 'cut.mcap'
+    cut.write_bytes(data[:int(0.6 * len(data))])
+    inspection = inspect_recording(cut)
+    assert inspection.summary['truncated'] and 50 < inspection.summary['samples'] < 201
+    checks = {check.name: check for check in inspection.checks}
+    for name in NEW:
+        assert checks[name].passed, checks[name]
