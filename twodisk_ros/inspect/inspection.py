@@ -17,10 +17,11 @@ import numpy as np
 from ..io import RecordingError, read_recording
 from .checks import run_checks
 from .differences import kinetic_energy
+from .force_checks import FORCE_TITLES, force_checks
 from .model import build_model
-from .results import Inspection, json_ready
-from .series import (METADATA_NAME, TOPIC_TYPES, extract_series, join_samples, select_topics,
-                     topic_role)
+from .results import Check, Inspection, json_ready
+from .series import (METADATA_NAME, TOPIC_TYPES, WRENCHES, extract_series, join_samples,
+                     select_topics, topic_role)
 
 __all__ = ['inspect_recording']
 
@@ -138,9 +139,27 @@ def inspect_recording(path):
         problems.append(f'cannot use the poses: {" ".join(str(error).split())}')
     checks, motion = run_checks(recording, problems, chosen, series, samples, model,
                                 parameters)
+    more, forces, force_series = _force_checks(series, samples, motion, model, parameters,
+                                               recording.truncated)
+    checks.extend(more)
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
     summary['diagnostics'] = _diagnostics_summary(series)
-    return Inspection(summary, checks, _plot_series(series, samples, motion, model, stamp0))
+    summary['contact_forces'] = forces
+    plot = _plot_series(series, samples, motion, model, stamp0)
+    plot.update(force_series)
+    return Inspection(summary, checks, plot)
+
+
+def _force_checks(series, samples, motion, model, parameters, truncated):
+    """:func:`force_checks`; an error inside makes ``contact_forces`` fail, never raises."""
+    try:
+        return force_checks(series, samples, motion, model, parameters, truncated)
+    except Exception as error:  # noqa: BLE001 - reported as a failed check
+        if not (any(role in series for role in WRENCHES) or 'friction' in parameters):
+            return [], {'recorded': False}, {}
+        reason = f'cannot be evaluated: {type(error).__name__}: {" ".join(str(error).split())}'
+        return [Check('contact_forces', FORCE_TITLES['contact_forces'], False, None, None, '',
+                      [reason])], {'recorded': True, 'error': reason}, {}
 
 
 def _diagnostics_summary(series):

@@ -25,6 +25,37 @@ def _value(value, unit):
     return f'{text} {unit}' if unit else text
 
 
+def _extremes(info):
+    friction = info.get('friction')
+    mu = 'inf' if friction is None else f'{friction:g}'
+    return (f'min N_A = {_value(info["min_normal_a"], "N")}, min N_B = '
+            f'{_value(info["min_normal_b"], "N")}, max mu_required = '
+            f'{_value(info["max_mu_required"], "")} (mu = {mu}), {len(info["stretches"])} '
+            f'invalid stretch(es)')
+
+
+def _force_lines(info):
+    """The ``contact forces:`` section (nothing for a report without that summary)."""
+    if not info:
+        return []
+    if not info.get('recorded'):
+        lines = ['contact forces: not recorded']
+        lines.extend(textwrap.wrap(info.get('note', ''), 99, initial_indent='  ',
+                                   subsequent_indent='    '))
+        poses = info.get('from_poses')
+        if poses:
+            lines.extend(textwrap.wrap(f'from the poses (information): {_extremes(poses)}', 99,
+                                       initial_indent='  ', subsequent_indent='    '))
+            for stretch in poses['stretches'][:_DAMAGE_SHOWN]:
+                lines.append(f'    - t = {stretch["start_s"]:.6g} … {stretch["end_s"]:.6g} s: '
+                             f'{stretch["reason"]}')
+        return lines
+    if 'stretches' not in info:
+        return ['contact forces: recorded (not evaluated, see the checks)']
+    return [f'contact forces: from {info["source"]}, {info["samples"]} samples',
+            f'  {_extremes(info)}']
+
+
 def format_report(inspection):
     """The human-readable report of an :class:`Inspection` (several lines, no final newline)."""
     s = inspection.summary
@@ -83,6 +114,7 @@ def format_report(inspection):
         lines.append('diagnostics: none recorded')
     lines.append(f'samples: {s["samples"]} stamps shared by pose, contacts and rolling_state'
                  + (f' ({s["mode"]} mode)' if s['mode'] else ''))
+    lines.extend(_force_lines(s.get('contact_forces')))
     lines.append('checks:')
     for check in inspection.checks:
         lines.append(f'  {check.status}  {check.name:<14} {_value(check.value, check.unit)} '

@@ -3,7 +3,10 @@
 Topics are matched by the last component of their name (so a namespace is allowed):
 ``pose`` (PoseStamped: G and the body → world orientation), ``contact_a`` and ``contact_b``
 (PointStamped), ``rolling_state`` (JointState ``theta``, ``psi``, ``phase``: positions and
-rates) and ``diagnostics`` (DiagnosticArray, key ``energy``).
+rates), ``diagnostics`` (DiagnosticArray, key ``energy``) and, optional (recordings made
+before the contact forces lack them), ``wrench_a`` and ``wrench_b`` (WrenchStamped: the
+ground's force on the body at A and at B, world axes, N; applied at the contact point of the
+same stamp, so the torque is 0).
 """
 
 from dataclasses import dataclass
@@ -13,7 +16,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 __all__ = ['JOINT_NAMES', 'METADATA_NAME', 'SAMPLED', 'STAMP_TOLERANCE', 'Samples', 'Series',
-           'TOPIC_TYPES', 'extract_series', 'join_samples', 'select_topics', 'topic_role']
+           'TOPIC_TYPES', 'WRENCHES', 'extract_series', 'join_samples', 'select_topics',
+           'topic_role', 'values_at']
 
 #: The topics read, by the last component of their name, and the types they must have.
 TOPIC_TYPES = {
@@ -22,7 +26,11 @@ TOPIC_TYPES = {
     'contact_b': 'geometry_msgs/msg/PointStamped',
     'rolling_state': 'sensor_msgs/msg/JointState',
     'diagnostics': 'diagnostic_msgs/msg/DiagnosticArray',
+    'wrench_a': 'geometry_msgs/msg/WrenchStamped',
+    'wrench_b': 'geometry_msgs/msg/WrenchStamped',
 }
+#: Optional topics published with the samples: the contact forces at A and at B.
+WRENCHES = ('wrench_a', 'wrench_b')
 #: Topics published together at every step, at ``rate`` Hz; all are required (the
 #: diagnostics are only reported and plotted).
 SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
@@ -89,6 +97,10 @@ def _point_values(msg):
     return {'point': _xyz(msg.point)}
 
 
+def _wrench_values(msg):
+    return {'force': _xyz(msg.wrench.force), 'torque': _xyz(msg.wrench.torque)}
+
+
 def _joint_values(msg):
     names = list(msg.name)
     index = [names.index(name) for name in JOINT_NAMES]
@@ -122,6 +134,8 @@ _EXTRACT = {
     'contact_b': _point_values,
     'rolling_state': _joint_values,
     'diagnostics': _diagnostic_values,
+    'wrench_a': _wrench_values,
+    'wrench_b': _wrench_values,
 }
 
 
@@ -209,3 +223,25 @@ def join_samples(series, t0_ns):
         contact_b=series['contact_b'].values['point'][picked['contact_b']],
         angles=state['position'][picked['rolling_state']],
         rates=state['velocity'][picked['rolling_state']])
+
+
+def values_at(series, key, stamps):
+    """The values ``key`` of the first message of ``series`` at each of ``stamps`` (int ns).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        NaN where no message carries the stamp.
+    found : numpy.ndarray of bool
+    """
+    stamps = np.asarray(stamps, dtype=np.int64)
+    data = series.values.get(key) if series is not None else None
+    if data is None or len(series) == 0:
+        return np.full((stamps.size, 3), np.nan), np.zeros(stamps.size, dtype=bool)
+    firsts = _first_of_each(series.stamp_ns)
+    own = series.stamp_ns[firsts]
+    where = np.clip(np.searchsorted(own, stamps), 0, own.size - 1)
+    found = own[where] == stamps
+    values = np.where(found.reshape((-1,) + (1,) * (data.ndim - 1)),
+                      data[firsts[where]], np.nan)
+    return values, found

@@ -1,4 +1,5 @@
-"""The figure of ``twodisk-inspect --plot``: traces on the ground, height of G and energy.
+"""The figure of ``twodisk-inspect --plot``: traces on the ground, height of G, energy and,
+for recordings with contact forces, N_A, N_B and μ_required.
 
 Kept apart from :mod:`twodisk_ros.inspect` so that the checks never import matplotlib.
 """
@@ -21,7 +22,8 @@ def plot_inspection(inspection, path):
     left panel shows the traces of A and B and the path of G on the ground with equal aspect,
     as Figures 3-4 of the paper; on the right the height of G and the energy: from the
     recorded poses (central differences), exact E(u, u̇) from the rolling state, and the
-    node's diagnostics.
+    node's diagnostics; for a recording with contact forces, a panel of N_A/(M g), N_B/(M g)
+    and μ_required against the recorded friction μ.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -29,7 +31,8 @@ def plot_inspection(inspection, path):
     data = inspection.series
     figure = Figure(figsize=(14, 8), layout='constrained')
     FigureCanvasAgg(figure)
-    grid = figure.add_gridspec(3, 2, width_ratios=(1.3, 1.0))
+    rows = 4 if 't_forces' in data else 3
+    grid = figure.add_gridspec(rows, 2, width_ratios=(1.3, 1.0))
     ground = figure.add_subplot(grid[:, 0])
     height = figure.add_subplot(grid[0, 1])
     energy = figure.add_subplot(grid[1, 1], sharex=height)
@@ -73,8 +76,13 @@ def plot_inspection(inspection, path):
                        color='tab:red', label='diagnostics')
     energy.set_ylabel('energy (J)')
     drift.set_ylabel('(E − E₀) / (M g L)')
-    drift.set_xlabel('t (s)')
-    for axes in (ground, height, energy, drift):
+    panels = [ground, height, energy, drift]
+    if 't_forces' in data:
+        drift.set_xlabel('')
+        panels.append(_force_panel(figure.add_subplot(grid[3, 1], sharex=height), data))
+    else:
+        drift.set_xlabel('t (s)')
+    for axes in panels:
         axes.grid(True, lw=0.3)
         if len(axes.lines) > 1:
             axes.legend(loc='best', fontsize='small')
@@ -90,3 +98,27 @@ def plot_inspection(inspection, path):
         title += ' (truncated file)'
     figure.suptitle(title)
     figure.savefig(path, dpi=110)
+
+
+def _force_panel(axes, data):
+    """N_A/(M g), N_B/(M g) and, on a second axis, μ_required with the friction μ."""
+    t, weight = data['t_forces'], float(data['weight'])
+    axes.plot(t, data['normal_a'] / weight, color='tab:red', lw=1.0, label='N_A / W')
+    axes.plot(t, data['normal_b'] / weight, color='tab:blue', lw=1.0, label='N_B / W')
+    axes.axhline(0.0, color='k', lw=0.6)
+    axes.set_ylabel('normal force / W')
+    axes.set_xlabel('t (s)')
+    mu = data['mu_required']
+    finite = mu[mu < 1e300]
+    other = axes.twinx()
+    other.plot(t, mu, color='tab:green', lw=0.9, label='μ_required')
+    friction = float(data['friction'])
+    if friction < 1e300:
+        other.axhline(friction, color='tab:green', lw=0.8, ls='--', label='μ (friction)')
+    top = 1.2 * float(finite.max()) if finite.size else 1.0
+    if friction < 1e300:   # around μ: what exceeds 3 μ is clipped (it slips anyway)
+        top = max(min(top, 3.0 * friction), 1.5 * friction)
+    other.set_ylim(0.0, top if top > 0 else 1.0)
+    other.set_ylabel('μ_required')
+    other.legend(loc='upper right', fontsize='small')
+    return axes
