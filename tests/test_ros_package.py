@@ -121,8 +121,9 @@ def workspace(tmp_path_factory):
             shutil.copy2(src, source / name)
     colcon = VENV_BIN / 'colcon'
     result = subprocess.run(
-        [str(colcon), 'build', '--base-paths', 'src', '--build-base', 'build',
-         '--install-base', 'install', '--event-handlers', 'console_direct+'],
+        [str(colcon), 'build', '--packages-select', PACKAGE, '--base-paths', 'src',
+         '--build-base', 'build', '--install-base', 'install',
+         '--event-handlers', 'console_direct+'],
         cwd=root, env=_clean_env(COLCON_HOME=str(root / 'colcon_home'),
                                  COLCON_LOG_PATH=str(root / 'log')),
         capture_output=True, text=True, timeout=120)
@@ -231,3 +232,19 @@ def test_installed_executable_rejects_invalid_start_value(tmp_path, installed):
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
     assert result.returncode == 2, result.stderr
     assert len(result.stderr.splitlines()) == 1 and 'Traceback' not in result.stderr
+
+
+def test_readme_workspace_route_records_and_inspects(workspace, tmp_path):
+    """As the README: source install/setup.bash (colcon-bash), record a run, inspect it."""
+    setup = workspace / 'install' / 'setup.bash'
+    assert setup.is_file(), 'colcon-bash did not write install/setup.bash'
+    lib = workspace / 'install' / PACKAGE / 'lib' / PACKAGE
+    share = workspace / 'install' / PACKAGE / 'share' / PACKAGE
+    script = (f'source {setup} && {lib / "roller"} --ros-args --params-file '
+              f'{share / "config" / "oloid.yaml"} -p realtime:=false -p duration:=2.0 '
+              f'-p record:=run.mcap && {lib / "twodisk-inspect"} run.mcap')
+    result = subprocess.run(['bash', '-c', script], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=180,
+                            env=_clean_env(COLCON_HOME=str(tmp_path / 'colcon_home')))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert 'result: PASS' in result.stdout
