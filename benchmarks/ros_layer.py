@@ -85,28 +85,29 @@ def _status(ok):
 
 def report_lines(out):
     """The report's sections for these measurements (Markdown lines)."""
-    w = []
-    w.append('## Full poses and positions (the node\'s source)\n')
-    w.append('`RollingCycle.poses(u)` (G, A, B and the quaternion from the tables) and '
+    lines = []
+    w = lines.append
+    w('## Full poses and positions (the node\'s source)\n')
+    w('`RollingCycle.poses(u)` (G, A, B and the quaternion from the tables) and '
              '`positions(u)` on 10⁶ phases over three cycles, best of 5; errors against the '
              'independent reference (orientation as an angle). Targets: full poses '
              f'≥ {TARGET_POSES / 1e6:g} M/s, positions ≥ {TARGET_POSITIONS / 1e6:g} M/s, '
              '≤ 1e-10 of the size.\n')
-    w.append('| body | full poses (M/s) | positions (M/s) | position error / size | '
+    w('| body | full poses (M/s) | positions (M/s) | position error / size | '
              'orientation error (rad) | reference\'s own error | sign flips |')
-    w.append('|---|---|---|---|---|---|---|')
+    w('|---|---|---|---|---|---|---|')
     for p in out['poses']:
-        w.append(f'| {p.body} | {p.rate_poses / 1e6:.2f} | {p.rate_positions / 1e6:.2f} | '
+        w(f'| {p.body} | {p.rate_poses / 1e6:.2f} | {p.rate_positions / 1e6:.2f} | '
                  f'{p.position_error:.1e} | {p.orientation_error:.1e} | '
                  f'{p.reference_error:.1e} | {p.sign_flips} |')
     ok = all(p.rate_poses >= TARGET_POSES and p.rate_positions >= TARGET_POSITIONS
              and p.position_error <= 1e-10 for p in out['poses'])
-    w.append(f'\n**{_status(ok)}** (the machine is shared: rates vary by up to 2× between '
+    w(f'\n**{_status(ok)}** (the machine is shared: rates vary by up to 2× between '
              'runs).\n')
     b = out['batch']
     share = b.per_second / b.floor_rate
-    w.append('## Batch recording against the file format\n')
-    w.append(f'`roller` in process, `realtime:=false`, `rate:={b.rate_hz:g}`, '
+    w('## Batch recording against the file format\n')
+    w(f'`roller` in process, `realtime:=false`, `rate:={b.rate_hz:g}`, '
              f'`duration:={b.duration:g}`, every topic recorded (pose, contacts, rolling_state, '
              'wrenches at the rate; paths at 2 Hz with up to 1000 poses; markers at 10 Hz; '
              'diagnostics at 1 Hz); `run_batch` is timed, start-up excluded. In the same run, '
@@ -145,4 +146,4 @@ def report_lines(out):
     w('## Solid mass model\n')
     w('`solid_hull(..., rtol=1e-9)`, best of 3: ' + ', '.join(
         f'{name} {wall * 1e3:.1f} ms' for name, wall in out['solid'].items()) + '.\n')
-    return w
+    return lines
