@@ -87,15 +87,19 @@ def finite_differences(t, position, rotation, step):
     (1, −8, 0, 8, −1) / 12h), exact for polynomials of degree 4: the error is ~ h⁴/30 × the
     fifth derivative, i.e. ~ (ω h)⁴ relative for a body turning at ω.
     """
+    return _differences(t, position, rotation, step, order=1)
+
+
+def _differences(t, position, rotation, step, order):
+    """(index, d^order x / dt^order, d^order φ / dτ^order at τ = 0) on the five-point stencils."""
     found = _stencils(t, step)
     if found is None:
         return np.zeros(0, dtype=int), np.zeros((0, 3)), np.zeros((0, 3))
     index, around, offsets = found
-    weights = _weights(offsets, 1, step)
+    weights = _weights(offsets, order, step)
     displacement = position[around] - position[index][:, None, :]
-    velocity = np.einsum('kn,knj->kj', weights, displacement)
-    angular_velocity = np.einsum('kn,knj->kj', weights, _turns(rotation, index))
-    return index, velocity, angular_velocity
+    return (index, np.einsum('kn,knj->kj', weights, displacement),
+            np.einsum('kn,knj->kj', weights, _turns(rotation, index)))
 
 
 def second_differences(t, position, rotation, step):
@@ -118,15 +122,7 @@ def second_differences(t, position, rotation, step):
     For equal intervals the weights are (−1, 16, −30, 16, −1) / 12h², error ~ h⁴/90 × the
     sixth derivative: ~ (ω h)⁴ relative to the accelerations of a body turning at ω.
     """
-    found = _stencils(t, step)
-    if found is None:
-        return np.zeros(0, dtype=int), np.zeros((0, 3)), np.zeros((0, 3))
-    index, around, offsets = found
-    weights = _weights(offsets, 2, step)
-    displacement = position[around] - position[index][:, None, :]
-    acceleration = np.einsum('kn,knj->kj', weights, displacement)
-    angular_acceleration = np.einsum('kn,knj->kj', weights, _turns(rotation, index))
-    return index, acceleration, angular_acceleration
+    return _differences(t, position, rotation, step, order=2)
 
 
 @dataclass
