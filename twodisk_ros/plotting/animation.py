@@ -112,7 +112,7 @@ class _Scene:
         from mpl_toolkits.mplot3d.art3d import Poly3DCollection
         import matplotlib
         with matplotlib.rc_context({'grid.color': '0.86', 'grid.linewidth': 0.5}):
-            ax = self.ax = self.figure.add_axes((-0.05, 0.08, 1.1, 0.88), projection='3d')
+            ax = self.ax = self.figure.add_axes((-0.04, 0.13, 1.08, 0.82), projection='3d')
         ax.view_init(elev=24, azim=-58)
         for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
             axis.pane.set_facecolor((0.95, 0.95, 0.93, 1.0))
