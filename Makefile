@@ -21,12 +21,14 @@ $(VENV)/.installed: requirements.txt
 test: venv
 	$(PY) -m pytest
 
-## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot.
+## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
 demo: venv
 	mkdir -p out
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
 	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap
 	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png
+	$(PY) -m twodisk_ros.plotting.animation out/oloid.mcap -o out/oloid.gif \
+	    --stop 6 --fps 15 --size 480x360
 
 ## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
 figures: venv

@@ -11,7 +11,8 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/config',
+         glob('config/*.yaml') + glob('config/*.rviz') + glob('config/*.json')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -25,6 +26,7 @@ setup(
             'roller = twodisk_ros.roller:main',
             'twodisk-inspect = twodisk_ros.inspect.cli:main',
             'twodisk-figures = twodisk_ros.plotting.figures:main',
+            'twodisk-animate = twodisk_ros.plotting.animate_cli:main',
         ],
     },
 )

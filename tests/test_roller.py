@@ -198,13 +198,81 @@ def test_diagnostics_report_the_eight_equilibria(oloid_run):
         assert_equilibria_match(diag, TwoDiskBody(0.1, 0.1, 0.05))
 
 
+def _plane_and_polygon(outline):
+    """Centre, unit normal and 2-d polygon (in-plane coordinates) of a closed outline."""
+    centre = outline[:-1].mean(axis=0)
+    _, _, vt = np.linalg.svd(outline[:-1] - centre)
+    basis, normal = vt[:2], vt[2]
+    return centre, normal, basis, (outline - centre) @ basis.T
+
+
+def _inside_convex(points, polygon, tol):
+    """True for 2-d points inside a closed convex polygon (either orientation)."""
+    edges = np.diff(polygon, axis=0)
+    rel = points[:, None, :] - polygon[None, :-1, :]
+    cross = edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]
+    return np.all(cross >= -tol, axis=1) | np.all(cross <= tol, axis=1)
+
+
 def test_markers(oloid_run):
+    from visualization_msgs.msg import Marker
     assert oloid_run['markers']
+    size = TwoDiskBody(0.1, 0.1, 0.05).size
     for array in oloid_run['markers']:
+        arrows = [m for m in array.markers if m.ns == 'twodisk_forces']
+        assert [m.id for m in arrows] == [100, 101]          # the contact forces
         body = [m for m in array.markers if m.ns == 'twodisk']
-        assert [m.id for m in body] == [0, 1, 2]
-        assert [m.id for m in array.markers if m.ns == 'twodisk_forces'] == [100, 101]
+        assert [m.id for m in body] == [0, 1, 2, 3, 4]
+        assert [m.type for m in body] == [Marker.LINE_STRIP] * 2 + [
+            Marker.LINE_LIST] + [Marker.TRIANGLE_LIST] * 2
         assert all(m.header.frame_id == 'world' for m in array.markers)
+        for outline_marker, fill in ((array.markers[0], array.markers[3]),
+                                     (array.markers[1], array.markers[4])):
+            outline = np.array([xyz(p) for p in outline_marker.points])
+            assert np.allclose(outline[0], outline[-1])
+            vertices = np.array([xyz(p) for p in fill.points])
+            assert len(vertices) == 3 * (len(outline) - 1)
+            assert fill.color.a < 1.0 and fill.scale.x == fill.scale.y == fill.scale.z == 1.0
+            centre, normal, basis, polygon = _plane_and_polygon(outline)
+            # every triangle vertex lies in the disk's plane and inside its outline
+            assert np.max(np.abs((vertices - centre) @ normal)) < 1e-9 * size
+            assert _inside_convex((vertices - centre) @ basis.T, polygon, 1e-12).all()
+            # and the fan covers the disk: its area is the area of the outline polygon
+            tri = vertices.reshape(-1, 3, 3)
+            area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                        axis=1).sum()
+            x, y = polygon[:, 0], polygon[:, 1]
+            shoelace = 0.5 * abs(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1]))
+            assert abs(area - shoelace) < 1e-9 * shoelace
+        # the contact line joins A and B on the ground
+        assert all(abs(p.z) < 1e-12 for p in array.markers[2].points)
+
+
+def test_hull_marker_is_the_ruled_surface():
+    from twodisk_ros.node import messages
+    from twodisk_ros.node.parameters import DEFAULTS
+    from twodisk_ros.node.simulation import Simulation
+    from visualization_msgs.msg import Marker
+    simulation = Simulation(DEFAULTS.with_values(a=0.2, b=0.1, delta=0.1,
+                                                 mass_model='solid'))
+    rotation = simulation.rotation(simulation.sample([0.3]), 0)
+    g = np.array([0.5, -0.2, 0.09])
+    disk1, disk2 = simulation.disk_outlines(rotation, g)
+    rim_1, rim_2 = simulation.hull_rims(rotation, g)
+    array = messages.body_markers('world', 0, disk1, disk2, disk1[0], disk2[0], 0.3,
+                                  hull=(rim_1, rim_2))
+    hull = array.markers[-1]
+    assert (hull.id, hull.type) == (5, Marker.TRIANGLE_LIST)
+    body = (np.array([xyz(p) for p in hull.points]) - g) @ rotation   # body frame
+    a, b, d = 0.2, 0.1, 0.1
+    x1, x2, x3 = body.T
+    on_1 = (np.abs(x3) < 1e-12) & np.isclose((x1 / b)**2 + ((x2 + d) / a)**2, 1.0)
+    on_2 = (np.abs(x1) < 1e-12) & np.isclose((x3 / b)**2 + ((x2 - d) / a)**2, 1.0)
+    assert np.all(on_1 | on_2)          # every vertex on the rim of disk 1 or of disk 2
+    assert on_1.sum() >= len(body) // 2 - 2 and on_2.sum() >= len(body) // 2 - 2
+    # without hull, no id 5; the old positional call still works
+    plain = messages.body_markers('world', 0, disk1, disk2, disk1[0], disk2[0], 0.3)
+    assert [m.id for m in plain.markers] == [0, 1, 2, 3, 4]
 
 
 def test_paths_grow_and_are_bounded(oloid_run):

@@ -71,15 +71,74 @@ def _line_marker(frame_id, time_ns, marker_id, kind, points, rgba, width):
     return marker
 
 
-def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size):
-    """Both disk outlines (LINE_STRIP, world points, m) and the contact line AB (LINE_LIST)."""
+#: Marker ids of :func:`body_markers` (namespace ``twodisk``).
+MARKER_IDS = {'outline_1': 0, 'outline_2': 1, 'contact_line': 2, 'disk_1': 3, 'disk_2': 4,
+              'hull': 5}
+DISK_COLORS = ((0.12, 0.37, 0.66), (0.85, 0.38, 0.17))    # disk 1 blue, disk 2 orange
+
+
+def _closed(outline):
+    """The outline with its last point equal to the first (appended if it is not there)."""
+    outline = np.asarray(outline, dtype=float)
+    extent = float(np.ptp(outline, axis=0).max()) if len(outline) else 0.0
+    if len(outline) > 1 and np.linalg.norm(outline[-1] - outline[0]) <= 1e-9 * extent:
+        return outline
+    return np.vstack([outline, outline[:1]])
+
+
+def _fan(outline):
+    """Triangles (centre, p_k, p_k+1) filling a convex closed outline: a (3k, 3) array.
+
+    The centre is the mean of the outline's points (the duplicate last point dropped).
+    """
+    outline = _closed(outline)
+    centre = outline[:-1].mean(axis=0)
+    count = len(outline) - 1
+    triangles = np.empty((count, 3, 3))
+    triangles[:, 0] = centre
+    triangles[:, 1] = outline[:-1]
+    triangles[:, 2] = outline[1:]
+    return triangles.reshape(-1, 3)
+
+
+def _strip(rim_1, rim_2):
+    """Triangles of the ruled surface between matching points of two closed curves."""
+    p, q = np.asarray(rim_1, dtype=float), np.asarray(rim_2, dtype=float)
+    quads = np.stack([p[:-1], p[1:], q[1:], p[:-1], q[1:], q[:-1]], axis=1)
+    return quads.reshape(-1, 3)
+
+
+def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size, *,
+                 filled=True, alpha=0.6, hull=None):
+    """The body as markers (world points, m), namespace ``twodisk``, ids :data:`MARKER_IDS`.
+
+    0, 1: the disk outlines (LINE_STRIP); 2: the contact line AB (LINE_LIST); 3, 4 (if
+    ``filled``): each disk as a filled surface, a fan of triangles from its centre over its
+    outline (TRIANGLE_LIST, disk 1 blue, disk 2 orange, opacity ``alpha``); 5 (if ``hull`` is
+    given): the convex hull as a TRIANGLE_LIST strip between ``hull = (rim_1, rim_2)``,
+    matching points of the two rims (arrays (n + 1, 3), closed), e.g. the end points A and B
+    of the rulings over one cycle (:meth:`~twodisk_ros.node.simulation.Simulation.hull_rims`).
+    ``disk1``, ``disk2``: closed outlines, arrays (n + 1, 3) with the last point the first.
+    """
     width = 0.01 * size
-    return MarkerArray(markers=[
-        _line_marker(frame_id, time_ns, 0, Marker.LINE_STRIP, disk1, (0.1, 0.4, 0.9, 1.0), width),
-        _line_marker(frame_id, time_ns, 1, Marker.LINE_STRIP, disk2, (0.9, 0.4, 0.1, 1.0), width),
+    (r1, g1, b1), (r2, g2, b2) = DISK_COLORS
+    markers = [
+        _line_marker(frame_id, time_ns, 0, Marker.LINE_STRIP, disk1, (r1, g1, b1, 1.0), width),
+        _line_marker(frame_id, time_ns, 1, Marker.LINE_STRIP, disk2, (r2, g2, b2, 1.0), width),
         _line_marker(frame_id, time_ns, 2, Marker.LINE_LIST, [contact_a, contact_b],
                      (0.1, 0.7, 0.2, 1.0), width),
-    ])
+    ]
+    surfaces = []
+    if filled:
+        surfaces += [(3, _fan(disk1), (r1, g1, b1, alpha)), (4, _fan(disk2), (r2, g2, b2, alpha))]
+    if hull is not None:
+        surfaces.append((5, _strip(*hull), (0.6, 0.6, 0.62, 0.35)))
+    for marker_id, triangles, rgba in surfaces:
+        marker = _line_marker(frame_id, time_ns, marker_id, Marker.TRIANGLE_LIST, triangles,
+                              rgba, 1.0)
+        marker.scale.y = marker.scale.z = 1.0
+        markers.append(marker)
+    return MarkerArray(markers=markers)
 
 
 def diagnostics(time_ns, name, level, message, values):

@@ -253,9 +253,11 @@ class Roller(Node):
             return
         rotation = self.simulation.rotation(sample, i)
         disk1, disk2 = self.simulation.disk_outlines(rotation, sample.position_g[i])
+        hull = (self.simulation.hull_rims(rotation, sample.position_g[i])
+                if self.settings.mass_model == 'solid' else None)
         message = messages.body_markers(self.settings.frame_id, time_ns, disk1, disk2,
                                         sample.contact_a[i], sample.contact_b[i],
-                                        self.simulation.body.size)
+                                        self.simulation.body.size, hull=hull)
         if sample.forces is not None:
             message.markers.extend(messages.force_arrows(
                 self.settings.frame_id, time_ns, (sample.contact_a[i], sample.contact_b[i]),

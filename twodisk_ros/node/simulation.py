@@ -180,3 +180,13 @@ class Simulation:
         disk1 = np.stack([b * np.sin(s), -d - a * np.cos(s), 0 * s], -1)
         disk2 = np.stack([0 * s, d + a * np.cos(s), b * np.sin(s)], -1)
         return disk1 @ rotation.T + position_g, disk2 @ rotation.T + position_g
+
+    def hull_rims(self, rotation, position_g, points=64):
+        """World end points A, B of the hull's rulings over one cycle: two arrays (points + 1, 3).
+
+        The convex hull of the disks is ruled by the contact segments AB of the rolling
+        cycle (:mod:`~twodisk_ros.physics.hull`); for the hull marker of ``body_markers``.
+        """
+        u = np.linspace(0.0, 2 * np.pi, points + 1)
+        r1, r2 = self.body.phase_vectors(u)[:2]
+        return r1 @ rotation.T + position_g, r2 @ rotation.T + position_g

@@ -22,6 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after selecting the backend)
 import numpy as np  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 
 from ..physics.body import TwoDiskBody  # noqa: E402
 from ..physics.cycle import RollingCycle  # noqa: E402
@@ -47,6 +48,10 @@ plt.rcParams.update({
 
 def _describe(body):
     return f'a = {body.a:.4g} m, b = {body.b:.4g} m, Δ = {body.delta:.4g} m'
+
+
+def _cycles(count):
+    return '1 cycle' if count == 1 else f'{count} cycles'
 
 
 def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, name=None):
@@ -86,15 +91,18 @@ def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, 
     cusp_u = np.arange(2 * cycles + 1) * math.pi
     _, _, b_cusp = cycle.positions(cusp_u)
     _, a_cusp, _ = cycle.positions(cusp_u[:-1] + math.pi / 2)
-    ax.plot(a_cusp[:, 0], a_cusp[:, 1], 'v', color=COLOR_A, ms=4, zorder=4, label='cusps')
-    ax.plot(b_cusp[:, 0], b_cusp[:, 1], '^', color=COLOR_B, ms=4, zorder=4)
+    ax.plot(a_cusp[:, 0], a_cusp[:, 1], 'v', color=COLOR_A, ms=4, zorder=4,
+            label='cusps of A (turning points)')
+    ax.plot(b_cusp[:, 0], b_cusp[:, 1], '^', color=COLOR_B, ms=4, zorder=4,
+            label='cusps of B (θ = 0)')
     ax.set_aspect('equal', adjustable='box')
     ax.set_xlabel('X (m)')
     ax.set_ylabel('Y (m)')
     prefix = f'{name}: ' if name else ''
-    ax.set_title(f'{prefix}{_describe(body)}; {cycles} cycles, '
-                 f'{cycle.displacement.shift.real:.4f} m per cycle')
-    ax.legend(loc='upper center', bbox_to_anchor=(0.5, 0.0), borderaxespad=3.6, ncol=4,
+    ax.set_title(f'{prefix}{_describe(body)}\n{_cycles(cycles)} of the phase u (0 to '
+                 f'{2 * cycles}π), one lobe of each trace per half-cycle; '
+                 f'{cycle.displacement.shift.real:.5g} m along X per cycle')
+    ax.legend(loc='upper center', bbox_to_anchor=(0.5, 0.0), borderaxespad=3.6, ncol=3,
               frameon=False)
     return ax
 
@@ -165,13 +173,18 @@ def plot_height(bodies, ax, samples=1441, annotate=0):
     curves = ax.legend(loc='upper left', bbox_to_anchor=(1.01, 1.0), frameon=False,
                        title='body')
     ax.add_artist(curves)
-    keys = [Line2D([], [], marker=m, color='0.3', ls='none', mfc='0.3', label=text)
-            for m, text in _FAMILY_LABELS.items()]
-    keys += [Line2D([], [], marker='o', color='0.3', ls='none', mfc='0.3', label='stable'),
-             Line2D([], [], marker='o', color='0.3', ls='none', mfc='white', label='unstable'),
-             Line2D([], [], marker='x', color='0.3', ls='none', label='neutral')]
-    ax.legend(handles=keys, loc='lower left', bbox_to_anchor=(1.01, 0.0), frameon=False,
-              title='equilibria')
+    # two keys: the shape gives the kind of equilibrium, the fill its stability
+    shapes = [Line2D([], [], marker=m, color='0.35', ls='none', mfc='0.8', mec='0.35',
+                     label=text) for m, text in _FAMILY_LABELS.items()]
+    kinds = ax.legend(handles=shapes, loc='center left', bbox_to_anchor=(1.01, 0.5),
+                      frameon=False, title='shape: kind of equilibrium')
+    ax.add_artist(kinds)
+    fills = [Patch(fc='0.3', ec='0.3', label='filled: stable'),
+             Patch(fc='white', ec='0.3', label='hollow: unstable'),
+             Line2D([], [], marker='x', color='0.3', ls='none',
+                    label='×: neutral (z_G constant)')]
+    ax.legend(handles=fills, loc='lower left', bbox_to_anchor=(1.01, -0.02), frameon=False,
+              title='fill: stability', handlelength=1.2)
     return ax
 
 

@@ -1,0 +1,132 @@
+"""``twodisk-animate``: GIFs from the library and from a recording, and its input errors."""
+
+import os
+from pathlib import Path
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image, ImageChops
+
+from twodisk_ros.plotting import animation
+from twodisk_ros.plotting.runs import RunError, library_run, recorded_run, settings_from
+
+REPO = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='94',
+           MPLBACKEND='Agg')
+SIZE = (160, 120)
+
+
+def _frames(path):
+    """The frames of a GIF as RGB images."""
+    with Image.open(path) as image:
+        frames = []
+        for k in range(image.n_frames):
+            image.seek(k)
+            frames.append(image.convert('RGB'))
+    return frames
+
+
+def _check_gif(path, count):
+    frames = _frames(path)
+    assert len(frames) == count
+    assert frames[0].size == SIZE
+    for first, second in zip(frames, frames[1:]):
+        assert ImageChops.difference(first, second).getbbox() is not None
+
+
+@pytest.fixture(scope='module')
+def recording(tmp_path_factory):
+    out = tmp_path_factory.mktemp('anim') / 'run.mcap'
+    made = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
+         '-p', 'duration:=1.0', '-p', f'record:={out}'],
+        cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
+    assert made.returncode == 0, made.stderr
+    return out
+
+
+def test_frame_times():
+    assert np.allclose(animation.frame_times(0.0, 0.5, 8), np.arange(5) / 8)
+    assert len(animation.frame_times(1.0, 1.05, 10)) == 1
+
+
+@pytest.mark.parametrize('view', ['3d', 'top'])
+def test_library_gif(tmp_path, view):
+    settings = settings_from(REPO / 'config' / 'oloid.yaml')
+    run = library_run(settings, stop=0.6, forces=True)
+    assert run.force_a.shape == run.contact_a.shape
+    # the normal forces carry the weight on average (gravity only: no drive)
+    assert 0.5 < np.mean(run.force_a[:, 2] + run.force_b[:, 2]) / run.weight < 1.5
+    out = tmp_path / f'{view}.gif'
+    count = animation.animate(run, out, start=0.1, stop=0.5, fps=10, view=view, size=SIZE,
+                              forces=True)
+    assert count == 5
+    _check_gif(out, 5)
+
+
+def test_settings_are_simulated(tmp_path):
+    out = tmp_path / 'settings.gif'
+    assert animation.animate(settings_from(mode='kinematic', omega0=4.0), out, stop=0.3,
+                             fps=10, size=SIZE, camera='follow') == 4
+    _check_gif(out, 4)
+
+
+def test_recording_gif_cli(recording, tmp_path):
+    run = recorded_run(recording)
+    assert len(run) >= 100 and run.t[0] == 0.0
+    assert np.allclose(run.contact_a[:, 2], 0.0, atol=1e-12)
+    out = tmp_path / 'rec.gif'
+    result = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.plotting.animation', str(recording), '-o',
+         str(out), '--stop', '0.9', '--fps', '5', '--size', '160x120', '--view', 'top'],
+        cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
+    assert result.returncode == 0, result.stderr
+    assert 'rec.gif: 5 frames' in result.stdout
+    _check_gif(out, 5)
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', *args],
+                          cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
+
+
+@pytest.mark.parametrize('args, words', [
+    (['/nonexistent/run.mcap', '-o', 'x.gif'], 'cannot read'),
+    (['--params-file', '/nonexistent.yaml', '-o', 'x.gif'], 'cannot read params file'),
+    (['-o', 'x.gif', '--start', '3', '--stop', '2'], 'start < stop'),
+    (['-o', 'x.gif', '--stop', '-1'], 'start < stop'),
+    (['-o', '/nonexistent/dir/x.gif', '--stop', '0.2'], 'does not exist'),
+    (['-o', 'x.png', '--stop', '0.2'], '.gif or .mp4'),
+    (['-o', 'x.gif', '--size', 'big'], 'WIDTHxHEIGHT'),
+    (['-o', 'x.gif', '--delta', '0.5'], 'delta/a'),
+    (['-o', 'x.gif', '--fps', '0'], 'fps'),
+])
+def test_bad_input_one_line_exit_2(tmp_path, args, words):
+    result = subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', *args],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                            env=dict(ENV, PYTHONPATH=str(REPO)))
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], result.stderr
+    assert not (tmp_path / 'x.gif').exists()
+
+
+def test_recording_span_past_its_end(recording, tmp_path):
+    with pytest.raises(RunError, match='run ends'):
+        animation.animate(recorded_run(recording), tmp_path / 'x.gif', stop=5.0, size=SIZE)
+
+
+@pytest.mark.skipif(shutil.which('ffmpeg') is None, reason='ffmpeg is not installed')
+def test_mp4(tmp_path):
+    out = tmp_path / 'run.mp4'
+    assert animation.animate(library_run(stop=0.3), out, fps=10, size=SIZE) == 4
+    assert out.stat().st_size > 1000
+
+
+@pytest.mark.skipif(shutil.which('ffmpeg') is not None, reason='ffmpeg is installed')
+def test_mp4_without_ffmpeg(tmp_path):
+    with pytest.raises(RunError, match='ffmpeg'):
+        animation.animate(library_run(stop=0.3), tmp_path / 'run.mp4', size=SIZE)
