@@ -25,6 +25,7 @@ setup(
             'roller = twodisk_ros.roller:main',
             'twodisk-inspect = twodisk_ros.inspect.cli:main',
             'twodisk-figures = twodisk_ros.plotting.figures:main',
+            'twodisk-sweep = twodisk_ros.sweep.cli:main',
         ],
     },
 )
