@@ -135,8 +135,8 @@ def main(argv=None):
     try:
         args = _parser().parse_args(argv)
         workers = None if args.workers is None else _integer('--workers', args.workers)
-        from .parts import PartsMismatch
-        from .run import SweepError, dask_client, run_sweep
+        from .parts import PartsCache, PartsMismatch
+        from .run import SweepError, dask_client, parts_folder, run_sweep
         try:
             spec = _spec(args)
         except SweepError as error:
@@ -150,8 +150,14 @@ def main(argv=None):
         return _fail(f'cannot write plots: {refusal}')
     progress = None if args.quiet else sys.stderr
     try:
+        PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
+    except PartsMismatch as error:
+        return _fail(error)
+    except OSError as error:
+        return _fail(f'cannot write {args.out}.parts/: {error.strerror or error}')
+    try:
         with dask_client(args.scheduler, workers) as client:
-            run = run_sweep(spec, client, out=args.out, progress=progress, fresh=args.fresh,
+            run = run_sweep(spec, client, out=args.out, progress=progress,
                             keep_parts=args.keep_parts)
     except (SweepError, PartsMismatch) as error:
         return _fail(error)

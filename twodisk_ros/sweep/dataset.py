@@ -74,6 +74,11 @@ def write_netcdf(dataset, path):
 
 
 def read_netcdf(path):
-    """The Dataset of a sweep file, loaded into memory (the file is closed on return)."""
+    """The Dataset of a sweep file, in memory, variables in the order written (file closed)."""
     with xr.open_dataset(path, engine='scipy') as dataset:
-        return dataset.load()
+        dataset = dataset.load()
+    order = [name for name in (*VARIABLES, 'failure') if name in dataset.data_vars]
+    dataset = dataset[order + [n for n in dataset.data_vars if n not in order]]
+    if 'failure' in dataset:
+        dataset['failure'] = dataset['failure'].astype(str)
+    return dataset

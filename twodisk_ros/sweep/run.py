@@ -196,7 +196,11 @@ def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
         else:
             cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1,
                                    threads_per_worker=1, processes=True, host='127.0.0.1',
-                                   dashboard_address=None, silence_logs=logging.CRITICAL)
+                                   dashboard_address=None, silence_logs=logging.CRITICAL,
+                                   # no dashboard; the scheduler's health routes on a free
+                                   # port of 127.0.0.1 (not 8787, which others may use)
+                                   scheduler_kwargs={'dashboard': False,
+                                                     'dashboard_address': '127.0.0.1:0'})
             client = Client(cluster, set_as_default=False)
         try:
             yield client
