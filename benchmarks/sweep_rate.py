@@ -15,6 +15,7 @@ listens on 127.0.0.1 only and is closed before the script ends.
 """
 
 import math
+import os
 import tempfile
 import time
 
@@ -81,6 +82,7 @@ def rate(workers):
 
 def main():
     n, per_body, stages = stage_costs()
+    print(f'load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores')
     print(f'cost per body, serial, {n} bodies of b/a in {B_RANGE}, delta/a in {D_RANGE}:')
     print(f'  total {1e3 * per_body:.1f} ms per body')
     for stage, seconds in stages.items():
@@ -114,12 +116,15 @@ def main():
     print(f'1000 x 1000 map ({bodies} bodies, {chunks} chunks of {DEFAULT_CHUNK_SIZE}); '
           f'T(N) = max(B c / N, chunks (s + o)) with c = {1e3 * c:.1f} ms/body (1-worker '
           f'run), s = {1e3 * save:.2f} ms (save), o = {1e3 * overhead:.2f} ms (round trip); '
-          f'same kind of cores, perfect scaling beyond the measured 2-worker efficiency:')
+          f'N dedicated cores like this one, ideal scaling (divide by the efficiency '
+          f'measured on your cluster):')
     for workers in (1, 2, 8, 32, 128, 512):
         compute = bodies * c / workers
         total = max(compute, client_floor)
         print(f'  N = {workers:4d}: {total / 3600:7.2f} h'
               + ('   (client-bound)' if client_floor > compute else ''))
+    print(f'load average after: {os.getloadavg()[0]:.2f} (other jobs on the machine lower the '
+          f'2-worker rate)')
 
 
 if __name__ == '__main__':
