@@ -294,6 +294,7 @@ def test_unreachable_scheduler_exit_2_fast(tmp_path):
     assert len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert 'cannot reach the Dask scheduler' in result.stderr
     assert time.monotonic() - start < 30
+    assert not (tmp_path / 'x.nc.parts').exists()
 
 
 @pytest.mark.slow

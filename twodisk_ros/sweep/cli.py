@@ -150,7 +150,7 @@ def main(argv=None):
         return _fail(f'cannot write plots: {refusal}')
     progress = None if args.quiet else sys.stderr
     try:
-        PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
+        cache = PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
     except PartsMismatch as error:
         return _fail(error)
     except OSError as error:
@@ -160,6 +160,8 @@ def main(argv=None):
             run = run_sweep(spec, client, out=args.out, progress=progress,
                             keep_parts=args.keep_parts)
     except (SweepError, PartsMismatch) as error:
+        if not cache.finished():
+            cache.remove()    # nothing to resume: leave no empty cache behind
         return _fail(error)
     except OSError as error:
         return _fail(f'cannot write {args.out}: {error}')
