@@ -5,8 +5,9 @@ Measured on one representative map, b/a ∈ [0.2, 3], Δ/a ∈ [0.05, 0.95] (no 
 1. the cost per body split by quantity (stage), serial, in this process (no Dask);
 2. the scheduling overhead per task (empty tasks on a 2-worker LocalCluster) and the client's
    cost per finished chunk (saving it to the resume cache);
-3. bodies per second with 1 and 2 worker processes (cluster start-up excluded, reported
-   apart), and the parallel efficiency rate(2) / (2 rate(1));
+3. bodies per second with 1 and 2 worker processes (start-up excluded and reported apart:
+   the cluster and the workers' first import of the physics), and the parallel efficiency rate(2) / (2 rate(1));
+   (CPU/wall in the tasks below 1 means other jobs took the cores: contention, not Dask);
 4. the wall time of a 100 × 100 map, extrapolated from the measured 2-worker rate;
 5. a projection for a 1000 × 1000 map on N workers (model printed with the numbers).
 
@@ -34,6 +35,10 @@ def _grid(shape):
     return np.linspace(*B_RANGE, shape[0]), np.linspace(*D_RANGE, shape[1])
 
 
+def _import_physics():
+    import twodisk_ros.sweep.quantities  # noqa: F401  (the workers' one-time imports)
+
+
 def _noop(x):
     return x
 
@@ -41,13 +46,14 @@ def _noop(x):
 def stage_costs():
     b, d = _grid(RATE_GRID)
     timings = {}
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     for bi in b:
         for di in d:
             body_quantities(bi, di, timings=timings)
     total = time.perf_counter() - start
     n = b.size * d.size
-    return n, total / n, {stage: timings.get(stage, 0.0) / n for stage in STAGES}
+    share = (time.process_time() - cpu) / total
+    return n, total / n, share, {stage: timings.get(stage, 0.0) / n for stage in STAGES}
 
 
 def task_overhead(client):
@@ -73,6 +79,7 @@ def rate(workers):
     start = time.perf_counter()
     with dask_client(workers=workers) as client:
         client.wait_for_workers(workers)
+        client.run(_import_physics)
         startup = time.perf_counter() - start
         overhead = task_overhead(client) if workers == 2 else math.nan
         with tempfile.TemporaryDirectory() as folder:
@@ -81,10 +88,10 @@ def rate(workers):
 
 
 def main():
-    n, per_body, stages = stage_costs()
+    n, per_body, share, stages = stage_costs()
     print(f'load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores')
     print(f'cost per body, serial, {n} bodies of b/a in {B_RANGE}, delta/a in {D_RANGE}:')
-    print(f'  total {1e3 * per_body:.1f} ms per body')
+    print(f'  total {1e3 * per_body:.1f} ms per body (wall; CPU/wall {share:.2f})')
     for stage, seconds in stages.items():
         print(f'  {stage:16s} {1e3 * seconds:7.2f} ms  ({100 * seconds / per_body:4.1f} %)')
     save = client_cost_per_chunk()
@@ -96,8 +103,9 @@ def main():
         r, seconds, startup, _, run = results[workers]
         print(f'{workers} worker(s): {r:.2f} bodies/s ({RATE_GRID[0]}x{RATE_GRID[1]} = '
               f'{RATE_GRID[0] * RATE_GRID[1]} bodies in {seconds:.2f} s, chunks of '
-              f'{DEFAULT_CHUNK_SIZE}: median task {np.median(run.chunk_seconds):.2f} s); '
-              f'cluster start-up {startup:.2f} s')
+              f'{DEFAULT_CHUNK_SIZE}: median task {np.median(run.chunk_seconds):.2f} s, '
+              f'CPU/wall in the tasks {sum(run.chunk_cpu_seconds) / sum(run.chunk_seconds):.2f}'
+              f'); cluster start-up {startup:.2f} s')
     overhead = results[2][3]
     efficiency = results[2][0] / (2 * results[1][0])
     print(f'parallel efficiency with 2 workers: {efficiency:.2f} (rate(2) / (2 rate(1))); '

@@ -2,7 +2,8 @@
 
 The grid (b/a × Δ/a, inclusive as :func:`numpy.linspace`) is flattened in C order (b/a major)
 and cut into chunks of consecutive points; each chunk is one Dask task running
-:func:`~twodisk_ros.sweep.quantities.chunk_quantities` on a worker. Results come back to the
+:func:`~twodisk_ros.sweep.quantities.timed_chunk` on a worker (which imports the physics
+only, not xarray). Results come back to the
 client, which saves each finished chunk in the resume cache
 (:class:`~twodisk_ros.sweep.parts.PartsCache`, ``FILE.nc.parts/``) as it completes, so
 workers need no shared file system and an interrupted sweep recomputes only the chunks it had
@@ -28,7 +29,7 @@ import numpy as np
 from .. import __version__
 from .dataset import build_dataset, write_netcdf
 from .parts import PartsCache
-from .quantities import MASS_MODELS, VARIABLES, chunk_quantities
+from .quantities import MASS_MODELS, VARIABLES, timed_chunk
 
 __all__ = ['SweepSpec', 'SweepRun', 'SweepError', 'linspace_grid', 'dask_client', 'run_sweep',
            'parts_folder', 'DEFAULT_CHUNK_SIZE', 'CONNECT_TIMEOUT']
@@ -154,6 +155,7 @@ class SweepRun:
     seconds: float            #: wall time (s)
     output: Path = None       #: the NetCDF file written, if any
     chunk_seconds: list = field(default_factory=list)   #: wall time per computed chunk (s)
+    chunk_cpu_seconds: list = field(default_factory=list)   #: worker CPU time per chunk (s)
 
 
 def parts_folder(out):
@@ -292,19 +294,20 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
     futures = {}
     for index in todo:
         part = chunks[index]
-        future = client.submit(_timed_chunk, b_flat[part], d_flat[part], spec.mass_model,
+        future = client.submit(timed_chunk, b_flat[part], d_flat[part], spec.mass_model,
                                spec.reference_speed, pure=False)
         futures[future] = index
-    computed, chunk_seconds = 0, []
+    computed, chunk_seconds, chunk_cpu = 0, [], []
     try:
         for future in as_completed(futures, loop=client.loop):
             index = futures[future]
-            result, seconds = future.result()
+            result, seconds, cpu = future.result()
             store(index, result)
             if cache is not None:
                 cache.save(index, result)
             computed += 1
             chunk_seconds.append(seconds)
+            chunk_cpu.append(cpu)
             bar.update(chunks[index].stop - chunks[index].start)
             if on_chunk is not None:
                 on_chunk(index, computed)
@@ -323,11 +326,4 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
         if not keep_parts:
             cache.remove()
     return SweepRun(dataset, computed, len(done), time.perf_counter() - started, written,
-                    chunk_seconds)
-
-
-def _timed_chunk(b_values, delta_values, mass_model, reference_speed):
-    """(chunk_quantities(...), wall time in s): the task run on a worker."""
-    start = time.perf_counter()
-    result = chunk_quantities(b_values, delta_values, mass_model, reference_speed)
-    return result, time.perf_counter() - start
+                    chunk_seconds, chunk_cpu)
