@@ -27,6 +27,7 @@ setup(
             'twodisk-inspect = twodisk_ros.inspect.cli:main',
             'twodisk-figures = twodisk_ros.plotting.figures:main',
             'twodisk-animate = twodisk_ros.plotting.animate_cli:main',
+            'twodisk-sweep = twodisk_ros.sweep.cli:main',
         ],
     },
 )

@@ -1,0 +1,329 @@
+"""Parameter sweeps on Dask (twodisk_ros.sweep): exact agreement, distributed, resume, input.
+
+Every scheduler and worker listens on 127.0.0.1 only; every process a test starts is stopped
+in a ``finally`` (terminate, wait, kill).
+"""
+
+import json
+import math
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.contact_forces import ContactForceModel
+from twodisk_ros.physics.contact_validity import liftoff_speed, mu_required_kinematic
+from twodisk_ros.physics.cycle import RollingCycle
+from twodisk_ros.physics.dynamics import RollingDynamics
+from twodisk_ros.physics.equilibria import STABLE
+from twodisk_ros.physics.mass_models import mass_properties
+from twodisk_ros.sweep.cli import main
+from twodisk_ros.sweep.dataset import read_netcdf
+from twodisk_ros.sweep.quantities import VARIABLES, contact_length_range
+from twodisk_ros.sweep.run import SweepSpec, dask_client, parts_folder, run_sweep
+
+REPO = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get('PYTHONPATH', ''))
+ENV.pop('DASK_SCHEDULER_ADDRESS', None)
+DASK = str(Path(sys.executable).with_name('dask'))
+# b/a = 0.5, 1, 1.5; Δ/a = 0.25, 0.5, 0.75, 1 (the oloid (1, 0.5) and masked Δ/a = 1 points)
+B_GRID = ('0.5', '1.5', '3')
+D_GRID = ('0.25', '1', '4')
+CHUNK = 3
+
+
+def _spec():
+    return SweepSpec(np.linspace(0.5, 1.5, 3), np.linspace(0.25, 1.0, 4), chunk_size=CHUNK)
+
+
+@pytest.fixture(scope='module')
+def client():
+    with dask_client(workers=2) as c:
+        yield c
+
+
+@pytest.fixture(scope='module')
+def local(client):
+    return run_sweep(_spec(), client, progress=None).dataset
+
+
+def _direct(b, d, reference_speed=0.5):
+    """The sweep's quantities of one body by direct library calls (a = g = M = 1)."""
+    body = TwoDiskBody(1.0, b, d)
+    cycle = RollingCycle(body)
+    dyn = RollingDynamics(body, mass_properties('laminae', 1.0, b, d, 1.0), 1.0, cycle=cycle)
+    found = dyn.equilibria_with_periods()
+    heights = [eq.height for eq, _ in found]
+    u_star, period = next((eq.phase, p) for eq, p in found if eq.stability == STABLE)
+    barrier = max(heights) - min(heights)
+    n = dyn.table_size
+    u = 2 * math.pi * np.arange(n) / n
+    model = ContactForceModel(dyn)
+    low, high = contact_length_range(body, n)
+    return {
+        'theta_max': body.theta_max, 'stability_margin': body.stability_margin,
+        'height_min': min(heights), 'height_max': max(heights), 'barrier': barrier,
+        'rollover_speed': float(dyn.angular_speed_per_phase(u_star))
+        * math.sqrt(2 * barrier / float(dyn.effective_mass(u_star))),
+        'oscillation_period': period, 'cycle_advance': abs(cycle.displacement.shift),
+        'cycle_heading': cycle.displacement.turn,
+        'cycle_time': float(np.sum(dyn.angular_speed_per_phase(u)) * (2 * math.pi / n)),
+        'contact_length_min': low, 'contact_length_max': high,
+        'liftoff_speed': liftoff_speed(model)[0],
+        'mu_required': float(mu_required_kinematic(model, reference_speed)),
+    }
+
+
+def _same(x, y):
+    """Bitwise-equal datasets (NaN equal to NaN), every variable and attribute."""
+    assert list(x.data_vars) == list(y.data_vars)
+    for name in x.data_vars:
+        assert x[name].attrs.keys() == y[name].attrs.keys()
+        np.testing.assert_array_equal(x[name].values, y[name].values, err_msg=name)
+    np.testing.assert_array_equal(x['b_over_a'].values, y['b_over_a'].values)
+    np.testing.assert_array_equal(x['delta_over_a'].values, y['delta_over_a'].values)
+
+
+def test_sweep_points_equal_direct_library_calls(local):
+    for b, d in [(1.0, 0.5), (1.5, 0.25), (0.5, 0.75)]:
+        point = local.sel(b_over_a=b, delta_over_a=d)
+        assert str(point['failure'].values) == ''
+        for name, value in _direct(b, d).items():
+            assert float(point[name]) == value, (b, d, name)
+
+
+def test_sweep_closed_forms(local):
+    b = local['b_over_a'].values[:, None]
+    d = local['delta_over_a'].values[None, :]
+    ok = d < 1
+    margin = b * b - 2 + 2 * d * d
+    assert np.array_equal(np.sign(margin)[np.broadcast_to(ok, margin.shape)],
+                          local['stable_family'].values[np.broadcast_to(ok, margin.shape)])
+    np.testing.assert_allclose(local['stability_margin'].values[:, :3], margin[:, :3],
+                               rtol=0, atol=1e-15)
+    cos_max = -1 / np.sqrt(1 + 4 * d * b * b + 4 * d * d * b * b)
+    np.testing.assert_allclose(np.cos(local['theta_max'].values[:, :3]), cos_max[:, :3],
+                               rtol=1e-15, atol=1e-15)
+    oloid = local.sel(b_over_a=1.0, delta_over_a=0.5)
+    assert float(oloid['cycle_advance']) == pytest.approx(8 * math.sqrt(3) * math.pi / 9,
+                                                          rel=1e-14)
+    assert float(oloid['height_min']) == pytest.approx(1 / math.sqrt(2), rel=1e-15)
+    assert float(oloid['height_max']) == pytest.approx(0.75, rel=1e-15)
+    assert float(oloid['contact_length_min']) == pytest.approx(math.sqrt(3), rel=1e-14)
+    assert float(oloid['contact_length_max']) == pytest.approx(math.sqrt(3), rel=1e-14)
+    assert float(oloid['stable_family']) == -1
+    # every point with Δ/a = 1 is masked, with a reason
+    edge = local.sel(delta_over_a=1.0)
+    for name in VARIABLES:
+        assert np.all(np.isnan(edge[name].values)), name
+    assert all('delta/a = 1.0 >= 1' in str(r) for r in edge['failure'].values)
+    assert np.all(local['failure'].values[:, :3] == '')
+    for name, (units, description) in VARIABLES.items():
+        assert local[name].attrs['units'] == units and local[name].attrs['description']
+    assert local.attrs['package_version'] and local.attrs['mass_model'] == 'laminae'
+
+
+def _free_port():
+    import socket
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+def _stop(procs):
+    for proc in procs:
+        if proc.poll() is None:
+            proc.terminate()
+    for proc in procs:
+        try:
+            proc.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)   # the group this test started with the proc
+            proc.wait(timeout=5)
+
+
+def _listening_hosts(procs):
+    """The addresses every started process (and its children) listens on."""
+    import psutil
+    hosts = set()
+    for proc in procs:
+        parent = psutil.Process(proc.pid)
+        for p in [parent, *parent.children(recursive=True)]:
+            hosts |= {c.laddr.ip for c in p.net_connections('inet')
+                      if c.status == psutil.CONN_LISTEN}
+    return hosts
+
+
+def _wait_for_workers(address, count, timeout=60):
+    from distributed import Client
+    with Client(address, timeout='20s', set_as_default=False) as c:
+        c.wait_for_workers(count, timeout=timeout)
+
+
+@pytest.mark.slow
+def test_distributed_cli_equals_local(local, tmp_path):
+    port = _free_port()
+    address = f'tcp://127.0.0.1:{port}'
+    procs = []
+    logs = []
+    try:
+        log = open(tmp_path / 'scheduler.log', 'w')
+        logs.append(log)
+        procs.append(subprocess.Popen(
+            [DASK, 'scheduler', '--host', '127.0.0.1', '--port', str(port), '--no-dashboard',
+             '--dashboard-address', '127.0.0.1:0'],
+            stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=tmp_path,
+            start_new_session=True))
+        for k in range(2):
+            log = open(tmp_path / f'worker{k}.log', 'w')
+            logs.append(log)
+            procs.append(subprocess.Popen(
+                [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
+                 '--nthreads', '1', '--no-dashboard', '--dashboard-address', '127.0.0.1:0'],
+                stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=tmp_path,
+                start_new_session=True))
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                _wait_for_workers(address, 2)
+                break
+            except (OSError, TimeoutError):
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.5)
+        assert _listening_hosts(procs) == {'127.0.0.1'}
+        out = tmp_path / 'remote.nc'
+        result = subprocess.run(
+            [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', *B_GRID,
+             '--delta-over-a', *D_GRID, '--out', str(out), '--chunk-size', str(CHUNK),
+             '--scheduler', address],
+            env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+        assert result.returncode == 0, result.stderr
+        assert 'Traceback' not in result.stderr
+        remote = read_netcdf(out)
+    finally:
+        _stop(procs)
+        for log in logs:
+            log.close()
+    assert all(p.returncode is not None for p in procs)
+    _same(local, remote)
+    assert not parts_folder(out).exists()
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_interrupted_sweep_resumes_without_recomputing(client, local, tmp_path):
+    out = tmp_path / 'map.nc'
+    spec = _spec()
+    n_chunks = len(spec.chunks())
+
+    def interrupt(index, computed):
+        if computed == 2:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        run_sweep(spec, client, out=out, progress=None, on_chunk=interrupt)
+    parts = parts_folder(out)
+    saved = sorted(parts.glob('chunk-*.npz'))
+    assert len(saved) == 2 and not out.exists()
+    manifest = json.loads((parts / 'manifest.json').read_text())
+    assert manifest['chunk_size'] == CHUNK
+    again = run_sweep(spec, client, out=out, progress=None)
+    assert again.resumed == 2 and again.computed == n_chunks - 2
+    _same(again.dataset, local)
+    _same(read_netcdf(out), local)
+    assert not parts.exists()
+    # a different grid is never mixed in: the cache of another sweep is refused (exit 2)
+    other = SweepSpec(np.linspace(0.5, 1.5, 2), np.linspace(0.25, 1.0, 4), chunk_size=CHUNK)
+    with pytest.raises(_Stop):
+        run_sweep(other, client, out=out, progress=None,
+                  on_chunk=lambda i, c: (_ for _ in ()).throw(_Stop()))
+    status = main(['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out),
+                   '--chunk-size', str(CHUNK), '--quiet', '--workers', '1'])
+    assert status == 2
+
+
+@pytest.mark.parametrize('override, words', [
+    ({'--b-over-a': ['1.5', '0.5', '3']}, 'reversed'),
+    ({'--b-over-a': ['1', '1', '3']}, 'empty range'),
+    ({'--delta-over-a': ['0.25', '0.75', '0']}, 'N must be an integer >= 1'),
+    ({'--b-over-a': ['0.5', 'x', '3']}, 'must be a number'),
+    ({'--b-over-a': ['0.5', '1.5', '2.5']}, 'integer'),
+    ({'--b-over-a': ['0', '1.5', '3']}, 'START must be > 0'),
+    ({'--b-over-a': ['0.5', '1.5']}, 'expected 3 arguments'),
+    ({'--reference-speed': ['fast']}, 'must be a number'),
+    ({'--chunk-size': ['0']}, 'integer >= 1'),
+    ({'--mass-model': ['lead']}, 'invalid choice'),
+    ({'--out': ['{tmp}/missing/map.nc']}, 'does not exist'),
+    ({'--out': ['{tmp}']}, 'is a directory'),
+    ({'--out': ['{tmp}/file.txt/map.nc']}, 'does not exist'),
+    ({'--plot': ['{tmp}/file.txt']}, 'not a directory'),
+])
+def test_bad_input_one_line_exit_2(override, words, capsys, tmp_path):
+    (tmp_path / 'file.txt').write_text('not a folder')
+    options = {'--b-over-a': ['0.5', '1.5', '3'], '--delta-over-a': ['0.25', '0.75', '3'],
+               '--out': [str(tmp_path / 'x.nc')], **override}
+    argv = [x for key, values in options.items()
+            for x in [key, *(v.replace('{tmp}', str(tmp_path)) for v in values)]]
+    status = main(argv)
+    err = capsys.readouterr().err
+    assert status == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert words in err and 'Traceback' not in err
+    assert not (tmp_path / 'x.nc.parts').exists()
+
+
+@pytest.mark.slow
+def test_unreachable_scheduler_exit_2_fast(tmp_path):
+    port = _free_port()   # nothing listens there
+    start = time.monotonic()
+    result = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', '1', '1', '1',
+         '--delta-over-a', '0.5', '0.5', '1', '--out', str(tmp_path / 'x.nc'),
+         '--scheduler', f'tcp://127.0.0.1:{port}'],
+        env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert 'cannot reach the Dask scheduler' in result.stderr
+    assert time.monotonic() - start < 30
+    assert not (tmp_path / 'x.nc.parts').exists()
+
+
+@pytest.mark.slow
+def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
+    out = tmp_path / 'map.nc'
+    cmd = [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', *B_GRID, '--delta-over-a',
+           *D_GRID, '--out', str(out), '--chunk-size', '1', '--workers', '1', '--quiet']
+    parts = parts_folder(out)
+    proc = subprocess.Popen(cmd, env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(list(parts.glob('chunk-*.npz'))) < 2 and proc.poll() is None \
+                and time.monotonic() < deadline:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        err = proc.communicate(timeout=60)[1]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait(timeout=10)
+    saved = len(list(parts.glob('chunk-*.npz')))
+    if proc.returncode == 0:
+        pytest.skip('the sweep finished before the signal arrived')
+    assert proc.returncode == 130, err
+    assert 'interrupted' in err and 'Traceback' not in err
+    assert saved >= 2 and not out.exists()
+    again = subprocess.run(cmd, env=ENV, cwd=tmp_path, capture_output=True, text=True,
+                           timeout=120)
+    assert again.returncode == 0, again.stderr
+    total = len(_spec().b_over_a) * len(_spec().delta_over_a)
+    assert f'{total - saved} chunks computed, {saved} resumed' in again.stderr
+    _same(read_netcdf(out), local)

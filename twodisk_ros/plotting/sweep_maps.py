@@ -1,0 +1,134 @@
+"""Maps of a parameter sweep (``twodisk-sweep --plot DIR``): one PNG per variable.
+
+Each map shows a variable of the sweep's Dataset over b/a (x) and Δ/a (y), both in units of a,
+with a colour bar in the variable's unit; the neutral curve b² = 2(a² − Δ²) and the named
+bodies (oloid, Two-Circle-Roller, the paper's Figure 3 and 4 bodies) are marked. Masked points
+(a failed body, Δ/a ≥ 1) are light grey; infinite values (a lift-off speed that is never
+reached, μ_required above the lift-off speed) are black, beyond the colour bar's end.
+Quantities whose positive values span a factor above 20 get a logarithmic scale.
+"""
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402  (after selecting the backend)
+import numpy as np  # noqa: E402
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, Normalize  # noqa: E402
+
+from .figures import FIGURE3, FIGURE4  # noqa: E402
+
+__all__ = ['NAMED_BODIES', 'plot_map', 'write_maps']
+
+#: (label, b/a, Δ/a) of the marked bodies.
+NAMED_BODIES = [
+    ('Oloid', 1.0, 0.5),
+    ('Two-Circle-Roller', 1.0, 1.0 / math.sqrt(2.0)),
+    ('Fig. 3', FIGURE3[1] / FIGURE3[0], FIGURE3[2] / FIGURE3[0]),
+    ('Fig. 4', FIGURE4[1] / FIGURE4[0], FIGURE4[2] / FIGURE4[0]),
+]
+DPI = 130
+_FAMILY_LABELS = {-1: 'θ = ±π/2', 0: 'neutral', 1: 'θ = 0 and\nturning points'}
+
+
+def _edges(values):
+    """Cell edges around grid values (a single value gets a cell of ±2 % or ±0.01)."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 1:
+        half = max(0.02 * abs(v[0]), 0.01)
+        return np.array([v[0] - half, v[0] + half])
+    mid = 0.5 * (v[1:] + v[:-1])
+    return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
+
+
+def _norm_and_cmap(name, values):
+    """(norm, cmap, extend, ticks) for a variable's finite values."""
+    if name == 'stable_family':
+        cmap = ListedColormap(['#f3b38a', '#f7f7f7', '#8db7de'])
+        cmap.set_bad('0.85')
+        return BoundaryNorm([-1.5, -0.5, 0.5, 1.5], cmap.N), cmap, 'neither', [-1, 0, 1]
+    cmap = plt.get_cmap('viridis').copy()
+    cmap.set_bad('0.85')
+    cmap.set_over('black')
+    finite = values[np.isfinite(values)]
+    extend = 'max' if np.any(np.isposinf(values)) else 'neither'
+    if finite.size == 0:
+        return Normalize(0.0, 1.0), cmap, extend, None
+    low, high = float(finite.min()), float(finite.max())
+    positive = finite[finite > 0]
+    if low > 0 and high / low > 20.0:
+        return LogNorm(low, high), cmap, extend, None
+    if name in ('barrier', 'rollover_speed') and positive.size and low >= 0 \
+            and high / positive.min() > 20.0:
+        return LogNorm(positive.min(), high), cmap, extend, None
+    if high == low:
+        low, high = low - 0.5 * max(abs(low), 1e-12), high + 0.5 * max(abs(high), 1e-12)
+    return Normalize(low, high), cmap, extend, None
+
+
+def plot_map(dataset, name, ax):
+    """Draw variable ``name`` of a sweep Dataset on ``ax``; returns the colour bar."""
+    var = dataset[name]
+    b = dataset['b_over_a'].values
+    d = dataset['delta_over_a'].values
+    values = np.asarray(var.values, dtype=float)            # (b/a, Δ/a)
+    norm, cmap, extend, ticks = _norm_and_cmap(name, values)
+    shown = np.where(np.isposinf(values), np.inf, values)
+    mesh = ax.pcolormesh(_edges(b), _edges(d), np.ma.masked_invalid(
+        np.where(np.isposinf(shown), np.nan, shown)).T, cmap=cmap, norm=norm,
+        rasterized=True)
+    if np.any(np.isposinf(values)):
+        over = np.ma.masked_where(~np.isposinf(values), np.ones_like(values))
+        ax.pcolormesh(_edges(b), _edges(d), over.T,
+                      cmap=ListedColormap(['black']), rasterized=True)
+    bar = ax.figure.colorbar(mesh, ax=ax, extend=extend, ticks=ticks)
+    units = var.attrs.get('units', '')
+    bar.set_label(f'{name} [{units}]' + ('   (black: inf)' if extend == 'max' else ''))
+    if name == 'stable_family':
+        bar.set_ticklabels([_FAMILY_LABELS[k] for k in ticks])
+    xlim = (_edges(b)[0], _edges(b)[-1])
+    ylim = (_edges(d)[0], _edges(d)[-1])
+    b_line = np.linspace(max(xlim[0], 1e-9), min(xlim[1], math.sqrt(2.0)), 400)
+    ax.plot(b_line, np.sqrt(np.clip(1.0 - b_line**2 / 2, 0.0, None)), color='k', lw=1.2,
+            ls='--', label='neutral: b² = 2(a² − Δ²)')
+    for label, x, y in NAMED_BODIES:
+        inside = xlim[0] <= x <= xlim[1] and ylim[0] <= y <= ylim[1]
+        if inside:
+            ax.plot(x, y, 'o', mfc='white', mec='k', ms=5, zorder=4)
+            ax.annotate(label, (x, y), xytext=(5, 4), textcoords='offset points', fontsize=7,
+                        bbox={'boxstyle': 'round,pad=0.15', 'fc': 'white', 'ec': 'none',
+                              'alpha': 0.7})
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_xlabel('b / a  [1]  (a = 1)')
+    ax.set_ylabel('Δ / a  [1]')
+    ax.set_title(f'{name}: {var.attrs.get("description", "")}', fontsize=8, wrap=True)
+    ax.legend(loc='lower left', fontsize=7, framealpha=0.8)
+    return bar
+
+
+def write_maps(dataset, folder):
+    """One PNG per float variable of ``dataset`` into ``folder`` (created if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, ``folder/NAME.png``.
+    """
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, var in dataset.data_vars.items():
+        if var.dtype.kind != 'f':
+            continue
+        fig, ax = plt.subplots(figsize=(6.4, 4.6))
+        try:
+            plot_map(dataset, name, ax)
+            path = out / f'{name}.png'
+            fig.savefig(path, dpi=DPI, bbox_inches='tight')
+        finally:
+            plt.close(fig)
+        written.append(path)
+    return written

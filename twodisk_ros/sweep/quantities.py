@@ -1,0 +1,241 @@
+"""What a parameter sweep computes for one body: pure numpy/scipy, no Dask, no files.
+
+Every body of the sweep has a = 1 and is named by its ratios (b/a, Δ/a); lengths are in units
+of a, times in units of √(a/g), angular speeds in units of √(g/a) (a = 1 m, g = 1 m/s²,
+M = 1 kg in the library calls). Each quantity is one call of the physics library
+(:mod:`twodisk_ros.physics`), so a sweep point agrees bitwise with the same call made directly
+(docs/sweeps.md lists the variables and their definitions).
+
+A body that cannot be built or whose computation fails is not an error of the sweep: its
+quantities from the failing stage on are NaN and ``failure`` says why, in one line.
+"""
+
+import math
+import time
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ..physics.body import TwoDiskBody
+from ..physics.contact_forces import ContactForceModel
+from ..physics.contact_validity import liftoff_speed, mu_required_kinematic
+from ..physics.cycle import RollingCycle, TWO_PI
+from ..physics.dynamics import RollingDynamics
+from ..physics.equilibria import NEUTRAL, STABLE
+from ..physics.mass_models import mass_properties
+
+__all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities',
+           'chunk_quantities', 'timed_chunk', 'contact_length_range', 'cycle_time']
+
+#: name → (units, description), in the order of the output; units with a = g = M = 1.
+VARIABLES = {
+    'theta_max': ('rad', 'largest contact angle |theta| on a disk (turning point of theta)'),
+    'stability_margin': ('a^2', 'b^2 - 2 a^2 + 2 Delta^2: > 0 theta = 0 stable, < 0 '
+                                'theta = +-pi/2 stable, 0 neutral'),
+    'stable_family': ('1', 'which equilibria are stable: +1 theta = 0 and the turning points, '
+                           '-1 theta = +-pi/2, 0 neutral (height of G constant)'),
+    'height_min': ('a', 'lowest height of the centre of mass G over a cycle'),
+    'height_max': ('a', 'highest height of the centre of mass G over a cycle'),
+    'barrier': ('a', 'potential barrier per unit weight: height_max - height_min, the rise '
+                     'of G from the stable equilibrium to the highest unstable one'),
+    'rollover_speed': ('sqrt(g/a)', 'angular speed |omega| at the stable equilibrium that '
+                                    'just carries the body over the barrier: '
+                                    '1/2 m(u*) du/dt^2 = M g barrier, |omega| = |omega_u(u*)| '
+                                    'du/dt (0 when neutral)'),
+    'oscillation_period': ('sqrt(a/g)', 'period of small oscillations about the stable '
+                                        'equilibrium, 2 pi sqrt(m(u*) / V\'\'(u*)) '
+                                        '(NaN when neutral)'),
+    'cycle_advance': ('a', 'distance the body (G) advances per rolling cycle, '
+                           '|displacement.shift|'),
+    'cycle_heading': ('rad', 'turn of the heading per rolling cycle, displacement.turn '
+                             '(2 pi: the body rolls straight on average)'),
+    'cycle_time': ('sqrt(a/g)', 'duration of one cycle at the kinematic speed |omega| = 1 '
+                                'sqrt(g/a): integral of |omega_u| du over one cycle'),
+    'contact_length_min': ('a', 'shortest distance |AB| between the contact points over a '
+                                'cycle'),
+    'contact_length_max': ('a', 'longest distance |AB| between the contact points over a '
+                                'cycle'),
+    'liftoff_speed': ('sqrt(g/a)', 'kinematic angular speed |omega| above which a contact '
+                                   'lifts off (inf: never; 0: already at rest)'),
+    'mu_required': ('1', 'friction coefficient needed to roll without slipping at the '
+                         'reference kinematic speed, max over a cycle (inf above the lift-off '
+                         'speed)'),
+}
+
+#: stable_family value → the stable equilibria.
+FAMILIES = {1: 'theta=0 and turning points', -1: 'theta=+-pi/2', 0: 'neutral'}
+
+#: Stages of one body, in order; a failing stage leaves its quantities and the later ones NaN.
+STAGES = ('body', 'cycle', 'equilibria', 'cycle_time', 'contact_length', 'contact_tables',
+          'liftoff_speed', 'mu_required')
+
+MASS_MODELS = ('laminae', 'solid')
+
+
+def _one_line(text, limit=200):
+    text = ' '.join(str(text).split())
+    return text if len(text) <= limit else text[:limit - 3] + '...'
+
+
+def cycle_time(dynamics):
+    """∫ |ω_u| du over one cycle (rad of body rotation; s at |ω| = 1 rad/s).
+
+    Trapezoidal rule on the dynamics' table nodes: |ω_u| is smooth and 2π-periodic, so the
+    rule converges spectrally and the table's resolution (resolved to ~1e-13) suffices.
+    """
+    n = dynamics.table_size
+    u = TWO_PI * np.arange(n) / n
+    return float(np.sum(dynamics.angular_speed_per_phase(u)) * (TWO_PI / n))
+
+
+def contact_length_range(body, nodes):
+    """(min, max) of |AB| = |r2 − r1| (m) over one cycle.
+
+    The extremes are located on ``nodes`` equally spaced phases and refined by bounded Brent
+    on the closed form (to ~1e-12 rad in u; the values to rounding).
+    """
+    def length(u):
+        geo = body.phase_geometry(u)
+        return np.linalg.norm(geo.contact_b - geo.contact_a, axis=-1)
+
+    u = TWO_PI * np.arange(nodes) / nodes
+    values = length(u)
+    step = TWO_PI / nodes
+    found = []
+    for sign, i in ((1.0, int(np.argmin(values))), (-1.0, int(np.argmax(values)))):
+        res = minimize_scalar(lambda x: sign * float(length(x)),
+                              bounds=(u[i] - step, u[i] + step), method='bounded',
+                              options={'xatol': 1e-12})
+        found.append(sign * min(sign * float(values[i]), float(res.fun)))
+    return found[0], found[1]
+
+
+def _stable_reference(dynamics):
+    """(u*, period) of the first stable equilibrium in phase order, or (None, None)."""
+    for eq, period in dynamics.equilibria_with_periods():
+        if eq.stability == STABLE:
+            return eq.phase, period
+    return None, None
+
+
+def body_quantities(b_over_a, delta_over_a, mass_model='laminae', reference_speed=0.5,
+                    timings=None):
+    """All sweep quantities of the body (a, b, Δ) = (1, b/a, Δ/a) with M = g = 1.
+
+    Parameters
+    ----------
+    b_over_a, delta_over_a : float
+        Shape of the body; 0 < Δ/a < 1 and b/a > 0 are needed, else the point fails.
+    mass_model : str
+        'laminae' (two thin disks) or 'solid' (uniform convex hull).
+    reference_speed : float
+        Kinematic angular speed |ω| (units √(g/a)) at which ``mu_required`` is evaluated.
+    timings : dict, optional
+        If given, the wall time of each stage (s) is added to ``timings[stage]``.
+
+    Returns
+    -------
+    values : dict
+        name → float for every name of :data:`VARIABLES` (NaN where not computed).
+    failure : str
+        '' on success, else one line: the failing stage and why.
+    """
+    values = dict.fromkeys(VARIABLES, math.nan)
+    b, d = float(b_over_a), float(delta_over_a)
+    if not (math.isfinite(b) and math.isfinite(d)):
+        return values, f'body: b/a = {b!r} and delta/a = {d!r} must be finite'
+    if d >= 1.0:
+        return values, (f'body: delta/a = {d!r} >= 1, the disks do not interlock '
+                        f'(needs 0 < delta/a < 1)')
+    state = {}
+
+    def run(stage):
+        if stage == 'body':
+            state['body'] = body = TwoDiskBody(1.0, b, d)
+            values['theta_max'] = body.theta_max
+            values['stability_margin'] = body.stability_margin
+        elif stage == 'cycle':
+            state['cycle'] = cycle = RollingCycle(state['body'])
+            values['cycle_advance'] = abs(cycle.displacement.shift)
+            values['cycle_heading'] = cycle.displacement.turn
+        elif stage == 'equilibria':
+            _equilibria_stage(state, values, mass_model, b, d)
+        elif stage == 'cycle_time':
+            values['cycle_time'] = cycle_time(state['dynamics'])
+        elif stage == 'contact_length':
+            low, high = contact_length_range(state['body'], state['dynamics'].table_size)
+            values['contact_length_min'], values['contact_length_max'] = low, high
+        elif stage == 'contact_tables':
+            state['model'] = ContactForceModel(state['dynamics'])
+        elif stage == 'liftoff_speed':
+            values['liftoff_speed'] = liftoff_speed(state['model'])[0]
+        else:
+            values['mu_required'] = float(mu_required_kinematic(state['model'],
+                                                                reference_speed))
+
+    for stage in STAGES:
+        start = time.perf_counter()
+        try:
+            run(stage)
+        except Exception as error:  # noqa: BLE001 (a failing body is data, not a crash)
+            return values, _one_line(f'{stage}: {type(error).__name__}: {error}')
+        finally:
+            if timings is not None:
+                timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
+    return values, ''
+
+
+def _equilibria_stage(state, values, mass_model, b, d):
+    """Dynamics (M = g = 1), the stable family, the height range, barrier and period."""
+    body = state['body']
+    props = mass_properties(mass_model, 1.0, b, d, 1.0)
+    state['dynamics'] = dynamics = RollingDynamics(body, props, 1.0, cycle=state['cycle'])
+    found = dynamics.equilibria_with_periods()
+    heights = [eq.height for eq, _ in found]
+    values['height_min'], values['height_max'] = min(heights), max(heights)
+    u_star, period = _stable_reference(dynamics)
+    if all(eq.stability == NEUTRAL for eq, _ in found):
+        values['stable_family'] = 0.0
+        values['barrier'] = 0.0
+        values['rollover_speed'] = 0.0
+        return
+    values['stable_family'] = 1.0 if body.stability_margin > 0 else -1.0
+    barrier = values['height_max'] - values['height_min']
+    values['barrier'] = barrier
+    if u_star is None:
+        raise RuntimeError('no stable equilibrium found although the body is not neutral')
+    values['oscillation_period'] = period
+    m_star = float(dynamics.effective_mass(u_star))
+    omega_u = float(dynamics.angular_speed_per_phase(u_star))
+    # ½ m(u*) u̇² = M g ΔH with M = g = 1, then |ω| = |ω_u(u*)| u̇
+    values['rollover_speed'] = omega_u * math.sqrt(2.0 * barrier / m_star)
+
+
+def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
+                     timings=None):
+    """:func:`body_quantities` over paired 1-D arrays of b/a and Δ/a (one task of a sweep).
+
+    Returns
+    -------
+    dict
+        name → float64 array for every name of :data:`VARIABLES`, and ``failure`` → list of
+        str, all of the length of the inputs.
+    """
+    b_values = np.asarray(b_values, dtype=float).ravel()
+    delta_values = np.asarray(delta_values, dtype=float).ravel()
+    out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
+    failures = []
+    for k, (b, d) in enumerate(zip(b_values, delta_values)):
+        values, failure = body_quantities(b, d, mass_model, reference_speed, timings)
+        for name, value in values.items():
+            out[name][k] = value
+        failures.append(failure)
+    out['failure'] = failures
+    return out
+
+
+def timed_chunk(b_values, delta_values, mass_model='laminae', reference_speed=0.5):
+    """(:func:`chunk_quantities` (...), wall time, CPU time of the process in s): one task."""
+    start, cpu = time.perf_counter(), time.process_time()
+    result = chunk_quantities(b_values, delta_values, mass_model, reference_speed)
+    return result, time.perf_counter() - start, time.process_time() - cpu
