@@ -4,10 +4,13 @@
 - batch recording: the node's messages/s against the ``mcap`` writer's and rclpy's floors,
   measured side by side in one run (``node_rates.py``);
 - real time at 100 Hz, 1 kHz and 10 kHz (``node_rates.py``);
-- contact forces per second, and the cost of the solid mass model.
+- contact forces per second, and the cost of the solid mass model;
+- parameter sweeps on Dask (``sweep_rate.py``).
 """
 
+import contextlib
 from dataclasses import asdict
+import io
 import time
 
 import numpy as np
@@ -70,13 +73,19 @@ def measure(builds, quick=False, log=print):
             f'{r.node_lag_ms:.2f} ms, dropped {r.dropped}')
     out['forces'] = contact_force_rate(10**5 if quick else 10**6)
     out['solid'] = solid_hull_cost()
+    log('   parameter sweeps on Dask (benchmarks/sweep_rate.py)')
+    import sweep_rate
+    text = io.StringIO()
+    with contextlib.redirect_stdout(text):
+        sweep_rate.main()
+    out['sweep'] = text.getvalue()
     return out
 
 
 def as_dict(out):
     return {'poses': [asdict(p) for p in out['poses']], 'batch': out['batch'].as_dict(),
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
-            'solid': out['solid']}
+            'solid': out['solid'], 'sweep': out['sweep']}
 
 
 def _status(ok):
@@ -146,4 +155,9 @@ def report_lines(out):
     w('## Solid mass model\n')
     w('`solid_hull(..., rtol=1e-9)`, best of 3: ' + ', '.join(
         f'{name} {wall * 1e3:.1f} ms' for name, wall in out['solid'].items()) + '.\n')
+    w('## Parameter sweeps on Dask\n')
+    w('`benchmarks/sweep_rate.py`, as printed (a LocalCluster on 127.0.0.1; the cost per body '
+      'split by quantity, bodies per second with 1 and 2 workers, the 100 × 100 map and the '
+      'projection to 1000 × 1000 with the model it uses):\n')
+    w('```\n' + out['sweep'].strip() + '\n```\n')
     return lines
