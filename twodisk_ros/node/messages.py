@@ -92,8 +92,10 @@ def _fan(outline):
     The centre is the mean of the outline's points (the duplicate last point dropped).
     """
     outline = _closed(outline)
-    centre = outline[:-1].mean(axis=0)
     count = len(outline) - 1
+    if count < 2:                     # no area to fill (an empty or one-point outline)
+        return np.zeros((0, 3))
+    centre = outline[:-1].mean(axis=0)
     triangles = np.empty((count, 3, 3))
     triangles[:, 0] = centre
     triangles[:, 1] = outline[:-1]
