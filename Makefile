@@ -25,7 +25,7 @@ test: venv
 demo: venv
 	mkdir -p out
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
-	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap
+	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap -p overwrite:=true
 	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png
 	$(PY) -m twodisk_ros.plotting.animation out/oloid.mcap -o out/oloid.gif \
 	    --stop 6 --fps 15 --size 480x360
