@@ -390,3 +390,22 @@ def test_duck_typed_message_and_unsupported_types():
     Fake.SLOT_TYPES = (definition.BasicType('wchar'),)
     with pytest.raises(TypeError, match='wchar'):
         cdr.serialize(Fake(c='x'))
+
+
+@pytest.mark.parametrize('length', range(10))
+def test_node_markers_encoded_from_arrays_as_the_generic_serializer(length):
+    """io/cdr_markers (the node's fast path) against serialize() of the same rclpy markers."""
+    from twodisk_ros.io.cdr_markers import encode_markers
+    frame = 'abcdefghi'[:length]
+    s = np.linspace(0.0, 2 * np.pi, 5 + 7 * length)
+    disk1 = np.stack([np.sin(s), -0.5 - np.cos(s), 0 * s], -1)
+    disk2 = np.stack([0 * s, 0.5 + np.cos(s), np.sin(s)], -1)
+    hull = (disk1, disk2) if length % 2 else None
+    specs = messages.body_marker_specs(disk1, disk2, (0, 0, 0), (1, 2, 0), 0.3, hull=hull)
+    specs += messages.force_arrow_specs(((0, 0, 0), (1, 2, 0)), ((0.1, 0.2, 4.0),
+                                                                 (0.0, -0.1, -0.5)), 9.81, 0.3)
+    stamp = 1_700_000_000_123_456_789 + length
+    expected = cdr.serialize(MarkerArray(markers=[messages.marker(frame, stamp, spec)
+                                                  for spec in specs]))
+    assert encode_markers(stamp, frame, specs) == expected
+    assert check(MarkerArray(markers=[messages.marker(frame, stamp, spec) for spec in specs]))

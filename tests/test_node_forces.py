@@ -136,3 +136,23 @@ def test_slip_when_friction_is_below_the_requirement(context, tmp_path):
     level, message, values = diagnostics_values(by_topic(recording, 'diagnostics')[-1])
     assert level == 2 and 'slip' in message
     assert float(values['slip_margin']) < 0
+
+
+def test_friction_changed_at_run_time_is_judged_from_then_on(context, tmp_path):
+    from rclpy.parameter import Parameter
+    from twodisk_ros.node.roller import Roller
+    node = Roller(context=context, parameter_overrides=[
+        Parameter('realtime', value=False), Parameter('duration', value=4.0),
+        Parameter('rate', value=1000.0), Parameter('friction', value=1e-4),
+        Parameter('record', value=str(tmp_path / 'f.mcap'))])
+    try:
+        node.run_batch(keep_going=lambda: node.samples_published < 1)   # one block: 2 s
+        assert node.simulation.invalid is not None and 'slip' in node.simulation.invalid.kind
+        (result,) = node.set_parameters([Parameter('friction', value=0.5)])
+        assert result.successful
+        node.run_batch()
+        assert node.settings.friction == 0.5 and node.simulation.settings.friction == 0.5
+        assert node.simulation.invalid is None          # 0.5 is ample for this motion
+    finally:
+        node.close()
+        node.destroy_node()

@@ -40,6 +40,8 @@ __all__ = [
     'encode_wrench_stamped',
     'serialize',
     'split_rows',
+    'stamp_columns',
+    'Layout',
 ]
 
 #: CDR_LE encapsulation header (representation id 0x0001, options 0).
@@ -49,7 +51,7 @@ _NS = 1_000_000_000
 _SEC_MIN, _SEC_MAX = -2**31, 2**31 - 1
 
 
-class _Layout:
+class Layout:
     """Byte layout of one message (or a part of one) with fixed lengths.
 
     ``start`` is the payload offset (bytes after the encapsulation header) of the first byte;
@@ -108,7 +110,7 @@ class _Layout:
             offset, dtype, count = self.fields[name]
             if count:
                 view = rows[:, offset:offset + dtype.itemsize * count].view(dtype)
-                view[...] = np.broadcast_to(values, (n, count))
+                view[...] = values          # broadcast to (n, count) by the assignment
         return rows
 
 
@@ -120,7 +122,7 @@ def split_rows(rows):
     return [data[i:i + size] for i in range(0, len(data), size)]
 
 
-def _stamps(stamps_ns, n=None):
+def stamp_columns(stamps_ns, n=None):
     """``(n, 2)`` int64 columns (sec, nanosec) from integer nanoseconds, range-checked."""
     ns = np.asarray(stamps_ns)
     if ns.dtype.kind not in 'iu' and ns.size:
@@ -144,7 +146,7 @@ def _float_array(values, width, name):
 
 
 def _header_only(frame_id):
-    layout = _Layout(prefix=ENCAPSULATION)
+    layout = Layout(prefix=ENCAPSULATION)
     layout.header(frame_id)
     return layout
 
@@ -173,7 +175,7 @@ def encode_pose_stamped(stamps_ns, frame_id, positions, quaternions):
     n = len(positions)
     layout = _header_only(frame_id)
     layout.pose()
-    return split_rows(layout.fill(n, stamp=_stamps(stamps_ns, n), position=positions,
+    return split_rows(layout.fill(n, stamp=stamp_columns(stamps_ns, n), position=positions,
                                   orientation=quaternions))
 
 
@@ -197,7 +199,7 @@ def encode_point_stamped(stamps_ns, frame_id, points):
     points = _float_array(points, 3, 'points')
     layout = _header_only(frame_id)
     layout.field('point', '<f8', 3)
-    return split_rows(layout.fill(len(points), stamp=_stamps(stamps_ns, len(points)),
+    return split_rows(layout.fill(len(points), stamp=stamp_columns(stamps_ns, len(points)),
                                   point=points))
 
 
@@ -226,7 +228,7 @@ def encode_wrench_stamped(stamps_ns, frame_id, forces, torques=None):
     layout = _header_only(frame_id)
     layout.field('force', '<f8', 3)
     layout.field('torque', '<f8', 3)
-    return split_rows(layout.fill(n, stamp=_stamps(stamps_ns, n), force=forces,
+    return split_rows(layout.fill(n, stamp=stamp_columns(stamps_ns, n), force=forces,
                                   torque=torques))
 
 
@@ -254,7 +256,7 @@ def encode_joint_state(stamps_ns, names, positions, velocities=None, frame_id=''
     names = list(names)
     positions = _float_array(positions, len(names), 'positions')
     n = len(positions)
-    columns = {'stamp': _stamps(stamps_ns, n), 'position': positions}
+    columns = {'stamp': stamp_columns(stamps_ns, n), 'position': positions}
     layout = _header_only(frame_id)
     layout.u32(len(names))
     for name in names:
@@ -300,10 +302,10 @@ def encode_path(stamp_ns, frame_id, positions, quaternions=None, stamps_ns=None)
     if quaternions.shape != (4,):
         quaternions = _float_array(quaternions.reshape(-1, 4), 4, 'quaternions')
     quaternions = np.broadcast_to(quaternions, (m, 4))
-    stamps = _stamps(stamp_ns if stamps_ns is None else stamps_ns, m)
+    stamps = stamp_columns(stamp_ns if stamps_ns is None else stamps_ns, m)
     layout = _header_only(frame_id)
     layout.u32(m)
-    parts = [layout.fill(1, stamp=_stamps(stamp_ns, 1))]
+    parts = [layout.fill(1, stamp=stamp_columns(stamp_ns, 1))]
     # Alignment is relative to the payload start: the first pose starts at a multiple of 4, and
     # every pose ends with a float64, so all later poses start at a multiple of 8 and share one
     # layout; the first one may have 4 bytes more padding.
@@ -311,7 +313,7 @@ def encode_path(stamp_ns, frame_id, positions, quaternions=None, stamps_ns=None)
     for rows in (slice(0, 1), slice(1, m)):
         if rows.start >= m:
             break
-        pose = _Layout(start)
+        pose = Layout(start)
         pose.header(frame_id)
         pose.pose()
         parts.append(pose.fill(len(positions[rows]), stamp=stamps[rows],

@@ -15,6 +15,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
+from ..io.cdr_markers import MarkerSpec
+
 JOINT_NAMES = ['theta', 'psi', 'phase']
 
 
@@ -61,14 +63,17 @@ def path(frame_id, time_ns, poses):
     return Path(header=header(frame_id, time_ns), poses=list(poses))
 
 
-def _line_marker(frame_id, time_ns, marker_id, kind, points, rgba, width):
-    marker = Marker(header=header(frame_id, time_ns), ns='twodisk', id=marker_id, type=kind,
-                    action=Marker.ADD)
-    marker.pose.orientation.w = 1.0
-    marker.scale.x = float(width)
-    marker.color = ColorRGBA(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
-    marker.points = [Point(x=x, y=y, z=z) for x, y, z in np.asarray(points, float).tolist()]
-    return marker
+def marker(frame_id, time_ns, spec):
+    """A ``visualization_msgs/Marker`` from a :class:`~twodisk_ros.io.cdr_markers.MarkerSpec`."""
+    result = Marker(header=header(frame_id, time_ns), ns=spec.ns, id=spec.id, type=spec.type,
+                    action=spec.action)
+    result.pose.orientation.w = 1.0
+    result.scale.x, result.scale.y, result.scale.z = (float(x) for x in spec.scale)
+    result.color = ColorRGBA(r=float(spec.color[0]), g=float(spec.color[1]),
+                             b=float(spec.color[2]), a=float(spec.color[3]))
+    result.points = [Point(x=x, y=y, z=z)
+                     for x, y, z in np.asarray(spec.points, float).reshape(-1, 3).tolist()]
+    return result
 
 
 #: Marker ids of :func:`body_markers` (namespace ``twodisk``).
@@ -110,25 +115,27 @@ def _strip(rim_1, rim_2):
     return quads.reshape(-1, 3)
 
 
-def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size, *,
-                 filled=True, alpha=0.6, hull=None):
-    """The body as markers (world points, m), namespace ``twodisk``, ids :data:`MARKER_IDS`.
+def body_marker_specs(disk1, disk2, contact_a, contact_b, size, *, filled=True, alpha=0.6,
+                      hull=None):
+    """The body as :class:`MarkerSpec` s (world points, m), namespace ``twodisk``.
 
-    0, 1: the disk outlines (LINE_STRIP); 2: the contact line AB (LINE_LIST); 3, 4 (if
-    ``filled``): each disk as a filled surface, a fan of triangles from its centre over its
-    outline (TRIANGLE_LIST, disk 1 blue, disk 2 orange, opacity ``alpha``); 5 (if ``hull`` is
-    given): the convex hull as a TRIANGLE_LIST strip between ``hull = (rim_1, rim_2)``,
-    matching points of the two rims (arrays (n + 1, 3), closed), e.g. the end points A and B
-    of the rulings over one cycle (:meth:`~twodisk_ros.node.simulation.Simulation.hull_rims`).
-    ``disk1``, ``disk2``: closed outlines, arrays (n + 1, 3) with the last point the first.
+    Ids :data:`MARKER_IDS`. 0, 1: the disk outlines (LINE_STRIP); 2: the contact line AB
+    (LINE_LIST); 3, 4 (if ``filled``): each disk as a filled surface, a fan of triangles from
+    its centre over its outline (TRIANGLE_LIST, disk 1 blue, disk 2 orange, opacity
+    ``alpha``); 5 (if ``hull`` is given): the convex hull as a TRIANGLE_LIST strip between
+    ``hull = (rim_1, rim_2)``, matching points of the two rims (arrays (n + 1, 3), closed),
+    e.g. the end points A and B of the rulings over one cycle
+    (:meth:`~twodisk_ros.node.simulation.Simulation.hull_rims`). ``disk1``, ``disk2``: closed
+    outlines, arrays (n + 1, 3) with the last point the first.
     """
     width = 0.01 * size
     (r1, g1, b1), (r2, g2, b2) = DISK_COLORS
-    markers = [
-        _line_marker(frame_id, time_ns, 0, Marker.LINE_STRIP, disk1, (r1, g1, b1, 1.0), width),
-        _line_marker(frame_id, time_ns, 1, Marker.LINE_STRIP, disk2, (r2, g2, b2, 1.0), width),
-        _line_marker(frame_id, time_ns, 2, Marker.LINE_LIST, [contact_a, contact_b],
-                     (0.1, 0.7, 0.2, 1.0), width),
+    line = (width, 0.0, 0.0)
+    specs = [
+        MarkerSpec('twodisk', 0, Marker.LINE_STRIP, Marker.ADD, line, (r1, g1, b1, 1.0), disk1),
+        MarkerSpec('twodisk', 1, Marker.LINE_STRIP, Marker.ADD, line, (r2, g2, b2, 1.0), disk2),
+        MarkerSpec('twodisk', 2, Marker.LINE_LIST, Marker.ADD, line, (0.1, 0.7, 0.2, 1.0),
+                   [contact_a, contact_b]),
     ]
     surfaces = []
     if filled:
@@ -136,11 +143,15 @@ def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size, *,
     if hull is not None:
         surfaces.append((5, _strip(*hull), (0.6, 0.6, 0.62, 0.35)))
     for marker_id, triangles, rgba in surfaces:
-        marker = _line_marker(frame_id, time_ns, marker_id, Marker.TRIANGLE_LIST, triangles,
-                              rgba, 1.0)
-        marker.scale.y = marker.scale.z = 1.0
-        markers.append(marker)
-    return MarkerArray(markers=markers)
+        specs.append(MarkerSpec('twodisk', marker_id, Marker.TRIANGLE_LIST, Marker.ADD,
+                                (1.0, 1.0, 1.0), rgba, triangles))
+    return specs
+
+
+def body_markers(frame_id, time_ns, disk1, disk2, contact_a, contact_b, size, **options):
+    """The body as a ``MarkerArray`` (:func:`body_marker_specs`, same arguments)."""
+    return MarkerArray(markers=[marker(frame_id, time_ns, spec) for spec in body_marker_specs(
+        disk1, disk2, contact_a, contact_b, size, **options)])
 
 
 def diagnostics(time_ns, name, level, message, values):
@@ -167,23 +178,26 @@ OK, WARN, ERROR = (ord(level) for level in (DiagnosticStatus.OK, DiagnosticStatu
 FORCE_ARROW_IDS = (100, 101)
 
 
-def force_arrows(frame_id, time_ns, points, forces, weight, size):
-    """ARROW markers of the ground's forces on the body at A and B (world frame).
+def force_arrow_specs(points, forces, weight, size):
+    """ARROW :class:`MarkerSpec` s of the ground's forces on the body at A and B (world frame).
 
     Each arrow starts at its contact point and is ``force / (M g) × size`` long, so the
     weight M g itself would be one body size; red when the force pulls (N < 0).
     """
     scale = size / weight if weight > 0 else 0.0
-    markers = []
+    specs = []
     for marker_id, point_xyz, force in zip(FORCE_ARROW_IDS, points, forces):
         start = np.asarray(point_xyz, dtype=float)
-        marker = Marker(header=header(frame_id, time_ns), ns='twodisk_forces', id=marker_id,
-                        type=Marker.ARROW, action=Marker.ADD)
-        marker.pose.orientation.w = 1.0
-        marker.points = [point(start), point(start + scale * np.asarray(force, dtype=float))]
-        marker.scale.x, marker.scale.y, marker.scale.z = 0.01 * size, 0.02 * size, 0.03 * size
         pulling = force[2] < 0
-        marker.color = ColorRGBA(r=0.9 if pulling else 0.2, g=0.1 if pulling else 0.6, b=0.1,
-                                 a=1.0)
-        markers.append(marker)
-    return markers
+        specs.append(MarkerSpec(
+            'twodisk_forces', marker_id, Marker.ARROW, Marker.ADD,
+            (0.01 * size, 0.02 * size, 0.03 * size),
+            (0.9 if pulling else 0.2, 0.1 if pulling else 0.6, 0.1, 1.0),
+            [start, start + scale * np.asarray(force, dtype=float)]))
+    return specs
+
+
+def force_arrows(frame_id, time_ns, points, forces, weight, size):
+    """The force arrows as ``Marker`` s (:func:`force_arrow_specs`)."""
+    return [marker(frame_id, time_ns, spec)
+            for spec in force_arrow_specs(points, forces, weight, size)]

@@ -29,6 +29,7 @@ from visualization_msgs.msg import MarkerArray
 
 from .. import __version__
 from ..io import McapRecorder, cdr
+from ..io.cdr_markers import encode_markers
 from . import messages
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
 from .simulation import Simulation
@@ -155,6 +156,9 @@ class Roller(Node):
             self._block = None
             self._history.clear()
             self._next['diagnostics'] = self._tick / self.settings.rate
+        else:   # the same motion; friction, frame or path length may have changed
+            self.simulation.update(candidate)
+            self._block = None
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
 
@@ -255,15 +259,15 @@ class Roller(Node):
         disk1, disk2 = self.simulation.disk_outlines(rotation, sample.position_g[i])
         hull = (self.simulation.hull_rims(rotation, sample.position_g[i])
                 if self.settings.mass_model == 'solid' else None)
-        message = messages.body_markers(self.settings.frame_id, time_ns, disk1, disk2,
-                                        sample.contact_a[i], sample.contact_b[i],
-                                        self.simulation.body.size, hull=hull)
+        specs = messages.body_marker_specs(disk1, disk2, sample.contact_a[i],
+                                           sample.contact_b[i], self.simulation.body.size,
+                                           hull=hull)
         if sample.forces is not None:
-            message.markers.extend(messages.force_arrows(
-                self.settings.frame_id, time_ns, (sample.contact_a[i], sample.contact_b[i]),
+            specs += messages.force_arrow_specs(
+                (sample.contact_a[i], sample.contact_b[i]),
                 (sample.forces.force_a[i], sample.forces.force_b[i]), self.simulation.weight,
-                self.simulation.body.size))
-        self._send('markers', cdr.serialize(message), time_ns)
+                self.simulation.body.size)
+        self._send('markers', encode_markers(time_ns, self.settings.frame_id, specs), time_ns)
 
     def achieved_rate(self):
         """Samples per wall-clock second over the last few ticks (realtime), or None."""

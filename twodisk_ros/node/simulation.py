@@ -127,6 +127,18 @@ class Simulation:
                       position_g=poses.position_g, contact_a=poses.contact_a,
                       contact_b=poses.contact_b, quaternion=quaternion, forces=contact)
 
+    def update(self, settings):
+        """Take settings that leave the motion unchanged (e.g. friction, frame_id).
+
+        A new friction coefficient is judged from now on: a slip found under the old one
+        is forgotten (a lift-off does not depend on it and is found again at once).
+        """
+        if settings.physics_differs(self.settings):
+            raise ValueError('these settings change the motion: build a new Simulation')
+        if settings.friction != self.settings.friction:
+            self.invalid = None
+        self.settings = settings
+
     def contact_status(self, sample, i):
         """(level, message, values) of the contact forces at sample i, for the diagnostics.
 
