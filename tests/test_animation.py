@@ -95,7 +95,8 @@ def _cli(*args):
 
 @pytest.mark.parametrize('args, words', [
     (['/nonexistent/run.mcap', '-o', 'x.gif'], 'cannot read'),
-    (['--params-file', '/nonexistent.yaml', '-o', 'x.gif'], 'cannot read params file'),
+    (['--params-file', '/nonexistent.yaml', '-o', 'x.gif'],
+     '--params-file /nonexistent.yaml: cannot read it'),
     (['-o', 'x.gif', '--start', '3', '--stop', '2'], 'start < stop'),
     (['-o', 'x.gif', '--stop', '-1'], 'start < stop'),
     (['-o', '/nonexistent/dir/x.gif', '--stop', '0.2'], 'does not exist'),

@@ -12,7 +12,7 @@ import yaml
 
 from .parameters import BY_NAME, ROS_OWN
 
-__all__ = ['ArgumentError', 'check_arguments']
+__all__ = ['ArgumentError', 'check_arguments', 'params_file_values']
 
 NODE_NAME = 'roller'
 _PARAM_FLAGS = ('-p', '--param')
@@ -62,8 +62,11 @@ def _node_key_matches(key):
     return last in (NODE_NAME, '*', '**') or key in ('*', '**')
 
 
-def _params_file_names(path):
-    """Parameter names a params file sets for this node, or ArgumentError."""
+def params_file_values(path):
+    """{name: value} that a params file (rclpy's format) sets for this node, or ArgumentError.
+
+    Nested mappings are flattened to dotted names, as rclpy does.
+    """
     try:
         with open(path, encoding='utf-8') as stream:
             tree = yaml.safe_load(stream)
@@ -76,14 +79,14 @@ def _params_file_names(path):
     if not isinstance(tree, dict):
         raise ArgumentError(f'--params-file {path}: expected a mapping of node names to '
                             '{ros__parameters: {...}}')
-    names = []
+    values = {}
     for key, entry in tree.items():
         if not isinstance(entry, dict) or not isinstance(entry.get('ros__parameters'), dict):
             raise ArgumentError(f'--params-file {path}: node {key!r} has no '
                                 'ros__parameters mapping')
         if _node_key_matches(key):
-            names.extend(_flatten(entry['ros__parameters']))
-    return names
+            values.update(_flatten(entry['ros__parameters']))
+    return values
 
 
 def _flatten(mapping, prefix=''):
@@ -92,7 +95,7 @@ def _flatten(mapping, prefix=''):
         if isinstance(value, dict):
             yield from _flatten(value, name + '.')
         else:
-            yield name
+            yield name, value
 
 
 def check_arguments(argv):
@@ -116,7 +119,7 @@ def check_arguments(argv):
             if name is not None:
                 names.append(name)
         elif flag in _FILE_FLAGS:
-            names.extend(_params_file_names(section[i + 1]))
+            names.extend(params_file_values(section[i + 1]))
         i += 2 if needs_value else 1
     warnings = []
     for name in dict.fromkeys(names):

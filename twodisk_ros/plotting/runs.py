@@ -10,10 +10,10 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-import yaml
 
 from ..io.errors import one_line
 from ..io.reader import read_recording
+from ..node.arguments import ArgumentError, params_file_values
 from ..node.parameters import BY_NAME, DEFAULTS, parse_recorded
 from ..physics.body import TwoDiskBody
 from ..physics.contact_forces import ContactForceModel
@@ -91,24 +91,9 @@ def _describe(settings):
 def _params_file_values(path):
     """The ros__parameters a params file (the node's format) sets for the roller node."""
     try:
-        with open(path, encoding='utf-8') as stream:
-            tree = yaml.safe_load(stream)
-    except OSError as error:
-        raise RunError(f'cannot read params file {path}: {one_line(error.strerror or error)}'
-                       ) from None
-    except yaml.YAMLError as error:
-        raise RunError(f'params file {path} is not valid YAML ({one_line(error)[:120]})'
-                       ) from None
-    if not isinstance(tree, dict):
-        raise RunError(f'params file {path}: expected a mapping of node names to '
-                       '{ros__parameters: {...}}')
-    values = {}
-    for key, entry in tree.items():
-        last = str(key).lstrip('/').rsplit('/', 1)[-1]
-        if last in ('roller', '*', '**') and isinstance(entry, dict):
-            parameters = entry.get('ros__parameters')
-            if isinstance(parameters, dict):
-                values.update(parameters)
+        values = params_file_values(path)
+    except ArgumentError as error:
+        raise RunError(one_line(error)) from None
     if not values:
         raise RunError(f'params file {path}: no ros__parameters for the roller node')
     return values
