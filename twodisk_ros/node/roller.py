@@ -158,7 +158,9 @@ class Roller(Node):
             self._next['diagnostics'] = self._tick / self.settings.rate
         else:   # the same motion; friction, frame or path length may have changed
             self.simulation.update(candidate)
-            self._block = None
+            if self._block is not None:     # the prepared samples, encoded again
+                first, sample, stamps, _ = self._block
+                self._block = (first, sample, stamps, self._encode(sample, stamps))
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
 
@@ -179,6 +181,10 @@ class Roller(Node):
                                     f'{self.simulation.invalid.reason}; the rolling solution '
                                     'is published on, marked invalid in /diagnostics')
         stamps = self._start_ns + np.round(ticks * (1e9 / rate)).astype(np.int64)
+        return sample, stamps, self._encode(sample, stamps)
+
+    def _encode(self, sample, stamps):
+        """CDR bytes of the per-sample topics somebody wants: {topic: [bytes per sample]}."""
         frame = self.settings.frame_id
         encoders = {
             'pose': lambda: cdr.encode_pose_stamped(stamps, frame, sample.position_g,
@@ -189,13 +195,16 @@ class Roller(Node):
                 stamps, messages.JOINT_NAMES,
                 np.column_stack([sample.theta, sample.psi, sample.phase]),
                 np.column_stack([sample.theta_rate, sample.psi_rate, sample.phase_rate])),
-            'wrench_a': lambda: cdr.encode_wrench_stamped(stamps, frame, sample.forces.force_a),
-            'wrench_b': lambda: cdr.encode_wrench_stamped(stamps, frame, sample.forces.force_b),
         }
+        if sample.forces is not None:   # (a subscriber may appear after the sampling)
+            encoders['wrench_a'] = lambda: cdr.encode_wrench_stamped(stamps, frame,
+                                                                     sample.forces.force_a)
+            encoders['wrench_b'] = lambda: cdr.encode_wrench_stamped(stamps, frame,
+                                                                     sample.forces.force_b)
         encoded = {topic: encode() for topic, encode in encoders.items() if self._wanted(topic)}
         for topic, column in encoded.items():
             self.messages_built[topic] += len(column)
-        return sample, stamps, encoded
+        return encoded
 
     def _emit(self, sample, stamps, encoded, start, stop):
         """Publish and record samples [start, stop) of a prepared block, sample by sample."""
