@@ -41,7 +41,7 @@ PATH_RATE = 2.0          # Hz of simulated time: paths (up to path_length poses 
 DIAGNOSTICS_RATE = 1.0   # Hz of simulated time
 BATCH_SAMPLES = 2000     # samples computed and written at once in batch runs
 AHEAD = 0.05             # s: realtime states are computed this far ahead, in one block
-MAX_LAG = 0.1            # s: a realtime node further behind drops samples to catch up
+MAX_LAG = 0.5            # s: a realtime node further behind drops samples to catch up
 QOS_DEPTH = 10
 MIN_SAMPLES = 5          # a stopped run that began publishing ends with at least this many
 TOPIC_TYPES = {
@@ -103,6 +103,7 @@ class Roller(Node):
                 self._recorder.add_topic(publisher.topic_name, kind, publisher.qos_profile)
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
+        self._dropped_reported = 0      # samples_dropped at the last diagnostics
         self.messages_built = {topic: 0 for topic in TOPIC_TYPES}
         self._history = _PathHistory(self.settings.path_length)
         self._tick = 0                  # global sample index: simulated time tick / rate
@@ -295,11 +296,15 @@ class Roller(Node):
             level, message = messages.WARN, (f'{name} drift {drift:.2e} exceeds tolerance '
                                               f'{s.tolerance:.1e}')
         achieved = self.achieved_rate()
-        if s.realtime and achieved is not None and achieved < 0.95 * s.rate \
-                and level < messages.ERROR:
+        dropped_lately = self.samples_dropped - self._dropped_reported
+        self._dropped_reported = self.samples_dropped
+        slow = achieved is not None and achieved < 0.95 * s.rate
+        if s.realtime and (slow or dropped_lately) and level < messages.ERROR:
             level = messages.WARN
-            message = (f'cannot hold rate {s.rate:g} Hz: achieved {achieved:.4g} Hz, '
-                       f'{self.samples_dropped} samples dropped to keep real time')
+            rate_text = f'achieved {achieved:.4g} Hz, ' if achieved is not None else ''
+            message = (f'cannot hold rate {s.rate:g} Hz: {rate_text}{dropped_lately} samples '
+                       f'dropped since the last report ({self.samples_dropped} in all) to keep '
+                       'real time')
         contact_level, contact_message, contact_values = self.simulation.contact_status(
             sample, i)
         if contact_level > level:
@@ -329,6 +334,11 @@ class Roller(Node):
             return
         rate = self.settings.rate
         now = time.monotonic()
+        if self._tick == 0 and not self.samples_published:
+            # the clock starts with the first tick, not when the node was built (start-up,
+            # discovery and the executor's first spin are not samples missed)
+            self._wall_start = now
+            self._start_ns = self.get_clock().now().nanoseconds
         due = int(math.floor((now - self._wall_start) * rate)) + 1   # ticks due so far
         if self._pending is not None:
             self._apply_pending()
