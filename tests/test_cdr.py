@@ -30,12 +30,11 @@ rclpy_serialization = pytest.importorskip('rclpy.serialization')
 typesys = pytest.importorskip('rosbags.typesys')
 
 from geometry_msgs.msg import Pose, PoseStamped, Quaternion  # noqa: E402
-from mcap.records import Schema  # noqa: E402
-from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
 from twodisk_ros.io import msgdefs  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
+from cdr_helpers import mcap_decode  # noqa: E402
 from twodisk_ros.io import cdr  # noqa: E402
 
 serialize_message = rclpy_serialization.serialize_message
@@ -128,14 +127,6 @@ def assert_same(expected, got, kind='message', where='msg'):
                         f'{where}.{name}')
 
 
-_MCAP_DECODERS = {}
-
-
-def mcap_decode(data, name):
-    if name not in _MCAP_DECODERS:
-        schema = Schema(id=1, name=name, encoding='ros2msg', data=msgdefs.full_text(name))
-        _MCAP_DECODERS[name] = DecoderFactory().decoder_for('cdr', schema)
-    return _MCAP_DECODERS[name](data)
 
 
 def check(ours, msg, extra=0):

@@ -30,8 +30,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue  # n
 from geometry_msgs.msg import (Point, Pose, PoseWithCovariance,  # noqa: E402
                                Quaternion, Twist, TwistWithCovariance, Vector3, Wrench,
                                WrenchStamped)
-from mcap.records import Schema  # noqa: E402
-from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
 from rcl_interfaces.msg import ParameterValue  # noqa: E402
 from sensor_msgs.msg import (CameraInfo, CompressedImage, Image, Imu, JointState,  # noqa: E402
@@ -44,6 +42,7 @@ from type_description_interfaces.msg import FieldType  # noqa: E402
 from unique_identifier_msgs.msg import UUID  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray, MeshFile, UVCoordinate  # noqa: E402
 
+from cdr_helpers import mcap_decode  # noqa: E402
 from twodisk_ros.io import cdr, msgdefs  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 
@@ -136,14 +135,6 @@ def assert_same(expected, got, kind='message', where='msg'):
                         f'{where}.{name}')
 
 
-_MCAP_DECODERS = {}
-
-
-def mcap_decode(data, name):
-    if name not in _MCAP_DECODERS:
-        schema = Schema(id=1, name=name, encoding='ros2msg', data=msgdefs.full_text(name))
-        _MCAP_DECODERS[name] = DecoderFactory().decoder_for('cdr', schema)
-    return _MCAP_DECODERS[name](data)
 
 
 def check(msg):
