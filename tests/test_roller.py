@@ -480,9 +480,12 @@ def test_subprocess_sigterm_exits_0(client_context):
     # signal landing in the middle of publishing still ends cleanly.
     for _ in range(3):
         poses.clear()
+        started = time.time_ns()     # poses of this process only (not queued ones of the last)
         process = start_roller('-p', 'rate:=1000.0')
         try:
-            assert spin_until(executor, lambda: len(poses) >= 50, 20.0), 'no pose messages'
+            assert spin_until(executor, lambda: sum(stamp_ns(m.header) >= started
+                                                    for m in poses) >= 50, 20.0), \
+                'no pose messages'
         finally:
             code, stderr = stop(process, signal.SIGTERM)
         assert 'Traceback' not in stderr, stderr
