@@ -89,7 +89,8 @@ class PartsCache:
     def save(self, index, arrays):
         """Save one chunk's arrays (name → array or list of str), atomically."""
         path = self._chunk_path(index)
-        tmp = path.with_name(path.name + f'.tmp{os.getpid()}.npz')
+        # the temporary name does not match chunk-*.npz: a half-written chunk is never listed
+        tmp = path.with_name(f'.{path.stem}.tmp{os.getpid()}.npz')
         np.savez(tmp, **{name: np.asarray(value) for name, value in arrays.items()})
         os.replace(tmp, path)
 
