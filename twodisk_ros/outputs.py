@@ -1,0 +1,131 @@
+"""One rule for every file a command writes (standard library only).
+
+Every command of the package that writes a file (``roller record:=``, ``twodisk-inspect
+--plot/--csv/--npz``, ``twodisk-animate -o``, ``twodisk-sweep --out/--plot``, the figure
+commands) checks its outputs with :func:`check_output` *before* doing any work, and writes
+them through :func:`replacing`:
+
+- an existing file is refused unless the user said so (``--overwrite``, ``overwrite:=true``);
+- a path that exists but is not a regular file (a directory, a device such as ``/dev/null``,
+  a FIFO, a socket) is refused even then: the command never replaces or removes what it did
+  not create;
+- a suffix the command cannot write (``--out maps.csv`` for a NetCDF file) is refused;
+- a missing parent directory is refused (nothing is created behind the user's back, except
+  the output directories a command documents);
+- the new content goes to a hidden temporary file beside the target and replaces it in one
+  atomic rename only when complete, so an interrupted or failed command leaves the old file
+  byte for byte as it was (and no half-written new one).
+
+Each refusal is an :class:`OutputError` whose message is one line naming the path, what is
+wrong and what is allowed; the commands print it and exit 2.
+"""
+
+import contextlib
+import os
+import stat
+import tempfile
+
+__all__ = ['OutputError', 'check_output', 'check_output_dir', 'replacing']
+
+
+class OutputError(ValueError):
+    """An output path the command refuses; the message is one line."""
+
+
+def _kind(mode):
+    for test, name in ((stat.S_ISDIR, 'a directory'), (stat.S_ISCHR, 'a character device'),
+                       (stat.S_ISBLK, 'a block device'), (stat.S_ISFIFO, 'a FIFO'),
+                       (stat.S_ISSOCK, 'a socket')):
+        if test(mode):
+            return name
+    return 'not a regular file'
+
+
+def check_output(path, *, overwrite=False, suffixes=None, option='--overwrite'):
+    """Check that ``path`` may be written; return it as given, or raise :class:`OutputError`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output file.
+    overwrite : bool
+        The user allowed replacing an existing regular file.
+    suffixes : sequence of str, optional
+        The suffixes the command can write (lower case, with the dot: ``('.png',)``).
+    option : str
+        How the user says "replace it", quoted in the refusal (``--overwrite``,
+        ``-p overwrite:=true``).
+    """
+    text = os.fspath(path)
+    if not text:
+        raise OutputError('the output path is empty')
+    if suffixes:
+        suffix = os.path.splitext(text)[1].lower()
+        if suffix not in suffixes:
+            allowed = ', '.join(suffixes)
+            raise OutputError(f'{text}: cannot write a {suffix or "suffix-less"} file here '
+                              f'(allowed: {allowed})')
+    try:
+        info = os.stat(text)
+    except FileNotFoundError:
+        info = None
+    except OSError as error:
+        raise OutputError(f'{text}: cannot use it as an output: '
+                          f'{error.strerror or error}') from None
+    if info is not None:
+        if not stat.S_ISREG(info.st_mode):
+            raise OutputError(f'{text} is {_kind(info.st_mode)}: the output must be a '
+                              'regular file (or a new name)')
+        if not overwrite:
+            raise OutputError(f'{text} exists: pass {option} to replace it')
+    parent = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(parent):
+        raise OutputError(f'{text}: directory {parent} does not exist')
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f'{text}: directory {parent} is not writable')
+    return path
+
+
+def check_output_dir(path, *, overwrite=False, names=(), option='--overwrite'):
+    """Check an output directory and the files ``names`` that will be written into it.
+
+    The directory may exist or will be created (its parent must exist). Each name that
+    exists in it is refused unless ``overwrite``; a name that is not a regular file always.
+    """
+    text = os.fspath(path)
+    if not text:
+        raise OutputError('the output directory is empty')
+    if os.path.exists(text) and not os.path.isdir(text):
+        raise OutputError(f'{text} exists and is not a directory')
+    parent = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(parent):
+        raise OutputError(f'{text}: directory {parent} does not exist')
+    if os.path.isdir(text):
+        for name in names:
+            check_output(os.path.join(text, name), overwrite=overwrite, option=option)
+    return path
+
+
+@contextlib.contextmanager
+def replacing(path):
+    """Write ``path`` through a hidden temporary file beside it, renamed over it at the end.
+
+    Yields the temporary file's path (for writers that open files by name, such as
+    matplotlib's ``savefig`` or xarray's ``to_netcdf``). On success the temporary file
+    replaces ``path`` atomically; on any exception (also KeyboardInterrupt) it is removed and
+    ``path`` is left as it was. Call :func:`check_output` first.
+    """
+    text = os.fspath(path)
+    directory, name = os.path.split(os.path.abspath(text))
+    stem, suffix = os.path.splitext(name)
+    # the suffix is kept: writers choose the format from it (PNG, GIF, NetCDF)
+    handle, temporary = tempfile.mkstemp(prefix=f'.{stem}.', suffix=f'.partial{suffix}',
+                                         dir=directory)
+    os.close(handle)
+    try:
+        yield temporary
+        os.replace(temporary, text)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(temporary)
+        raise
