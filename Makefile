@@ -12,14 +12,24 @@ export MPLBACKEND := Agg
 
 venv: $(VENV)/.installed
 
-$(VENV)/.installed: requirements.txt
+# The pinned requirements, then twodisk_ros itself (editable: the venv runs this checkout's
+# code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep` and
+# `twodisk-figures` are in .venv/bin and work from any directory; the parameter files go to
+# .venv/share/twodisk_ros/config, where a colcon install puts them.
+$(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation \
+	    --use-pep517 --editable .
+	install -d $(VENV)/share/twodisk_ros/config
+	install -m 644 package.xml $(VENV)/share/twodisk_ros/
+	install -m 644 config/* $(VENV)/share/twodisk_ros/config/
 	touch $@
 
-## Run the whole test suite (what CI runs).
+## Run the whole test suite (what CI runs), one pytest worker per core (a test module stays
+## on one worker: each module has its own ROS domain).
 test: venv
-	$(PY) -m pytest
+	$(PY) -m pytest -n auto --dist loadfile
 
 ## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
 demo: venv
@@ -37,7 +47,7 @@ figures: venv
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
 bench: venv
-	$(PY) benchmarks/run_all.py
+	$(PY) benchmarks/run_all.py --overwrite
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache .hypothesis

@@ -190,5 +190,8 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0):
 
 
 if __name__ == '__main__':
+    import argparse
+    argparse.ArgumentParser(description=__doc__.splitlines()[0] + ' Real time at 100 Hz, 1 kHz '
+                            'and 10 kHz (5 s each).').parse_args()
     for hz in (100.0, 1000.0, 10000.0):
         print(realtime_rate(hz, seconds=5.0, warmup=2.0))

@@ -36,6 +36,7 @@ from report import write_report, TARGET_RATE, TARGET_POS_ERROR, TARGET_RATIO  # 
 from reference import ReferenceBody  # noqa: E402
 
 from twodisk_ros import TwoDiskBody  # noqa: E402
+from twodisk_ros.outputs import OutputError, check_output  # noqa: E402
 from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
 
@@ -177,7 +178,16 @@ def main(argv=None):
     parser.add_argument('--figure',
                         default=os.path.join(ROOT, 'docs', 'figures', 'work_precision.png'))
     parser.add_argument('--json', default=os.path.join(HERE, 'results.json'))
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace the report, the figure and the JSON if they exist '
+                        '(make bench passes it)')
     args = parser.parse_args(argv)
+    try:
+        for path, suffixes in ((args.out, ('.md',)), (args.figure, ('.png',)),
+                               (args.json, ('.json',))):
+            check_output(path, overwrite=args.overwrite, suffixes=suffixes)
+    except OutputError as error:
+        parser.exit(2, f'{parser.prog}: {error}\n')
     start = time.perf_counter()
     machine = machine_info()
     date = _run(['date', '-u']) or datetime.datetime.now(datetime.timezone.utc).isoformat()

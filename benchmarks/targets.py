@@ -392,10 +392,17 @@ def speed_ratios(results):
 
 
 if __name__ == '__main__':       # PYTHONPATH=. python benchmarks/targets.py [body ...]
-    import sys
+    import argparse
     from scenarios import BODIES
     from work_precision import build
-    for name in sys.argv[1:] or list(BODIES):
+    parser = argparse.ArgumentParser(description='Poses per second of the table method, and '
+                                     'their errors, for the benchmark bodies.')
+    parser.add_argument('bodies', nargs='*', metavar='BODY',
+                        help=f'bodies to measure (default: all of {", ".join(BODIES)})')
+    chosen = parser.parse_args().bodies
+    for unknown in set(chosen) - set(BODIES):
+        parser.error(f'unknown body {unknown!r} (known: {", ".join(BODIES)})')
+    for name in chosen or list(BODIES):
         r = poses_throughput(build(name))
         print(f'{name}: poses {r.rate_poses / 1e6:.2f} M/s, positions '
               f'{r.rate_positions / 1e6:.2f} M/s, state {r.rate_state / 1e6:.2f} M/s; errors: '

@@ -296,4 +296,9 @@ def field_names():
 
 
 if __name__ == '__main__':
+    import argparse
+    argparse.ArgumentParser(
+        prog='python -m twodisk_ros.node.parameters',
+        description="Print the roller node's parameter table (Markdown, as in the README)."
+    ).parse_args()
     print(markdown_table())   # the README's table
