@@ -93,15 +93,27 @@ def _refused_output(args):
         path = getattr(args, option)
         if path is None:
             continue
+        if os.path.isdir(path):
+            return f'cannot write {what} {path}: it is a directory (give a file name ending ' \
+                   f'in {suffix})'
         try:
             check_output(path, overwrite=args.overwrite, suffixes=(suffix,))
         except OutputError as error:
-            return f'cannot write {what}: {error}'
+            return f'cannot write {what} {path}: {_without_path(str(error), path)}'
         real = os.path.realpath(path)
         if real in chosen:
-            return f'cannot write {what}: {path} is also the --{chosen[real]} output'
+            return f'cannot write {what} {path}: it is also the --{chosen[real]} output'
         chosen[real] = option
     return None
+
+
+def _without_path(message, path):
+    """An :class:`OutputError` message without the path it starts with (named already)."""
+    text = os.fspath(path)
+    if not message.startswith(text):
+        return message
+    rest = message[len(text):]
+    return rest[2:] if rest.startswith(': ') else 'it' + rest
 
 
 def _run(args):
