@@ -348,16 +348,25 @@ def test_unreadable_file_exits_2_with_one_line(tmp_path, kind):
 
 
 def test_truncated_file_reports_recovery_and_checks_the_rest(capsys, tmp_path, clean_file):
+    """A cut file is checked on what was recovered; the verdict is INCOMPLETE (exit 4)."""
     data = clean_file.read_bytes()
     cut = tmp_path / 'cut.mcap'
     cut.write_bytes(data[:int(0.6 * len(data))])
     status, out, _ = run_main(capsys, cut)
-    assert status == 0, out
-    assert 'TRUNCATED' in out and f'of {int(0.6 * len(data))} bytes' in out
+    assert status == 4, out
+    assert 'TRUNCATED' in out and f'of the {int(0.6 * len(data)):,} bytes'.replace(',', ' ') in out
+    assert 'result: INCOMPLETE (all ' in out and 'FAIL' not in out
     status, out, _ = run_main(capsys, cut, '--json')
     document = json.loads(out)
     recovered = document['summary']['recovered']
-    assert document['summary']['truncated'] is True and status == 0
+    assert document['summary']['truncated'] is True and status == 4
+    assert document['verdict'] == 'INCOMPLETE' and document['exit_status'] == 4
+    assert document['checks_passed'] is True and document['passed'] is False
     assert 0 < recovered['bytes'] < recovered['total_bytes'] == int(0.6 * len(data))
     assert 100 < document['summary']['samples'] < 301
+    run = document['summary']['run']
+    # the share of the run: samples recovered of the 3 s × 100 Hz + 1 the run holds
+    assert run['expected_samples'] == 301
+    assert run['recovered_samples'] == document['summary']['samples']
+    assert run['share'] == run['recovered_samples'] / 301
     assert 0 < recovered['messages'] < len(read_recording(clean_file).messages)

@@ -3,7 +3,7 @@
 One recording is made per session by the node itself (a 2 s batch run at 100 Hz); hundreds of
 mutated copies (bit flips, truncations at random points and at every record boundary, zeroed,
 duplicated and removed ranges, wrong CRCs, tiny files) are inspected in-process, a few through
-a subprocess.  Whatever the damage: exit 0/1 with a report, or exit 2 with exactly one
+a subprocess.  Whatever the damage: exit 0/1/4 with a report, or exit 2 with exactly one
 non-empty line ``twodisk-inspect: cannot read recording PATH: <reason>``; never a traceback,
 never a hang.  The random generator is seeded: a failure names the seed and the case.
 """
@@ -217,7 +217,7 @@ def run_in_process(path, *extra):
 
 def assert_outcome(status, out, err, path, why):
     assert 'Traceback' not in out + err, why + err[-2000:]
-    assert status in (0, 1, 2), why
+    assert status in (0, 1, 2, 4), why     # PASS, FAIL, unreadable, INCOMPLETE
     if status == 2:
         lines = err.splitlines()
         assert len(lines) == 1 and err.endswith('\n'), why + repr(err)
@@ -253,7 +253,8 @@ def test_inspector_survives_every_mutation(tmp_path, variants):
     print(f'\nfuzz outcomes by kind (exit status: cases): {report}')
     assert sum(sum(c.values()) for c in outcomes.values()) > 550
     # the mutations reach every outcome: reports of what was recovered, and refusals
-    assert outcomes['flip'][1] and outcomes['truncate'][0] and outcomes['tiny'][2]
+    assert outcomes['flip'][1] and outcomes['truncate'][4] and outcomes['tiny'][2]
+    assert not outcomes['truncate'][0]      # a cut file is never a PASS
 
 
 def test_damaged_files_through_a_subprocess(tmp_path, variants):
@@ -403,5 +404,5 @@ def test_plot_of_a_damaged_recording_names_the_file_written(tmp_path, original):
     path.write_bytes(original[:len(original) * 2 // 3])
     png = tmp_path / 'cut.png'
     status, out, err = run_in_process(path, '--plot', str(png))
-    assert status in (0, 1) and err == ''
+    assert status == 4 and err == ''     # INCOMPLETE: the checks pass on the cut file
     assert f'plot: {png}' in out and png.stat().st_size > 0

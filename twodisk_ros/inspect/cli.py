@@ -1,7 +1,12 @@
-"""``twodisk-inspect FILE.mcap [--json] [--plot PNG]``: summary and checks of a recording.
+"""``twodisk-inspect FILE.mcap [--json] [--plot PNG] [--csv CSV] [--npz NPZ] [--overwrite]``.
 
-Exit status: 0 when every check passes, 1 when one fails, 2 when the file cannot be read or
-the plot cannot be written (one line on stderr).
+Summary and checks of a recording, and its states as a table.
+
+Exit status (:mod:`twodisk_ros.inspect.results`): 0 PASS (every check passes and the run is
+all there), 1 FAIL (a check fails), 4 INCOMPLETE (every check passes on the recovered part,
+but the file is cut or damaged), 2 the file cannot be read, an output is refused (an existing
+file without ``--overwrite``, a wrong suffix, a missing directory) or cannot be written (one
+line on stderr).
 """
 
 import argparse
@@ -14,39 +19,43 @@ import numpy as np
 
 from ..io import RecordingError
 from ..io.errors import one_line
+from ..outputs import OutputError, check_output, replacing
 from .inspection import inspect_recording
 from .report import PROG, format_report
+from .results import EXIT_UNUSABLE
 
 __all__ = ['main']
+
+#: (option, suffix, what) of every file the command may write.
+_OUTPUTS = (('plot', '.png', 'plot'), ('csv', '.csv', 'CSV'), ('npz', '.npz', 'NPZ'))
 
 
 def _parser():
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description='Summarise a roller MCAP recording and check it offline against the '
-                    'physics (contacts, no slip, energy, timestamps).',
-        epilog='Exit status: 0 every check passes, 1 a check fails, 2 the file cannot be read '
-               '(or the plot cannot be written).')
+        description='Summarise a roller MCAP recording, check it offline against the '
+                    'physics (contacts, no slip, energy, timestamps) and against the run it '
+                    'was meant to hold (duration x rate), and export its states.',
+        epilog='Exit status: 0 PASS (every check passes and the whole run is there), 1 FAIL '
+               '(a check fails), 4 INCOMPLETE (the checks pass on what was recovered, but '
+               'the file is cut or damaged), 2 the file cannot be read or an output is '
+               'refused or cannot be written.')
     parser.add_argument('file', help='the .mcap recording')
     parser.add_argument('--json', action='store_true',
-                        help='print one JSON document (summary and checks) instead of text')
+                        help='print one JSON document (summary, checks, verdict) instead of '
+                             'text')
     parser.add_argument('--plot', metavar='PNG',
                         help='write a figure (a file name ending in .png): traces on the '
                              'ground, height of G, energy')
+    parser.add_argument('--csv', metavar='CSV',
+                        help='write the states, one row per sample, as CSV (.csv; header '
+                             '"name [unit]", floats that read back exactly)')
+    parser.add_argument('--npz', metavar='NPZ',
+                        help='write the same columns as a NumPy .npz (one array per column, '
+                             'with "columns" and "units")')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace existing --plot/--csv/--npz files (refused otherwise)')
     return parser
-
-
-def _plot_refusal(path):
-    """Why the figure cannot go to ``path`` (None if it can be tried).
-
-    The path must name a ``.png`` file: matplotlib would append ``.png`` to a path without
-    suffix, and the report must name the file actually written.
-    """
-    if os.path.isdir(path):
-        return 'it is a directory (give a file name ending in .png)'
-    if not os.fspath(path).lower().endswith('.png'):
-        return 'the file name must end in .png'
-    return None
 
 
 def _print(text):
@@ -58,10 +67,7 @@ def _print(text):
 
 
 def main(argv=None):
-    """Run ``twodisk-inspect``; return the exit status.
-
-    0 when every check passes, 1 when a check fails, 2 when the file cannot be read or the
-    plot cannot be written (one line on stderr, no traceback).
+    """Run ``twodisk-inspect``; return the exit status (module doc: 0, 1, 2 or 4).
 
     Parameters
     ----------
@@ -80,38 +86,80 @@ def main(argv=None):
         return _run(args)
 
 
+def _refused_output(args):
+    """One line saying why an output cannot be written, or None (checked before any work)."""
+    chosen = {}
+    for option, suffix, what in _OUTPUTS:
+        path = getattr(args, option)
+        if path is None:
+            continue
+        if os.path.isdir(path):
+            return f'cannot write {what} {path}: it is a directory (give a file name ending ' \
+                   f'in {suffix})'
+        try:
+            check_output(path, overwrite=args.overwrite, suffixes=(suffix,))
+        except OutputError as error:
+            return f'cannot write {what} {path}: {_without_path(str(error), path)}'
+        real = os.path.realpath(path)
+        if real in chosen:
+            return f'cannot write {what} {path}: it is also the --{chosen[real]} output'
+        chosen[real] = option
+    return None
+
+
+def _without_path(message, path):
+    """An :class:`OutputError` message without the path it starts with (named already)."""
+    text = os.fspath(path)
+    if not message.startswith(text):
+        return message
+    rest = message[len(text):]
+    return rest[2:] if rest.startswith(': ') else 'it' + rest
+
+
 def _run(args):
-    if args.plot:
-        refusal = _plot_refusal(args.plot)
-        if refusal:
-            print(f'{PROG}: cannot write plot {args.plot}: {refusal}', file=sys.stderr)
-            return 2
+    refusal = _refused_output(args)
+    if refusal:
+        print(f'{PROG}: {one_line(refusal)}', file=sys.stderr)
+        return EXIT_UNUSABLE
     try:
         inspection = inspect_recording(args.file)
     except RecordingError as error:
         print(f'{PROG}: {one_line(error) or "unreadable"}', file=sys.stderr)
-        return 2
+        return EXIT_UNUSABLE
     except Exception as error:  # noqa: BLE001 - last resort: one line, never a traceback
         print(f'{PROG}: cannot read recording {args.file}: internal error: '
               f'{one_line(error) or "no message"} ({type(error).__name__})', file=sys.stderr)
-        return 2
+        return EXIT_UNUSABLE
     if args.json:
         _print(json.dumps(inspection.as_dict(), indent=2, allow_nan=False, ensure_ascii=False))
     else:
         _print(format_report(inspection))
-    if args.plot:
+    for option, _, what in _OUTPUTS:
+        path = getattr(args, option)
+        if path is None:
+            continue
         try:
-            from ..plotting.inspection import plot_inspection
-            plot_inspection(inspection, args.plot)
-        except Exception as error:  # noqa: BLE001 - any failure to plot is one line
+            _write(option, inspection, path)
+        except Exception as error:  # noqa: BLE001 - any failure to write is one line
             reason = one_line(error) or type(error).__name__
             if not isinstance(error, (OSError, ValueError)):
                 reason = f'{reason} ({type(error).__name__})'
-            print(f'{PROG}: cannot write plot {args.plot}: {reason}', file=sys.stderr)
-            return 2
+            print(f'{PROG}: cannot write {what} {path}: {reason}', file=sys.stderr)
+            return EXIT_UNUSABLE
         if not args.json:
-            _print(f'plot: {args.plot}')
-    return 0 if inspection.passed else 1
+            _print(f'{option}: {path}')
+    return inspection.exit_status
+
+
+def _write(option, inspection, path):
+    """Write one output through a temporary file renamed over ``path`` when complete."""
+    if option == 'plot':
+        from ..plotting.inspection import plot_inspection
+        with replacing(path) as temporary:
+            plot_inspection(inspection, temporary)
+    else:
+        from .export import write_outputs
+        write_outputs(inspection, **{option: path})
 
 
 if __name__ == '__main__':

@@ -9,13 +9,16 @@ damaged file (corrupt chunks, CRC mismatches, lost framing: see
 :mod:`twodisk_ros.io.mcap_scan` for what is skipped) is checked on what could be read, and
 the damage, with messages that do not decode, are problems of the ``inputs`` check.  A file
 from which no channel, message or metadata can be read is not a recording
-(:class:`RecordingError`).
+(:class:`RecordingError`).  How much of the *run* was recovered (samples against ``duration``
+× ``rate``) is ``summary['run']`` (:mod:`twodisk_ros.inspect.completeness`); with it the
+checks give the verdict PASS, FAIL or INCOMPLETE (:mod:`twodisk_ros.inspect.results`).
 """
 
 import numpy as np
 
 from ..io import RecordingError, read_recording
 from .checks import run_checks
+from .completeness import run_completeness
 from .differences import kinetic_energy
 from .force_checks import FORCE_TITLES, force_checks
 from .model import build_model
@@ -145,9 +148,13 @@ def inspect_recording(path):
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
     summary['diagnostics'] = _diagnostics_summary(series)
     summary['contact_forces'] = forces
+    diagnostics = series.get('diagnostics')
+    summary['run'] = json_ready(run_completeness(
+        recording, parameters, None if samples is None else samples.t,
+        0 if diagnostics is None else len(diagnostics)))
     plot = _plot_series(series, samples, motion, model, stamp0)
     plot.update(force_series)
-    return Inspection(summary, checks, plot)
+    return Inspection(summary, checks, plot, samples=samples, sources=series)
 
 
 def _force_checks(series, samples, motion, model, parameters, truncated):

@@ -2,9 +2,10 @@
 
 import textwrap
 
+from .results import FAIL, INCOMPLETE
 from .series import METADATA_NAME
 
-__all__ = ['PROG', 'format_report']
+__all__ = ['PROG', 'format_report', 'run_phrase']
 
 PROG = 'twodisk-inspect'
 _DAMAGE_SHOWN = 10
@@ -23,6 +24,80 @@ def _value(value, unit):
         return 'n/a'
     text = f'{value:.3g}'
     return f'{text} {unit}' if unit else text
+
+
+def _count(number):
+    """An integer with its thousands apart: 10001 → '10 001'."""
+    return f'{number:,}'.replace(',', ' ')
+
+
+def _percent(part, whole):
+    """part / whole in %, one decimal; never 100.0 for a part short of the whole, nor 0.0."""
+    share = 100.0 * part / whole
+    text = f'{share:.1f}'
+    if part < whole and text in ('100.0', '100'):
+        text = '99.9'
+    elif 0 < part and text == '0.0':
+        text = '0.1'
+    return f'{text} %'
+
+
+def run_phrase(run):
+    """The share of the run recovered, in words (``summary['run']``; '' without it).
+
+    E.g. ``recovered 6 667 of 10 001 samples of the run (66.7 %), t = 0 … 6.66 s of 10 s``.
+    """
+    if not run:
+        return ''
+    count, expected = run['recovered_samples'], run['expected_samples']
+    span = (f't = {run["first_s"]:.6g} … {run["last_s"]:.6g} s' if count else 'no sample')
+    if expected is not None:
+        return (f'recovered {_count(count)} of {_count(expected)} samples of the run '
+                f'({_percent(count, expected)}), {span} of {run["duration_s"]:.6g} s')
+    why = ('duration 0: the run was to go on until stopped, so no count is expected'
+           if run['duration_s'] == 0 else 'no recorded duration and rate: no expected count')
+    return f'recovered {_count(count)} samples, {span} ({why})'
+
+
+def _run_lines(run):
+    """The ``run:`` line: the share of the run, completeness of the file, diagnostics."""
+    if not run:
+        return []
+    text = run_phrase(run)
+    if run['stopped_early']:
+        text += ('; stopped early, the file is complete (closed by the node, as after '
+                 'SIGINT or SIGTERM)')
+    elif run['complete']:
+        text += '; the file is complete'
+    else:
+        text += f'; INCOMPLETE: {run["reason"]}'
+    diagnostics = run['recovered_diagnostics']
+    if run['expected_diagnostics'] is not None and not run['stopped_early']:
+        text += f'; {diagnostics} of {run["expected_diagnostics"]} diagnostics'
+    else:
+        text += f'; {diagnostics} diagnostics'
+    return textwrap.wrap(f'run: {text}', 99, initial_indent='  ', subsequent_indent='    ')
+
+
+def _result_line(inspection):
+    """``result: PASS|FAIL|INCOMPLETE (...)``."""
+    checks, run = inspection.checks, inspection.summary.get('run') or {}
+    failed = [check.name for check in checks if not check.passed]
+    verdict = inspection.verdict
+    if verdict == FAIL:
+        text = (f'result: FAIL ({len(failed)} of {len(checks)} checks failed: '
+                f'{", ".join(failed)})')
+        if not inspection.complete:
+            text += f'; the run is also INCOMPLETE: {run["reason"]}, {run_phrase(run)}'
+        return text
+    if verdict == INCOMPLETE:
+        return (f'result: INCOMPLETE (all {len(checks)} checks passed on the recovered part, '
+                f'but {run["reason"]}: {run_phrase(run)})')
+    text = f'result: PASS (all {len(checks)} checks passed)'
+    if run.get('stopped_early'):
+        text += f'; the run was stopped early, at t = {run["last_s"]:.6g} s of ' \
+                f'{run["duration_s"]:.6g} s, and its file is complete'
+    return text
 
 
 def _extremes(info):
@@ -64,9 +139,9 @@ def format_report(inspection):
              f'written by {s["library"] or "?"}']
     rec = s['recovered']
     fraction = rec['fraction'] if rec['fraction'] is not None else 0.0
-    recovered = (f'recovered {rec["messages"]} messages from {rec["bytes"]} of '
-                 f'{rec["total_bytes"]} bytes ({fraction:.1%}); the checks below are of that '
-                 f'part')
+    recovered = (f'read {rec["messages"]} messages from {_count(rec["bytes"])} of the '
+                 f'{_count(rec["total_bytes"])} bytes in the file ({100 * fraction:.1f} % '
+                 f'of this file, not of the run); the checks below are of that part')
     if s.get('damaged'):
         cut = ', and TRUNCATED (no footer)' if s['truncated'] else ''
         parts = f'{len(s["damage"])} damaged part' + ('s' if len(s['damage']) > 1 else '')
@@ -86,6 +161,7 @@ def format_report(inspection):
                      f'{len(s["topics"])} topics')
     else:
         lines.append('  no messages')
+    lines.extend(_run_lines(s.get('run')))
     lines.append('topics:')
     width = max([len(t['topic']) for t in s['topics']] + [5])
     type_width = max([len(t['type']) for t in s['topics']] + [4])
@@ -122,10 +198,5 @@ def format_report(inspection):
         for line in check.detail:
             lines.extend(textwrap.wrap(line, 99, initial_indent=' ' * 8,
                                        subsequent_indent=' ' * 10))
-    failed = [check.name for check in inspection.checks if not check.passed]
-    if failed:
-        lines.append(f'result: FAIL ({len(failed)} of {len(inspection.checks)} checks failed: '
-                     f'{", ".join(failed)})')
-    else:
-        lines.append(f'result: PASS (all {len(inspection.checks)} checks passed)')
+    lines.append(_result_line(inspection))
     return '\n'.join(lines)

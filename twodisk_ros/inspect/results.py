@@ -1,11 +1,33 @@
-"""The results of an inspection: checks with values and tolerances, and the whole report."""
+"""The results of an inspection: checks with values and tolerances, the verdict, the report.
+
+The verdict of a recording and the exit status of ``twodisk-inspect``:
+
+``PASS`` (0)
+    every check passes and the run is all there (a run stopped early by a signal, whose file
+    the node closed, is all there: :mod:`~twodisk_ros.inspect.completeness`);
+``FAIL`` (1)
+    a check fails (whatever else: it takes precedence);
+``INCOMPLETE`` (4)
+    every check passes on what was recovered, but the run is not all there: the file is cut
+    (no footer) or damaged, or samples are missing inside it;
+
+and exit status 2 for a file that cannot be read or an output that cannot be written
+(:data:`EXIT_UNUSABLE`).
+"""
 
 from dataclasses import dataclass, field
 import math
 
 import numpy as np
 
-__all__ = ['Check', 'Inspection', 'json_ready']
+__all__ = ['Check', 'EXIT_STATUS', 'EXIT_UNUSABLE', 'FAIL', 'INCOMPLETE', 'Inspection', 'PASS',
+           'json_ready']
+
+PASS, FAIL, INCOMPLETE = 'PASS', 'FAIL', 'INCOMPLETE'
+#: Exit status of ``twodisk-inspect`` for each verdict.
+EXIT_STATUS = {PASS: 0, FAIL: 1, INCOMPLETE: 4}
+#: Exit status for a file that cannot be read, bad arguments or an output refused.
+EXIT_UNUSABLE = 2
 
 
 @dataclass
@@ -55,26 +77,57 @@ class Inspection:
     Attributes
     ----------
     summary : dict
-        JSON-ready: file, truncation, duration, topics, parameters, samples.
+        JSON-ready: file, truncation, duration, topics, parameters, samples, and ``run``
+        (:func:`~twodisk_ros.inspect.completeness.run_completeness`: the share of the run
+        recovered).
     checks : list of Check
     series : dict of str to numpy.ndarray
         Time series for :func:`twodisk_ros.plotting.inspection.plot_inspection` (times in s
         from the first stamp).
+    samples : Samples or None
+        The joined samples (:func:`~twodisk_ros.inspect.series.join_samples`).
+    sources : dict of str to Series
+        The recorded series by role (``'pose'``, ``'wrench_a'``, ...), for the export.
     """
 
     summary: dict
     checks: list
     series: dict = field(default_factory=dict)
+    samples: object = None
+    sources: dict = field(default_factory=dict)
 
     @property
     def passed(self):
-        """True if every check passed."""
+        """True if every check passed (on what was recovered: see :attr:`verdict`)."""
         return bool(self.checks) and all(check.passed for check in self.checks)
 
+    @property
+    def complete(self):
+        """True if the run is all there (summaries without ``run`` count as complete)."""
+        return bool(self.summary.get('run', {}).get('complete', True))
+
+    @property
+    def verdict(self):
+        """``'PASS'``, ``'FAIL'`` (a check fails) or ``'INCOMPLETE'`` (checks pass, run cut)."""
+        if not self.passed:
+            return FAIL
+        return PASS if self.complete else INCOMPLETE
+
+    @property
+    def exit_status(self):
+        """0 PASS, 1 FAIL, 4 INCOMPLETE (:data:`EXIT_STATUS`)."""
+        return EXIT_STATUS[self.verdict]
+
     def as_dict(self):
-        """One JSON-ready document: summary, checks, overall result."""
+        """One JSON-ready document: summary, checks, verdict and exit status.
+
+        ``passed`` is True only for the verdict PASS; ``checks_passed`` says whether every
+        check passed on what was recovered.
+        """
         return {'summary': self.summary, 'checks': [c.as_dict() for c in self.checks],
-                'passed': self.passed, 'exit_status': 0 if self.passed else 1}
+                'verdict': self.verdict, 'passed': self.verdict == PASS,
+                'checks_passed': self.passed, 'complete': self.complete,
+                'exit_status': self.exit_status}
 
 
 def json_ready(value):
