@@ -25,6 +25,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from ..physics.body import TwoDiskBody  # noqa: E402
+from . import palette  # noqa: E402
 from ..physics.cycle import RollingCycle  # noqa: E402
 from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
@@ -35,7 +36,7 @@ __all__ = ['FIGURE3', 'FIGURE4', 'plot_traces', 'plot_height', 'plot_stability_m
 FIGURE3 = (2.0, 1.0, 1.0)
 FIGURE4 = (math.sqrt(1.5), 1.0, 1.0)
 
-COLOR_A, COLOR_B, COLOR_RULING = '#1f5fa8', '#c8501e', '0.72'
+COLOR_A, COLOR_B, COLOR_RULING = palette.A, palette.B, '0.72'
 DPI = 150
 TWO_PI = 2.0 * math.pi
 
