@@ -12,7 +12,7 @@ import numpy as np
 
 from . import palette
 
-__all__ = ['plot_inspection', 'invariant_drift', 'align_zeros']
+__all__ = ['plot_inspection', 'inspection_figure', 'invariant_drift', 'align_zeros']
 
 #: μ_required is drawn up to this multiple of the friction μ (the rest is clipped, and said)
 MU_CLIP = 3.0
@@ -24,13 +24,23 @@ SHADES = (('lift-off', palette.INVALID, 'a contact lifts off (N < 0)'),
 
 
 def plot_inspection(inspection, path):
-    """Write a figure of a recording: traces on the ground, height of G, energy over time.
+    """Write :func:`inspection_figure` of a recording to ``path`` (PNG, 110 dpi)."""
+    inspection_figure(inspection).savefig(path, dpi=110)
+
+
+def inspection_figure(inspection):
+    """The figure of a recording: traces on the ground, height of G, energy over time.
 
     Parameters
     ----------
     inspection : Inspection
-    path : str or os.PathLike
-        PNG file to write.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        On an Agg canvas. Its axes are labelled (``Axes.get_label()``) ``'ground'``,
+        ``'height'``, ``'energy'``, ``'drift'`` and, with contact forces, ``'forces'`` and
+        ``'mu'`` (the twin axis of μ).
 
     Notes
     -----
@@ -85,7 +95,10 @@ def plot_inspection(inspection, path):
         title += (f'\nshaded: {len(stretches)} stretch(es) outside the rolling model (red: '
                   'lift-off, amber: slip): the motion shown there is not physics')
     figure.suptitle(title)
-    figure.savefig(path, dpi=110)
+    for axes, name in ((ground, 'ground'), (height, 'height'), (energy, 'energy'),
+                       (drift, 'drift')):
+        axes.set_label(name)
+    return figure
 
 
 # -- panels --------------------------------------------------------------------------------
@@ -274,6 +287,8 @@ def _force_panel(axes, data):
     mu = data['mu_required']
     finite = mu[np.isfinite(mu) & (mu < 1e300)]
     other = axes.twinx()
+    axes.set_label('forces')
+    other.set_label('mu')
     friction = float(data['friction'])
     peak = float(finite.max()) if finite.size else 0.0
     top = 1.15 * peak if peak > 0 else 1.0
