@@ -1,4 +1,5 @@
-"""Tests of :mod:`twodisk_ros.plotting.figures`: files written, and plotted data against closed forms."""
+"""The figures (plotting/figures.py, contact_forces.py, sweep_maps.py): files written, plotted
+data against closed forms, and the figure commands (help, --overwrite)."""
 
 import math
 import os

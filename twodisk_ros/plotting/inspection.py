@@ -167,7 +167,8 @@ def _drift_panel(drift, inspection):
     """The invariant's drift as recorded, and the inspector's FD check quoted beside it."""
     found = invariant_drift(inspection)
     if found is None:
-        drift.text(0.5, 0.5, 'no rolling_state rates recorded:\nthe drift cannot be computed',
+        drift.text(0.5, 0.5, 'the drift cannot be computed:\n'
+                   'no phase rates recorded, or omega0 = 0',
                    ha='center', va='center', transform=drift.transAxes)
         drift.set_title('drift of the invariant')
         return
@@ -298,7 +299,8 @@ def _force_panel(axes, data):
         if peak > MU_CLIP * friction:      # what exceeds 3 μ slips anyway: clipped, and said
             top = MU_CLIP * friction
             where = float(t[np.isfinite(mu) & (mu < 1e300)][int(np.argmax(finite))])
-            label += f' (clipped at {top:.3g} = {MU_CLIP:g} μ; max {peak:.3g} at t = {where:.3g} s)'
+            label += (f' (clipped at {top:.3g} = {MU_CLIP:g} μ; max {peak:.3g} at '
+                      f't = {where:.3g} s)')
     if np.any(~np.isfinite(mu) | (mu >= 1e300)):
         label += '; none where a contact lifts off'
     other.plot(t, np.where(mu < 1e300, mu, np.nan), color=palette.MU, lw=0.9, label=label)
