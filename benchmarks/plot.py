@@ -51,10 +51,10 @@ def work_precision_figure(results, reference_errors, path):
                 style = dict(METHOD_STYLE[method])
                 label = f'{method}, {KIND_LABELS[kind]}'
                 if quad:
-                    label += f' [{pts[0].solver}]'
+                    label += f' [{pts[0].solver}: any tolerance]'
                 (line,) = ax.plot(xs, ys, color=color, markersize=7, label=label, **style)
                 legend.setdefault(label, line)
-                for r, x, y in zip(pts, xs, ys):
+                for j, (r, x, y) in enumerate(zip(pts, xs, ys)):
                     if y >= top:
                         what = (f'error {r.error:.0e} × size' if math.isfinite(r.error)
                                 else 'NaN samples')
@@ -67,10 +67,15 @@ def work_precision_figure(results, reference_errors, path):
                         legend.setdefault('error > body size (drawn at the top edge)', tri)
                         diverged += 1
                         continue
-                    text = 'any tol' if quad else _tol_label(r.tolerance)
-                    offset = (5, -10) if (quad and kind == 'kinematic') else (5, 3)
-                    ax.annotate(text, (x, y), textcoords='offset points', xytext=offset,
-                                fontsize=7, color=color)
+                    # the loosest and the tightest tolerance only (the others lie between,
+                    # in order): labels of neighbouring points would overlap; the
+                    # tolerance-independent points are named in the legend
+                    if quad or 0 < j < len(pts) - 1:
+                        continue
+                    tightest = j == 0      # pts are sorted by tolerance, tightest first
+                    ax.annotate(_tol_label(r.tolerance), (x, y), textcoords='offset points',
+                                xytext=(7, -3) if tightest else (7, 3), ha='left',
+                                va='top' if tightest else 'bottom', fontsize=7, color=color)
         refs = [v for (b, _), v in reference_errors.items() if b == body]
         if refs:
             (ref_line,) = ax.axhline(max(refs), color='grey', linestyle=':', linewidth=1),
@@ -86,7 +91,8 @@ def work_precision_figure(results, reference_errors, path):
         ax.grid(True, which='major', alpha=0.3)
     fig.legend(list(legend.values()), list(legend.keys()), loc='outside lower center', ncol=3,
                fontsize=8)
-    fig.suptitle('Work-precision: direct (DOP853 on closed forms) vs table; numbers = log10 '
-                 'of the tolerance; laminae, g = 9.81 m/s², 1 kHz output')
+    fig.suptitle('Work-precision: direct (DOP853 on closed forms) vs table; laminae, '
+                 'g = 9.81 m/s², 1 kHz output\nnumbers: log10 of the tolerance at the ends of '
+                 'each line (1e-6, 1e-8, 1e-10, 1e-12 in order along it)')
     fig.savefig(path, dpi=110)
     plt.close(fig)

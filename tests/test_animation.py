@@ -14,8 +14,8 @@ from twodisk_ros.plotting import animation
 from twodisk_ros.plotting.runs import RunError, library_run, recorded_run, settings_from
 
 REPO = Path(__file__).resolve().parents[1]
-ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='94',
-           MPLBACKEND='Agg')
+ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+           ROS_DOMAIN_ID=os.environ.get('ROS_DOMAIN_ID', '94'), MPLBACKEND='Agg')
 SIZE = (160, 120)
 
 
@@ -131,3 +131,27 @@ def test_mp4(tmp_path):
 def test_mp4_without_ffmpeg(tmp_path):
     with pytest.raises(RunError, match='ffmpeg'):
         animation.animate(library_run(stop=0.3), tmp_path / 'run.mp4', size=SIZE)
+
+
+@pytest.mark.parametrize('view', ['3d', 'top'])
+def test_legend_readable_at_the_demo_size(view):
+    """At 480 × 360 (make demo) the legend's letters are at least 9 px high, it has at most
+    5 entries and lies inside the picture, below the view; its colours are the palette's."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from twodisk_ros.plotting import palette
+    run = library_run(settings_from(REPO / 'config' / 'oloid.yaml'), stop=0.2, forces=True)
+    figure = Figure(figsize=(4.8, 3.6), dpi=animation.DPI)
+    FigureCanvasAgg(figure)
+    scene = animation._Scene(run, figure, view, 'fit', True, np.array([0]))
+    scene.draw(0)
+    figure.canvas.draw()
+    (legend,) = figure.legends
+    texts = legend.get_texts()
+    assert len(texts) <= 5
+    for text in texts:
+        assert text.get_fontsize() * figure.dpi / 72.0 >= 9.0, text.get_text()
+    box = legend.get_window_extent(figure.canvas.get_renderer())
+    assert box.x0 >= 0 and box.x1 <= 480 and box.y0 >= 0
+    assert scene.trace_a.get_color() == palette.A and scene.trace_b.get_color() == palette.B
+    assert scene.segment.get_color() == palette.AB

@@ -1,15 +1,19 @@
-"""Tests of :mod:`twodisk_ros.plotting.figures`: files written, and plotted data against closed forms."""
+"""The figures (plotting/figures.py, contact_forces.py, sweep_maps.py): files written, plotted
+data against closed forms, and the figure commands (help, --overwrite)."""
 
 import math
+import os
 import struct
 import subprocess
 import sys
+import time
 
 import matplotlib
 
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 from numpy.testing import assert_allclose  # noqa: E402
 
 from twodisk_ros.plotting import figures  # noqa: E402
@@ -117,8 +121,117 @@ def test_plot_functions_return_their_axes():
         plt.close(fig)
 
 
-def test_contact_force_figures_are_written(tmp_path):
+def test_contact_force_figures_are_written(tmp_path, capsys):
     from twodisk_ros.plotting import contact_forces
-    contact_forces.main(str(tmp_path))
+    assert contact_forces.main(['--out', str(tmp_path)]) == 0
     for name in ('contact_forces_cycle.png', 'contact_forces_speed.png'):
         assert (tmp_path / name).stat().st_size > 20_000
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(contact_forces.NAMES)
+
+
+def test_coinciding_liftoff_speeds_are_named_together():
+    """The oloid (8.2810) and the Fig. 3 body (8.2796 rad/s) share one dotted line: said."""
+    from twodisk_ros.physics.contact_validity import liftoff_speed
+    from twodisk_ros.plotting import contact_forces
+    criticals = [liftoff_speed(contact_forces.force_model(shape))[0]
+                 for _, shape in contact_forces.BODIES]
+    assert abs(criticals[0] - criticals[2]) < 0.005 * criticals[0]      # the claim
+    assert contact_forces.coinciding_speeds(criticals) == [[2, 0]]
+
+
+# -- the command lines: help without side effects, existing outputs refused ---------------
+REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FIGURE_COMMANDS = ('twodisk_ros.plotting.figures', 'twodisk_ros.plotting.contact_forces')
+
+
+def _run(module, args, cwd, timeout=60):
+    env = dict(os.environ, PYTHONPATH=REPO, MPLBACKEND='Agg')
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, '-m', module, *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=timeout)
+    return done, time.monotonic() - start
+
+
+@pytest.mark.parametrize('module', FIGURE_COMMANDS)
+@pytest.mark.parametrize('flag', ['--help', '-h'])
+def test_help_exits_0_quickly_and_writes_nothing(tmp_path, module, flag):
+    done, elapsed = _run(module, [flag], tmp_path, timeout=30)
+    assert done.returncode == 0 and 'usage:' in done.stdout and '--overwrite' in done.stdout
+    assert 'Traceback' not in done.stderr
+    assert elapsed < 5.0                # a hang or a figure drawn would take longer
+    assert list(tmp_path.iterdir()) == []   # before: a folder named --help
+
+
+@pytest.mark.parametrize('module', FIGURE_COMMANDS)
+def test_existing_figure_refused_without_overwrite(tmp_path, module):
+    names = figures.NAMES if module.endswith('figures') else ('contact_forces_cycle.png',
+                                                              'contact_forces_speed.png')
+    old = tmp_path / names[-1]
+    old.write_bytes(b'an older figure')
+    done, _ = _run(module, ['--out', str(tmp_path)], tmp_path)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and 'exists' in lines[0] and '--overwrite' in lines[0]
+    assert 'Traceback' not in done.stderr
+    assert old.read_bytes() == b'an older figure'
+    assert sorted(p.name for p in tmp_path.iterdir()) == [old.name]    # nothing else written
+
+
+def test_overwrite_replaces_the_figures(tmp_path, capsys):
+    old = tmp_path / 'height.png'
+    old.write_bytes(b'an older figure')
+    assert figures.main(['--out', str(tmp_path), '--overwrite']) == 0
+    assert old.read_bytes()[:8] == PNG_SIGNATURE
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(figures.NAMES)
+
+
+# -- the sweep maps -----------------------------------------------------------------------
+def _sweep(b_over_a, delta_over_a):
+    import xarray as xr
+    from twodisk_ros.physics.equilibria import stability_map
+    b, d = np.meshgrid(b_over_a, delta_over_a, indexing='ij')
+    return xr.Dataset({
+        'stable_family': (('b_over_a', 'delta_over_a'), stability_map(b, d).astype(float),
+                          {'units': '1', 'description': 'which equilibria are stable: +1 '
+                           'theta = 0 and the turning points, -1 theta = +-pi/2, 0 neutral'}),
+        'rollover_speed': (('b_over_a', 'delta_over_a'), 1.0 + b * d,
+                           {'units': 'sqrt(g/a)', 'description': 'angular speed |omega| '
+                            'with omega_u, 1/2 m du/dt^2, Delta/a <= 1'}),
+    }, coords={'b_over_a': b_over_a, 'delta_over_a': delta_over_a})
+
+
+def test_sweep_map_cells_stay_on_the_grid():
+    """No cell is drawn beyond the grid's first and last values (Δ/a outside [0.02, 0.98])."""
+    from twodisk_ros.plotting.sweep_maps import plot_map
+    b, d = np.linspace(0.2, 3.0, 12), np.linspace(0.02, 0.98, 10)
+    for name in ('stable_family', 'rollover_speed'):
+        fig, ax = plt.subplots()
+        try:
+            plot_map(_sweep(b, d), name, ax)
+            for mesh in [c for c in ax.collections if hasattr(c, 'get_coordinates')]:
+                xy = mesh.get_coordinates()
+                assert xy[..., 0].min() == pytest.approx(0.2)
+                assert xy[..., 0].max() == pytest.approx(3.0)
+                assert xy[..., 1].min() == pytest.approx(0.02)
+                assert xy[..., 1].max() == pytest.approx(0.98)
+            assert ax.get_ylim() == pytest.approx((0.02, 0.98))
+        finally:
+            plt.close(fig)
+
+
+def test_sweep_map_titles_and_bars_use_symbols():
+    from twodisk_ros.plotting.sweep_maps import plot_map, symbols
+    assert symbols('theta = +-pi/2, Delta/a <= 1, sqrt(g/a), a^2, theta_max') == (
+        'θ = ±π/2, Δ/a ≤ 1, √(g/a), a², theta_max')
+    b, d = np.linspace(0.2, 3.0, 4), np.linspace(0.02, 0.98, 3)
+    for name in ('stable_family', 'rollover_speed'):
+        fig, ax = plt.subplots()
+        try:
+            bar = plot_map(_sweep(b, d), name, ax)
+            texts = [ax.get_title(), bar.ax.get_ylabel()] + [
+                t.get_text() for t in bar.ax.get_yticklabels()]
+            for text in texts:
+                for ascii_word in ('theta ', '+-pi', 'pi/2', 'Delta', 'sqrt', '^2', 'omega'):
+                    assert ascii_word not in text, (name, text)
+        finally:
+            plt.close(fig)

@@ -16,6 +16,7 @@ from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from ..io.cdr_markers import MarkerSpec
+from ..plotting import palette
 
 JOINT_NAMES = ['theta', 'psi', 'phase']
 
@@ -79,7 +80,8 @@ def marker(frame_id, time_ns, spec):
 #: Marker ids of :func:`body_markers` (namespace ``twodisk``).
 MARKER_IDS = {'outline_1': 0, 'outline_2': 1, 'contact_line': 2, 'disk_1': 3, 'disk_2': 4,
               'hull': 5}
-DISK_COLORS = ((0.12, 0.37, 0.66), (0.85, 0.38, 0.17))    # disk 1 blue, disk 2 orange
+#: disk 1 and disk 2 (r, g, b): the package's one palette (plotting/palette.py)
+DISK_COLORS = (palette.rgb(palette.A), palette.rgb(palette.B))
 
 
 def _closed(outline):
@@ -134,14 +136,14 @@ def body_marker_specs(disk1, disk2, contact_a, contact_b, size, *, filled=True, 
     specs = [
         MarkerSpec('twodisk', 0, Marker.LINE_STRIP, Marker.ADD, line, (r1, g1, b1, 1.0), disk1),
         MarkerSpec('twodisk', 1, Marker.LINE_STRIP, Marker.ADD, line, (r2, g2, b2, 1.0), disk2),
-        MarkerSpec('twodisk', 2, Marker.LINE_LIST, Marker.ADD, line, (0.1, 0.7, 0.2, 1.0),
-                   [contact_a, contact_b]),
+        MarkerSpec('twodisk', 2, Marker.LINE_LIST, Marker.ADD, line,
+                   palette.rgb(palette.AB) + (1.0,), [contact_a, contact_b]),
     ]
     surfaces = []
     if filled:
         surfaces += [(3, _fan(disk1), (r1, g1, b1, alpha)), (4, _fan(disk2), (r2, g2, b2, alpha))]
     if hull is not None:
-        surfaces.append((5, _strip(*hull), (0.6, 0.6, 0.62, 0.35)))
+        surfaces.append((5, _strip(*hull), palette.rgb(palette.HULL) + (0.35,)))
     for marker_id, triangles, rgba in surfaces:
         specs.append(MarkerSpec('twodisk', marker_id, Marker.TRIANGLE_LIST, Marker.ADD,
                                 (1.0, 1.0, 1.0), rgba, triangles))
@@ -182,7 +184,8 @@ def force_arrow_specs(points, forces, weight, size):
     """ARROW :class:`MarkerSpec` s of the ground's forces on the body at A and B (world frame).
 
     Each arrow starts at its contact point and is ``force / (M g) × size`` long, so the
-    weight M g itself would be one body size; red when the force pulls (N < 0).
+    weight M g itself would be one body size; purple (:data:`palette.FORCE`), red when the
+    force pulls (N < 0, :data:`palette.FORCE_PULLING`).
     """
     scale = size / weight if weight > 0 else 0.0
     specs = []
@@ -192,7 +195,7 @@ def force_arrow_specs(points, forces, weight, size):
         specs.append(MarkerSpec(
             'twodisk_forces', marker_id, Marker.ARROW, Marker.ADD,
             (0.01 * size, 0.02 * size, 0.03 * size),
-            (0.9 if pulling else 0.2, 0.1 if pulling else 0.6, 0.1, 1.0),
+            palette.rgb(palette.FORCE_PULLING if pulling else palette.FORCE) + (1.0,),
             [start, start + scale * np.asarray(force, dtype=float)]))
     return specs
 

@@ -15,14 +15,15 @@ import shutil
 
 import numpy as np
 
+from . import palette
 from .runs import Run, RunError, library_run
 
 __all__ = ['VIEWS', 'CAMERAS', 'animate', 'frame_times', 'main']
 
 VIEWS = ('3d', 'top')
 CAMERAS = ('auto', 'follow', 'fit')
-COLOR_1, COLOR_2 = '#1f5fa8', '#d9622b'        # disk 1 / trace of A, disk 2 / trace of B
-COLOR_AB, COLOR_G, COLOR_FORCE = '#1b8a3a', '0.15', '#7b2d8e'
+COLOR_1, COLOR_2 = palette.A, palette.B        # disk 1 / trace of A, disk 2 / trace of B
+COLOR_AB, COLOR_G, COLOR_FORCE = palette.AB, palette.G, palette.FORCE
 DPI = 100
 
 
@@ -97,6 +98,8 @@ class _Scene:
         self.top = float(np.max(run.position_g[:, 2])) + size   # the body's highest point
         fontsize = max(6.0, min(11.0, figure.get_figheight() * 2.3))
         self.fontsize = fontsize
+        # the legend is read at the size of the picture: at least 8 px (6 pt at 100 dpi) high
+        self.legend_fontsize = max(0.85 * fontsize, 8.0 * 72.0 / figure.dpi)
         if view == '3d':
             self._setup_3d()
         else:
@@ -171,21 +174,24 @@ class _Scene:
         self.ax.set_ylim(centre[1] - 0.5 * width * shape, centre[1] + 0.5 * width * shape)
 
     def _legend(self):
+        """One short legend below the view; its font grows with the figure (≥ 8 px high)."""
+        from matplotlib.legend_handler import HandlerTuple
         from matplotlib.lines import Line2D
         from matplotlib.patches import Patch
-        handles = [Patch(fc=COLOR_1, alpha=0.6, label='disk 1'),
-                   Patch(fc=COLOR_2, alpha=0.6, label='disk 2'),
-                   Line2D([], [], color=COLOR_AB, lw=2, label='AB'),
-                   Line2D([], [], color=COLOR_1, label='trace of A'),
-                   Line2D([], [], color=COLOR_2, label='trace of B'),
-                   Line2D([], [], color=COLOR_G, ls='--', lw=0.8, label='path of G')]
+        handles = [(Patch(fc=COLOR_1, alpha=0.6), Line2D([], [], color=COLOR_1)),
+                   (Patch(fc=COLOR_2, alpha=0.6), Line2D([], [], color=COLOR_2)),
+                   Line2D([], [], color=COLOR_AB, lw=2),
+                   Line2D([], [], color=COLOR_G, ls='--', lw=0.8)]
+        labels = ['disk 1, trace of A', 'disk 2, trace of B', 'contact line AB', 'path of G']
         if self.forces:
-            handles.append(Line2D([], [], color=COLOR_FORCE, lw=1.5,
-                                  label='ground force (L ≙ Mg)' if self.view == '3d'
-                                  else 'ground force, horizontal (L ≙ Mg)'))
-        self.figure.legend(handles=handles, loc='lower center', ncol=min(len(handles), 4),
-                           fontsize=self.fontsize * 0.72, frameon=False,
-                           bbox_to_anchor=(0.5, 0.0), handlelength=1.5, columnspacing=1.0)
+            handles.append(Line2D([], [], color=COLOR_FORCE, lw=1.5))
+            labels.append('ground force (L ≙ Mg)' if self.view == '3d'
+                          else 'ground force, horizontal')
+        self.figure.legend(handles, labels, loc='lower center', ncol=3,
+                           fontsize=self.legend_fontsize, frameon=False,
+                           bbox_to_anchor=(0.5, 0.0), handlelength=2.2, columnspacing=1.2,
+                           handletextpad=0.5, borderaxespad=0.2,
+                           handler_map={tuple: HandlerTuple(ndivide=None, pad=0.2)})
 
     # -- one frame ---------------------------------------------------------------------------
     def draw(self, frame):

@@ -1,10 +1,12 @@
 """Figures of the contact forces (matplotlib, Agg): over one cycle, and against speed.
 
-Run ``python -m twodisk_ros.plotting.contact_forces`` (from the repository root) to write
-docs/figures/contact_forces_cycle.png and docs/figures/contact_forces_speed.png.
+``python -m twodisk_ros.plotting.contact_forces [--out DIR] [--overwrite]`` writes
+DIR/contact_forces_cycle.png and DIR/contact_forces_speed.png (DIR default docs/figures,
+created if missing; existing files are replaced only with ``--overwrite``).
 The bodies are those of config/*.yaml (mass 1 kg, laminae, g = 9.81 m/s²).
 """
 
+import argparse
 import math
 import os
 import sys
@@ -20,8 +22,10 @@ from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
 from twodisk_ros.physics.contact_forces import ContactForceModel  # noqa: E402
 from twodisk_ros.physics.contact_validity import (  # noqa: E402
     liftoff_speed, mu_required_kinematic)
+from twodisk_ros.outputs import OutputError, check_output_dir, replacing  # noqa: E402
 
-__all__ = ['BODIES', 'force_model', 'plot_cycle', 'plot_speed', 'main']
+__all__ = ['BODIES', 'NAMES', 'coinciding_speeds', 'force_model', 'plot_cycle', 'plot_speed',
+           'main']
 
 #: (label, (a, b, Δ) in m) as in config/oloid.yaml, two_circle_roller.yaml, figure3/4.yaml
 BODIES = (
@@ -31,6 +35,9 @@ BODIES = (
     ('paper Fig. 4 (a = 0.1225 m, b = Δ = 0.1 m)', (math.sqrt(1.5) * 0.1, 0.1, 0.1)),
 )
 FIGURES = os.path.join('docs', 'figures')
+NAMES = ('contact_forces_cycle.png', 'contact_forces_speed.png')
+#: lift-off speeds closer than this fraction draw their dotted lines on top of each other
+SAME_LINE = 0.005
 
 
 def force_model(shape, mass=1.0, model='laminae', gravity=9.81):
@@ -69,23 +76,59 @@ def plot_cycle(path, shape=BODIES[0][1], fractions=(0.0, 0.5, 0.8, 0.95), sample
     for axis in (top, bottom):
         axis.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _save(fig, path)
+
+
+def _save(fig, path):
+    """Save through a temporary file renamed over ``path`` when complete; close ``fig``."""
+    try:
+        with replacing(path) as temporary:
+            fig.savefig(temporary, dpi=120)
+    finally:
+        plt.close(fig)
+
+
+def coinciding_speeds(criticals):
+    """Groups (indices) of lift-off speeds within :data:`SAME_LINE` of each other."""
+    order = sorted(range(len(criticals)), key=lambda k: criticals[k])
+    groups, current = [], [order[0]]
+    for k in order[1:]:
+        if criticals[k] - criticals[current[-1]] <= SAME_LINE * criticals[k]:
+            current.append(k)
+        else:
+            groups.append(current)
+            current = [k]
+    groups.append(current)
+    return [group for group in groups if len(group) > 1]
 
 
 def plot_speed(path, bodies=BODIES, samples=160):
-    """max over a cycle of μ_required against Ω (kinematic), lift-off speeds marked."""
+    """max over a cycle of μ_required against Ω (kinematic), lift-off speeds marked.
+
+    Lift-off speeds that coincide at the scale of the figure (within :data:`SAME_LINE`, as the
+    oloid's 8.2810 and the Fig. 3 body's 8.2796 rad/s) are named together beside their
+    shared dotted line.
+    """
     fig, axis = plt.subplots(figsize=(8, 5.5))
     colours = plt.cm.tab10(np.arange(len(bodies)))
+    criticals, names = [], []
     for (label, shape), colour in zip(bodies, colours):
         model = force_model(shape)
         critical = liftoff_speed(model)[0]
+        criticals.append(critical)
+        names.append(label.split(' (')[0])
         omega = critical * np.linspace(0.02, 0.998, samples)
         mu = mu_required_kinematic(model, omega)
         axis.semilogy(omega, mu, color=colour, lw=1.8,
-                      label=f'{label}: Ω_c = {critical:.2f} rad/s')
+                      label=f'{label}: Ω_c = {critical:.4f} rad/s')
         axis.axvline(critical, color=colour, ls=':', lw=1.2)
         axis.plot(critical, mu[-1], marker='x', ms=9, mew=2, color=colour)
+    for group in coinciding_speeds(criticals):
+        text = ', '.join(f'{names[k]} {criticals[k]:.4f}' for k in sorted(group))
+        axis.annotate(f'Ω_c = {text} rad/s:\nindistinguishable here (one dotted line)',
+                      (criticals[group[0]], 0.02), xycoords=('data', 'axes fraction'),
+                      xytext=(-6, 0), textcoords='offset points', ha='right', va='bottom',
+                      fontsize=8, bbox=dict(boxstyle='round,pad=0.25', fc='white', ec='0.7'))
     axis.plot([], [], color='0.3', ls=':', marker='x', ms=9, mew=2,
               label='lift-off speed Ω_c (a contact leaves the ground)')
     axis.set_xlabel('angular speed held by the drive  Ω = |ω|  (rad/s)')
@@ -95,16 +138,39 @@ def plot_speed(path, bodies=BODIES, samples=160):
     axis.grid(alpha=0.3, which='both')
     axis.legend(fontsize=8, loc='upper left')
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    _save(fig, path)
 
 
-def main(directory=FIGURES):
-    """Write both figures into ``directory``."""
-    os.makedirs(directory, exist_ok=True)
-    plot_cycle(os.path.join(directory, 'contact_forces_cycle.png'))
-    plot_speed(os.path.join(directory, 'contact_forces_speed.png'))
+def _parser():
+    parser = argparse.ArgumentParser(
+        prog='python -m twodisk_ros.plotting.contact_forces',
+        description='Write the contact-force figures (PNG): N_A, N_B and mu_required over one '
+                    'cycle of the oloid at fractions of its lift-off speed, and the friction '
+                    'needed against the driven speed for the bodies of config/*.yaml.',
+        epilog=f'Writes {NAMES[0]} and {NAMES[1]} into DIR. Exit status: 0 written, 2 bad '
+               'arguments or an output refused (one line, nothing written).')
+    parser.add_argument('--out', metavar='DIR', default=FIGURES,
+                        help=f'output directory, created if missing (default {FIGURES})')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace existing figures (without it they are refused)')
+    return parser
+
+
+def main(argv=None):
+    """Write both figures into ``--out``; return the exit status (0, or 2 refused)."""
+    args = _parser().parse_args(argv)
+    try:
+        check_output_dir(args.out, overwrite=args.overwrite, names=NAMES)
+    except OutputError as error:
+        print(f'contact_forces: {error}', file=sys.stderr)
+        return 2
+    os.makedirs(args.out, exist_ok=True)
+    plot_cycle(os.path.join(args.out, NAMES[0]))
+    plot_speed(os.path.join(args.out, NAMES[1]))
+    for name in NAMES:
+        print(os.path.join(args.out, name))
+    return 0
 
 
 if __name__ == '__main__':
-    main(*sys.argv[1:2])
+    raise SystemExit(main())

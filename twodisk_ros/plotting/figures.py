@@ -1,6 +1,7 @@
 """Figures of the paper and of the notes, as PNG files (matplotlib, Agg).
 
-Run ``python -m twodisk_ros.plotting.figures --out DIR`` (``make figures`` writes ``docs/figures``):
+Run ``python -m twodisk_ros.plotting.figures --out DIR [--overwrite]`` (``make figures`` writes
+``docs/figures``; existing PNGs are replaced only with ``--overwrite``):
 
 * ``figure3.png``, ``figure4.png``, ``oloid_traces.png``: traces of the contact points A and B
   on the ground over three whole cycles (world frame, m), as in the paper's Figures 3 and 4;
@@ -13,6 +14,7 @@ Plotting lives only here; the physics core never imports matplotlib.
 
 import argparse
 import math
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -25,17 +27,19 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from ..physics.body import TwoDiskBody  # noqa: E402
+from ..outputs import OutputError, check_output_dir, replacing  # noqa: E402
+from . import palette  # noqa: E402
 from ..physics.cycle import RollingCycle  # noqa: E402
 from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
-__all__ = ['FIGURE3', 'FIGURE4', 'plot_traces', 'plot_height', 'plot_stability_map',
+__all__ = ['FIGURE3', 'FIGURE4', 'NAMES', 'plot_traces', 'plot_height', 'plot_stability_map',
            'write_figures', 'main']
 
 #: The paper's bodies (a, b, Δ) in m.
 FIGURE3 = (2.0, 1.0, 1.0)
 FIGURE4 = (math.sqrt(1.5), 1.0, 1.0)
 
-COLOR_A, COLOR_B, COLOR_RULING = '#1f5fa8', '#c8501e', '0.72'
+COLOR_A, COLOR_B, COLOR_RULING = palette.A, palette.B, '0.72'
 DPI = 150
 TWO_PI = 2.0 * math.pi
 
@@ -238,9 +242,17 @@ def plot_stability_map(ax, b_range=(0.05, 3.0), resolution=400):
     return ax
 
 
+#: the files :func:`write_figures` writes, in order
+NAMES = ('figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png')
+
+
 def _save(fig, path):
-    fig.savefig(path, dpi=DPI, bbox_inches='tight')
-    plt.close(fig)
+    """Save through a temporary file renamed over ``path`` when complete; close ``fig``."""
+    try:
+        with replacing(path) as temporary:
+            fig.savefig(temporary, dpi=DPI, bbox_inches='tight')
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -272,10 +284,28 @@ def write_figures(out_dir):
 
 
 def main(argv=None):
-    """Command line: ``python -m twodisk_ros.plotting.figures --out DIR``."""
-    parser = argparse.ArgumentParser(description='Write the figures (PNG) of twodisk_ros.')
-    parser.add_argument('--out', default='docs/figures', help='output directory')
+    """Command line: ``python -m twodisk_ros.plotting.figures [--out DIR] [--overwrite]``.
+
+    Returns the exit status: 0 written, 2 an output refused (one line on stderr, nothing
+    written).
+    """
+    parser = argparse.ArgumentParser(
+        prog='python -m twodisk_ros.plotting.figures',
+        description='Write the figures (PNG) of twodisk_ros: the paper\'s Figures 3 and 4 and '
+                    'the oloid\'s traces over whole cycles, the height of G with the '
+                    'equilibria, and the stability map.',
+        epilog=f'Writes {", ".join(NAMES)} into DIR. Exit status: 0 written, 2 bad '
+               'arguments or an output refused (one line, nothing written).')
+    parser.add_argument('--out', metavar='DIR', default='docs/figures',
+                        help='output directory, created if missing (default docs/figures)')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace existing figures (without it they are refused)')
     args = parser.parse_args(argv)
+    try:
+        check_output_dir(args.out, overwrite=args.overwrite, names=NAMES)
+    except OutputError as error:
+        print(f'figures: {error}', file=sys.stderr)
+        return 2
     for path in write_figures(args.out):
         print(path)
     return 0

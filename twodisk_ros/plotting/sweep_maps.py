@@ -9,6 +9,7 @@ Quantities whose positive values span a factor above 20 get a logarithmic scale.
 """
 
 import math
+import re
 from pathlib import Path
 
 import matplotlib
@@ -18,9 +19,10 @@ import matplotlib.pyplot as plt  # noqa: E402  (after selecting the backend)
 import numpy as np  # noqa: E402
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, Normalize  # noqa: E402
 
+from ..outputs import replacing  # noqa: E402
 from .figures import FIGURE3, FIGURE4  # noqa: E402
 
-__all__ = ['NAMED_BODIES', 'plot_map', 'write_maps']
+__all__ = ['NAMED_BODIES', 'plot_map', 'symbols', 'write_maps']
 
 #: (label, b/a, Δ/a) of the marked bodies.
 NAMED_BODIES = [
@@ -33,25 +35,43 @@ DPI = 130
 _FAMILY_LABELS = {-1: 'θ = ±π/2', 0: 'neutral', 1: 'θ = 0 and\nturning points'}
 
 
-def _edges(values):
-    """Cell edges around grid values (a single value gets a cell of ±2 % or ±0.01)."""
+def _edges(values, low=None, high=None):
+    """Cell edges around grid values, clipped to the grid's own range [values[0], values[-1]].
+
+    Inner edges are the midpoints; the outer cells end at the first and last grid values, so
+    nothing is drawn where nothing was computed (e.g. Δ/a below 0 or above 1). A single value
+    gets a cell of ±2 % (or ±0.01), clipped to [low, high] if given.
+    """
     v = np.asarray(values, dtype=float)
     if v.size == 1:
         half = max(0.02 * abs(v[0]), 0.01)
-        return np.array([v[0] - half, v[0] + half])
+        return np.clip(np.array([v[0] - half, v[0] + half]),
+                       -np.inf if low is None else low, np.inf if high is None else high)
     mid = 0.5 * (v[1:] + v[:-1])
-    return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
+    return np.concatenate([[v[0]], mid, [v[-1]]])
+
+
+#: ASCII of the Dataset's attributes → the symbols of the figures (whole words only)
+_SYMBOLS = ((r'\+-pi/2', '±π/2'), (r'\bDelta\b', 'Δ'), (r'\btheta\b', 'θ'),
+            (r'\bomega_u\b', 'ω_u'), (r'\bomega\b', 'ω'), (r'\bpi\b', 'π'), (r'\bmu\b', 'μ'),
+            (r'sqrt\(', '√('), (r'\^2', '²'), (r'<=', '≤'), (r'>=', '≥'))
+
+
+def symbols(text):
+    """``text`` (a variable's ASCII description or unit) with the figures' symbols:
+    ``theta = +-pi/2`` → ``θ = ±π/2``, ``sqrt(g/a)`` → ``√(g/a)``, ``a^2`` → ``a²``.
+    Variable names such as ``theta_max`` or ``mu_required`` are kept."""
+    for pattern, symbol in _SYMBOLS:
+        text = re.sub(pattern, symbol, text)
+    return text
 
 
 def _norm_and_cmap(name, values):
     """(norm, cmap, extend, ticks) for a variable's finite values."""
     if name == 'stable_family':
-        cmap = ListedColormap(['#f3b38a', '#f7f7f7', '#8db7de'])
-        cmap.set_bad('0.85')
+        cmap = ListedColormap(['#f3b38a', '#f7f7f7', '#8db7de']).with_extremes(bad='0.85')
         return BoundaryNorm([-1.5, -0.5, 0.5, 1.5], cmap.N), cmap, 'neither', [-1, 0, 1]
-    cmap = plt.get_cmap('viridis').copy()
-    cmap.set_bad('0.85')
-    cmap.set_over('black')
+    cmap = plt.get_cmap('viridis').with_extremes(bad='0.85', over='black')
     finite = values[np.isfinite(values)]
     extend = 'max' if np.any(np.isposinf(values)) else 'neither'
     if finite.size == 0:
@@ -76,20 +96,21 @@ def plot_map(dataset, name, ax):
     values = np.asarray(var.values, dtype=float)            # (b/a, Δ/a)
     norm, cmap, extend, ticks = _norm_and_cmap(name, values)
     shown = np.where(np.isposinf(values), np.inf, values)
-    mesh = ax.pcolormesh(_edges(b), _edges(d), np.ma.masked_invalid(
+    b_edges, d_edges = _edges(b, low=0.0), _edges(d, low=0.0, high=1.0)
+    mesh = ax.pcolormesh(b_edges, d_edges, np.ma.masked_invalid(
         np.where(np.isposinf(shown), np.nan, shown)).T, cmap=cmap, norm=norm,
         rasterized=True)
     if np.any(np.isposinf(values)):
         over = np.ma.masked_where(~np.isposinf(values), np.ones_like(values))
-        ax.pcolormesh(_edges(b), _edges(d), over.T,
+        ax.pcolormesh(b_edges, d_edges, over.T,
                       cmap=ListedColormap(['black']), rasterized=True)
     bar = ax.figure.colorbar(mesh, ax=ax, extend=extend, ticks=ticks)
-    units = var.attrs.get('units', '')
-    bar.set_label(f'{name} [{units}]' + ('   (black: inf)' if extend == 'max' else ''))
+    units = symbols(var.attrs.get('units', ''))
+    bar.set_label(f'{name} [{units}]' + ('   (black: ∞)' if extend == 'max' else ''))
     if name == 'stable_family':
         bar.set_ticklabels([_FAMILY_LABELS[k] for k in ticks])
-    xlim = (_edges(b)[0], _edges(b)[-1])
-    ylim = (_edges(d)[0], _edges(d)[-1])
+    xlim = (b_edges[0], b_edges[-1])
+    ylim = (d_edges[0], d_edges[-1])
     b_line = np.linspace(max(xlim[0], 1e-9), min(xlim[1], math.sqrt(2.0)), 400)
     ax.plot(b_line, np.sqrt(np.clip(1.0 - b_line**2 / 2, 0.0, None)), color='k', lw=1.2,
             ls='--', label='neutral: b² = 2(a² − Δ²)')
@@ -104,13 +125,17 @@ def plot_map(dataset, name, ax):
     ax.set_ylim(*ylim)
     ax.set_xlabel('b / a  [1]  (a = 1)')
     ax.set_ylabel('Δ / a  [1]')
-    ax.set_title(f'{name}: {var.attrs.get("description", "")}', fontsize=8, wrap=True)
+    ax.set_title(f'{name}: {symbols(var.attrs.get("description", ""))}', fontsize=8,
+                 wrap=True)
     ax.legend(loc='lower left', fontsize=7, framealpha=0.8)
     return bar
 
 
 def write_maps(dataset, folder):
     """One PNG per float variable of ``dataset`` into ``folder`` (created if missing).
+
+    Existing maps are replaced (the command line checks them first); each is written
+    through a temporary file renamed over it when complete.
 
     Returns
     -------
@@ -127,7 +152,8 @@ def write_maps(dataset, folder):
         try:
             plot_map(dataset, name, ax)
             path = out / f'{name}.png'
-            fig.savefig(path, dpi=DPI, bbox_inches='tight')
+            with replacing(path) as temporary:      # never a half-written map
+                fig.savefig(temporary, dpi=DPI, bbox_inches='tight')
         finally:
             plt.close(fig)
         written.append(path)
