@@ -36,14 +36,14 @@ demo: venv
 	mkdir -p out
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
 	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap -p overwrite:=true
-	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png
+	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png --overwrite
 	$(PY) -m twodisk_ros.plotting.animation out/oloid.mcap -o out/oloid.gif \
 	    --stop 6 --fps 15 --size 480x360
 
 ## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
 figures: venv
-	$(PY) -m twodisk_ros.plotting.figures --out docs/figures
-	$(PY) -m twodisk_ros.plotting.contact_forces docs/figures
+	$(PY) -m twodisk_ros.plotting.figures --out docs/figures --overwrite
+	$(PY) -m twodisk_ros.plotting.contact_forces --out docs/figures --overwrite
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
 bench: venv

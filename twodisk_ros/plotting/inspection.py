@@ -88,7 +88,10 @@ def inspection_figure(inspection):
         title += (f" — a = {_number(params.get('a'))} m, b = {_number(params.get('b'))} m, "
                   f"Δ = {_number(params.get('delta'))} m, {params.get('mass_model')}, "
                   f"{params.get('mode')}")
-    title += ' — ' + ('all checks pass' if inspection.passed else 'CHECKS FAIL')
+    verdict = getattr(inspection, 'verdict', None) or ('PASS' if inspection.passed else 'FAIL')
+    title += ' — ' + {'PASS': 'PASS: all checks pass',
+                      'INCOMPLETE': 'INCOMPLETE: the checks pass on the part recovered',
+                      }.get(verdict, 'FAIL: checks fail')
     if summary['truncated']:
         title += ' (truncated file)'
     if stretches:
