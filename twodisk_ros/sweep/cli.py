@@ -140,6 +140,8 @@ def _checked(args):
              else _integer('--chunk-size', args.chunk_size))
     check_size(b[2], d[2], chunk)
     check_some_valid(d[0])
+    if os.path.isdir(args.out):       # said first: the suffix is not the problem then
+        raise OutputError(f'{args.out} is a directory: --out must name a .nc file')
     check_output(args.out, overwrite=args.overwrite, suffixes=('.nc',))
     parts = f'{args.out}.parts'
     if os.path.lexists(parts) and not os.path.isdir(parts):
