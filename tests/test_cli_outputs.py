@@ -113,6 +113,8 @@ def test_the_wrapper_blocks_dask(tmp_path):
      'integer'),
     (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3',
       '--reference-speed', 'inf'], 'finite'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3', '--workers',
+      '100000'], 'per core of this machine'),
 ])
 def test_sweep_typo_exits_2_fast_without_dask(tmp_path, args, words):
     result, seconds = _run(SWEEP, *args, '--out', tmp_path / 'x.nc', cwd=tmp_path,
