@@ -220,7 +220,7 @@ class _Stop(Exception):
     pass
 
 
-def test_interrupted_sweep_resumes_without_recomputing(client, local, tmp_path):
+def test_interrupted_sweep_resumes_without_recomputing(client, local, tmp_path, capsys):
     out = tmp_path / 'map.nc'
     spec = _spec()
     n_chunks = len(spec.chunks())
@@ -246,9 +246,11 @@ def test_interrupted_sweep_resumes_without_recomputing(client, local, tmp_path):
     with pytest.raises(_Stop):
         run_sweep(other, client, out=out, progress=None,
                   on_chunk=lambda i, c: (_ for _ in ()).throw(_Stop()))
+    # (--overwrite: the output exists; the cache, not the output, is what is refused here)
     status = main(['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out),
-                   '--chunk-size', str(CHUNK), '--quiet', '--workers', '1'])
+                   '--chunk-size', str(CHUNK), '--quiet', '--workers', '1', '--overwrite'])
     assert status == 2
+    assert 'different sweep' in capsys.readouterr().err
 
 
 @pytest.mark.parametrize('override, words', [
@@ -264,7 +266,10 @@ def test_interrupted_sweep_resumes_without_recomputing(client, local, tmp_path):
     ({'--mass-model': ['lead']}, 'invalid choice'),
     ({'--out': ['{tmp}/missing/map.nc']}, 'does not exist'),
     ({'--out': ['{tmp}']}, 'is a directory'),
-    ({'--out': ['{tmp}/file.txt/map.nc']}, 'does not exist'),
+    ({'--out': ['{tmp}/file.txt/map.nc']}, 'Not a directory'),
+    ({'--out': ['{tmp}/x.csv']}, 'allowed: .nc'),
+    ({'--delta-over-a': ['1', '2', '3']}, 'no body of the grid is valid'),
+    ({'--b-over-a': ['0.2', '3', '10000000000']}, 'allowed: at most 10000000 bodies'),
     ({'--plot': ['{tmp}/file.txt']}, 'not a directory'),
 ])
 def test_bad_input_one_line_exit_2(override, words, capsys, tmp_path):

@@ -7,25 +7,50 @@ config/oloid.yaml) or of an MCAP recording of the node::
     twodisk-animate run.mcap -o run.gif --start 2 --stop 8 --fps 15 --size 480x360
     twodisk-animate -o top.gif --a 0.2 --b 0.1 --delta 0.1 --view top --forces
 
-Exit status: 0 written, 2 bad input (unreadable file, bad span, unwritable output; one line
-on stderr), 1 an internal error.
+Outputs follow :mod:`twodisk_ros.outputs`: ``-o`` must end in ``.gif`` (``.mp4`` only when
+ffmpeg is installed); an existing file is refused unless ``--overwrite``; the file is written
+through a hidden temporary name and renamed, so an interrupted or failed run leaves it as it
+was. The request is sized before anything is simulated or drawn: at most :data:`MAX_FRAMES`
+frames, a simulated run of at most :data:`MAX_SIMULATED_SECONDS`, and no more memory than
+:func:`twodisk_ros.limits.memory_limit` allows (:func:`estimate_memory`).
+
+Exit status: 0 written, 2 bad input (unreadable file, bad span, a request too large,
+unwritable output; one line on stderr), 1 an internal error, 130 interrupted.
 """
 
 import argparse
+import math
 import os
 import re
+import shutil
 import sys
 
-from .runs import RunError, library_run, recorded_run, settings_from
+from ..limits import LimitError, check_memory, describe_bytes
+from ..outputs import OutputError, check_output, replacing
 
-__all__ = ['main']
+__all__ = ['main', 'estimate_memory', 'MAX_FRAMES', 'MAX_SIMULATED_SECONDS']
 
 PROG = 'twodisk-animate'
+#: At most this many frames (4 min at 15 fps; ~0.09 s of drawing each at 640x480 here).
+MAX_FRAMES = 3600
+#: A simulated run is computed from 0 s up to at most this time (s): 720 001 samples.
+MAX_SIMULATED_SECONDS = 3600.0
+#: Memory per sample of a run (B): measured 435-660 B (60 001 samples, with forces), rounded up.
+BYTES_PER_SAMPLE = 1024
+#: Memory per pixel of each frame (B): the GIF writer keeps every frame as RGBA until the end;
+#: measured 5.7-9.7 B (100-200 frames at 320x240 and 640x480), rounded up.
+BYTES_PER_FRAME_PIXEL = 10
+#: Size limits of a frame (pixels), as :func:`~twodisk_ros.plotting.animation.animate`.
+MIN_SIDE, MAX_SIDE = 64, 4096
+
+
+class _Refusal(ValueError):
+    """Bad input found before the run is read or simulated; one line."""
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise RunError(message)
+        raise _Refusal(message)
 
 
 def _size(text):
@@ -38,11 +63,17 @@ def _size(text):
 def _parser():
     parser = _Parser(prog=PROG, description='Render a rolling run (library or MCAP '
                      'recording) as an animated GIF, or MP4 when ffmpeg is installed.',
-                     epilog='Exit status: 0 written, 2 bad input (one line on stderr).')
+                     epilog=f'At most {MAX_FRAMES} frames and a simulated run of at most '
+                            f'{MAX_SIMULATED_SECONDS:g} s. Exit status: 0 written, 2 bad input '
+                            f'or a request too large (one line on stderr), 1 internal error, '
+                            f'130 interrupted.')
     parser.add_argument('recording', nargs='?', help='an MCAP recording of the roller node '
                         '(omit to simulate with the parameters below)')
     parser.add_argument('-o', '--output', required=True,
-                        help='the file to write: .gif, or .mp4 (needs ffmpeg)')
+                        help='the file to write: .gif, or .mp4 (needs ffmpeg); an existing '
+                             'file is refused unless --overwrite')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace an existing output (only once the new one is complete)')
     parser.add_argument('--start', type=float, default=0.0, help='first time shown (s)')
     parser.add_argument('--stop', type=float, default=None,
                         help='last time shown (s); default: end of the recording, 6 s '
@@ -68,7 +99,76 @@ def _parser():
     return parser
 
 
+def _check_output(path, overwrite):
+    """The output's suffix (.gif; .mp4 only with ffmpeg) and :func:`check_output`."""
+    suffix = os.path.splitext(os.fspath(path))[1].lower()
+    if suffix not in ('.gif', '.mp4'):
+        raise OutputError(f'cannot write {path}: the file name must end in .gif or .mp4 '
+                          f'(.mp4 needs ffmpeg)')
+    if suffix == '.mp4' and shutil.which('ffmpeg') is None:
+        raise OutputError(f'cannot write {path}: MP4 needs ffmpeg, which is not installed '
+                          '(write a .gif instead)')
+    check_output(path, overwrite=overwrite, suffixes=('.gif', '.mp4'))
+
+
+def _frame_count(start, stop, fps):
+    """Frames of the span, as :func:`~twodisk_ros.plotting.animation.frame_times` counts
+    them, without building the times."""
+    return int(math.floor((stop - start) * fps + 1e-9)) + 1
+
+
+def estimate_memory(frames, size, samples):
+    """Bytes an animation of ``frames`` frames of ``size`` (w, h) pixels from a run of
+    ``samples`` samples needs (see BYTES_PER_FRAME_PIXEL and BYTES_PER_SAMPLE)."""
+    width, height = size
+    return frames * width * height * BYTES_PER_FRAME_PIXEL + samples * BYTES_PER_SAMPLE
+
+
+def _check_numbers(args):
+    """The span, the frame rate and the size: finite, ordered, in range."""
+    for name in ('start', 'stop', 'fps'):
+        value = getattr(args, name)
+        if value is not None and not math.isfinite(value):
+            raise _Refusal(f'--{name} must be a finite number, got {value!r}')
+    if not 0 < args.fps <= 120:
+        raise _Refusal(f'fps must be in (0, 120], got {args.fps!r}')
+    if args.start < 0 or (args.stop is not None and args.stop <= args.start):
+        raise _Refusal(f'the span must satisfy 0 <= start < stop, got start = {args.start!r} '
+                       f's, stop = {args.stop!r} s')
+    width, height = args.size
+    if not (MIN_SIDE <= width <= MAX_SIDE and MIN_SIDE <= height <= MAX_SIDE):
+        raise _Refusal(f'size must be between {MIN_SIDE}x{MIN_SIDE} and {MAX_SIDE}x{MAX_SIDE} '
+                       f'pixels, got {width}x{height}')
+
+
+def _check_size(args, stop, samples):
+    """Refuse more than MAX_FRAMES frames or more memory than the machine allows (the run's
+    ``samples`` included)."""
+    frames = _frame_count(args.start, stop, args.fps)
+    width, height = args.size
+    what = (f'--start {args.start:g} --stop {stop:g} at --fps {args.fps:g} is {frames} frames '
+            f'of {width}x{height}')
+    if frames > MAX_FRAMES:
+        need = estimate_memory(frames, args.size, samples)
+        raise LimitError(f'{what} (~{describe_bytes(need)} of memory); allowed: at most '
+                         f'{MAX_FRAMES} frames (shorten the span or lower --fps)')
+    check_memory(estimate_memory(frames, args.size, samples), what)
+
+
+def _check_request(args):
+    """What can be sized before the run is read or simulated (no physics imported)."""
+    if args.recording is None:
+        stop = 6.0 if args.stop is None else args.stop
+        _check_size(args, stop, 0)
+        if stop > MAX_SIMULATED_SECONDS:
+            raise LimitError(f'a simulated run is computed from 0 s, --stop {stop:g} s is too '
+                             f'long; allowed: --stop <= {MAX_SIMULATED_SECONDS:g} s')
+    elif args.stop is not None:
+        _check_size(args, args.stop, 0)
+
+
 def _run_of(args):
+    from .runs import LIBRARY_RATE, RunError, library_run, recorded_run, settings_from
     if args.recording:
         given = [f'--{n.replace("_", "-")}' for n in ('params_file', 'a', 'b', 'delta',
                                                        'theta0', 'branch', 'omega0', 'mass',
@@ -76,32 +176,53 @@ def _run_of(args):
                  if getattr(args, n) is not None]
         if given:
             raise RunError(f'{given[0]} applies to simulated runs, not to a recording')
-        return recorded_run(args.recording)
+        run = recorded_run(args.recording)
+        _check_size(args, float(run.t[-1]) if args.stop is None else args.stop, len(run))
+        return run
+    stop = 6.0 if args.stop is None else args.stop
+    _check_size(args, stop, max(2, int(math.ceil(stop * LIBRARY_RATE)) + 1))
     settings = settings_from(args.params_file, **{
         n: getattr(args, n) for n in ('a', 'b', 'delta', 'theta0', 'branch', 'omega0',
                                       'mass', 'gravity', 'mode', 'mass_model')})
-    stop = 6.0 if args.stop is None else args.stop
-    if not stop > 0:
-        raise RunError(f'the span must satisfy 0 <= start < stop, got stop = {stop!r} s')
     return library_run(settings, stop=stop, forces=args.forces)
 
 
+def _one_line(error):
+    return ' '.join(str(error).split())
+
+
+def _refuse(error):
+    print(f'{PROG}: {_one_line(error)}', file=sys.stderr)
+    return 2
+
+
 def main(argv=None):
-    """Run ``twodisk-animate``; return the exit status (0, 1 or 2)."""
-    from .animation import animate
+    """Run ``twodisk-animate``; return the exit status (0, 1, 2 or 130)."""
     try:
         args = _parser().parse_args(argv)
+        _check_output(args.output, args.overwrite)
+        _check_numbers(args)
+        _check_request(args)
+    except (_Refusal, OutputError, LimitError) as error:
+        return _refuse(error)      # before numpy, scipy and matplotlib are imported
+    from .runs import RunError
+    try:
         run = _run_of(args)
-        count = animate(run, args.output, start=args.start, stop=args.stop, fps=args.fps,
-                        view=args.view, size=args.size, forces=args.forces,
-                        camera=args.camera)
-    except RunError as error:
-        print(f'{PROG}: {" ".join(str(error).split())}', file=sys.stderr)
-        return 2
+        from .animation import animate
+        with replacing(args.output) as temporary:
+            count = animate(run, temporary, start=args.start, stop=args.stop, fps=args.fps,
+                            view=args.view, size=args.size, forces=args.forces,
+                            camera=args.camera)
+    except (RunError, OutputError, LimitError) as error:
+        return _refuse(error)
+    except KeyboardInterrupt:
+        print(f'{PROG}: interrupted; nothing written', file=sys.stderr)
+        return 130
     except Exception as error:  # noqa: BLE001 - one line, not a traceback
         if os.environ.get('TWODISK_DEBUG'):
             raise
-        print(f'{PROG}: internal error: {type(error).__name__}: {error}', file=sys.stderr)
+        print(f'{PROG}: internal error: {type(error).__name__}: {_one_line(error)}',
+              file=sys.stderr)
         return 1
     if args.forces and run.force_a is None:
         print(f'{PROG}: note: the recording has no /wrench_a, /wrench_b: no forces drawn',

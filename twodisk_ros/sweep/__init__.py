@@ -4,10 +4,11 @@
 - :mod:`~twodisk_ros.sweep.run`: the grid, chunks as Dask tasks, progress and resume;
 - :mod:`~twodisk_ros.sweep.parts`: the resume cache ``FILE.nc.parts/``;
 - :mod:`~twodisk_ros.sweep.dataset`: the xarray Dataset and its NetCDF file;
+- :mod:`~twodisk_ros.sweep.request`: the checks and size limits made before Dask starts;
 - :mod:`~twodisk_ros.sweep.cli`: the command line (``python -m twodisk_ros.sweep``).
 
 Units: a = 1, g = 1, M = 1, so lengths are in a, times in √(a/g) and angular speeds in √(g/a)
 (docs/sweeps.md). Dask and xarray are imported only by the modules that need them.
 """
 
-__all__ = ['quantities', 'run', 'parts', 'dataset', 'cli']
+__all__ = ['quantities', 'run', 'parts', 'dataset', 'request', 'cli']

@@ -4,22 +4,39 @@ Usage::
 
     twodisk-sweep --b-over-a START STOP N --delta-over-a START STOP N --out FILE.nc
                   [--mass-model laminae|solid] [--reference-speed W] [--scheduler ADDRESS]
-                  [--workers N] [--chunk-size K] [--plot DIR] [--fresh] [--keep-parts]
-                  [--quiet]
+                  [--workers N] [--chunk-size K] [--plot DIR] [--overwrite] [--fresh]
+                  [--keep-parts] [--quiet]
+
+The whole command line is checked first (numbers, the size of the grid against the memory of
+the machine, the outputs), before Dask or xarray is imported: a mistake costs a fraction of a
+second. Outputs follow :mod:`twodisk_ros.outputs`: ``--out`` must end in ``.nc``; an existing
+output (``FILE.nc``, or a ``DIR/NAME.png`` of ``--plot``) is refused unless ``--overwrite``;
+files are written through hidden temporary names and renamed, so an interrupted or failed
+sweep leaves them as they were. The resume cache ``FILE.nc.parts/`` is not an output: an
+interrupted sweep resumes with or without ``--overwrite`` (``--fresh`` discards the cache).
 
 Exit status: 0 written; 1 a task failed (finished chunks are kept: run again to resume);
-2 bad input, unreachable scheduler or unwritable output (one line on stderr); 130
-interrupted (finished chunks are kept: run the same command again to resume).
+2 bad input, a grid too large for this machine, a grid without any valid body, unreachable
+scheduler or unwritable output (one line on stderr); 130 interrupted (finished chunks are
+kept: run the same command again to resume).
 """
 
 import argparse
 import os
 from pathlib import Path
+import shutil
 import sys
+import tempfile
 
-__all__ = ['main', 'PROG']
+from ..outputs import OutputError, check_output, check_output_dir
+from .request import (DEFAULT_CHUNK_SIZE, SweepError, check_size, check_some_valid, grid_range,
+                      linspace_grid)
+
+__all__ = ['main', 'PROG', 'MAX_WORKERS_PER_CORE']
 
 PROG = 'twodisk-sweep'
+#: A local cluster has at most this many worker processes per core of the machine.
+MAX_WORKERS_PER_CORE = 4
 
 
 class _Parser(argparse.ArgumentParser):
@@ -36,14 +53,17 @@ def _parser():
         prog=PROG,
         description='Compute maps of the rolling two-disk bodies over b/a and Delta/a '
                     '(a = g = M = 1) on Dask and save them as NetCDF.',
-        epilog='Exit status: 0 done, 1 a task failed, 2 bad input / unreachable scheduler / '
-               'unwritable output, 130 interrupted (run again to resume).')
+        epilog='Exit status: 0 done, 1 a task failed, 2 bad input / grid too large or without '
+               'a valid body / unreachable scheduler / unwritable output, 130 interrupted '
+               '(run again to resume).')
     parser.add_argument('--b-over-a', nargs=3, required=True, metavar=('START', 'STOP', 'N'),
                         help='grid of b/a, inclusive: numpy.linspace(START, STOP, N)')
     parser.add_argument('--delta-over-a', nargs=3, required=True,
                         metavar=('START', 'STOP', 'N'),
                         help='grid of Delta/a, inclusive; points with Delta/a >= 1 are masked')
-    parser.add_argument('--out', required=True, metavar='FILE.nc', help='NetCDF output file')
+    parser.add_argument('--out', required=True, metavar='FILE.nc',
+                        help='NetCDF output file (.nc); an existing one is refused unless '
+                             '--overwrite')
     parser.add_argument('--mass-model', default='laminae', choices=('laminae', 'solid'),
                         help='laminae (two thin disks, default) or solid (convex hull)')
     parser.add_argument('--reference-speed', default='0.5', metavar='W',
@@ -56,7 +76,13 @@ def _parser():
                         help='worker processes of the local cluster (default: every core)')
     parser.add_argument('--chunk-size', default=None, metavar='K',
                         help='bodies per task (default 16, ~1 s of work)')
-    parser.add_argument('--plot', metavar='DIR', help='write one PNG map per variable to DIR')
+    parser.add_argument('--plot', metavar='DIR',
+                        help='write one PNG map per variable to DIR/NAME.png (DIR is created '
+                             'if its parent exists)')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace an existing FILE.nc and existing maps (they are replaced '
+                             'only once the new ones are complete); the resume cache is kept '
+                             'either way')
     parser.add_argument('--fresh', action='store_true',
                         help='discard the resume cache FILE.nc.parts/ of an earlier sweep')
     parser.add_argument('--keep-parts', action='store_true',
@@ -82,47 +108,72 @@ def _number(name, text):
         raise _Usage(f'{name} must be a number, got {text!r}') from None
 
 
-def _grid(name, values):
-    from .run import linspace_grid
+def _grid_range(name, values):
     start, stop = (_number(f'{name} START/STOP', v) for v in values[:2])
-    return linspace_grid(name, start, stop, _integer(f'{name} N', values[2]))
+    return grid_range(name, start, stop, _integer(f'{name} N', values[2]))
 
 
-def _output_refusal(out):
-    """Why the output cannot be written (None if it can be tried)."""
-    path = Path(out)
-    if path.is_dir():
-        return f'{out} is a directory'
-    parent = path.parent if str(path.parent) else Path('.')
-    if not parent.is_dir():
-        return f'its folder {parent} does not exist'
-    if not os.access(parent, os.W_OK | os.X_OK) or (path.exists()
-                                                      and not os.access(path, os.W_OK)):
-        return f'{parent} is not writable'
-    return None
+def _plot_names():
+    """The files ``--plot DIR`` writes: one PNG per float variable of the Dataset."""
+    from .quantities import VARIABLES    # numpy/scipy only
+    return [f'{name}.png' for name in VARIABLES]
 
 
-def _plot_refusal(folder):
-    path = Path(folder)
-    if path.exists() and not path.is_dir():
-        return f'{folder} is not a directory'
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        return f'{folder}: {error.strerror or error}'
-    if not os.access(path, os.W_OK | os.X_OK):
-        return f'{folder} is not writable'
-    return None
+def _checked(args):
+    """Everything of the command line checked, nothing allocated or imported beyond numpy
+    (scipy with --plot); returns (b range, Delta range, reference speed, chunk, workers).
 
-
-def _spec(args):
-    from .run import DEFAULT_CHUNK_SIZE, SweepSpec
-    b = _grid('--b-over-a', args.b_over_a)
-    d = _grid('--delta-over-a', args.delta_over_a)
+    Raises _Usage, SweepError or OutputError (one line each)."""
+    workers = None
+    if args.workers is not None:
+        workers = _integer('--workers', args.workers)
+        most = MAX_WORKERS_PER_CORE * (os.cpu_count() or 1)
+        if workers > most:
+            raise _Usage(f'--workers {workers}: at most {most} worker processes '
+                         f'({MAX_WORKERS_PER_CORE} per core of this machine)')
+    b = _grid_range('--b-over-a', args.b_over_a)
+    d = _grid_range('--delta-over-a', args.delta_over_a)
     speed = _number('--reference-speed', args.reference_speed)
+    if not (speed >= 0 and speed != float('inf')):
+        raise _Usage(f'--reference-speed must be finite and >= 0, got {args.reference_speed!r}')
     chunk = (DEFAULT_CHUNK_SIZE if args.chunk_size is None
              else _integer('--chunk-size', args.chunk_size))
-    return SweepSpec(b, d, args.mass_model, speed, chunk)
+    check_size(b[2], d[2], chunk)
+    check_some_valid(d[0])
+    if os.path.isdir(args.out):       # said first: the suffix is not the problem then
+        raise OutputError(f'{args.out} is a directory: --out must name a .nc file')
+    check_output(args.out, overwrite=args.overwrite, suffixes=('.nc',))
+    parts = f'{args.out}.parts'
+    if os.path.lexists(parts) and not os.path.isdir(parts):
+        raise SweepError(f'{parts} (the resume cache of {args.out}) exists and is not a '
+                         f'directory')
+    if args.plot:
+        check_output_dir(args.plot, overwrite=args.overwrite, names=_plot_names())
+    return b, d, speed, chunk, workers
+
+
+def _write_maps(dataset, folder, overwrite):
+    """The maps of ``write_maps`` into ``folder``, each renamed into place only when all are
+    drawn (a failure leaves the old maps as they were); returns the paths written."""
+    from ..plotting.sweep_maps import write_maps
+    folder = Path(folder)
+    created = not folder.exists()
+    folder.mkdir(exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix='.maps.', suffix='.partial', dir=folder))
+    try:
+        drawn = write_maps(dataset, staging)
+        targets = [folder / path.name for path in drawn]
+        for target in targets:          # a map that appeared meanwhile is refused too
+            check_output(target, overwrite=overwrite)
+        for path, target in zip(drawn, targets):
+            os.replace(path, target)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        if created:
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
+    shutil.rmtree(staging, ignore_errors=True)
+    return targets
 
 
 def _fail(message, status=2):
@@ -134,20 +185,18 @@ def main(argv=None):
     """Run the command line; returns the exit status (see the module docstring)."""
     try:
         args = _parser().parse_args(argv)
-        workers = None if args.workers is None else _integer('--workers', args.workers)
-        from .parts import PartsCache, PartsMismatch
-        from .run import SweepError, dask_client, parts_folder, run_sweep
-        try:
-            spec = _spec(args)
-        except SweepError as error:
-            raise _Usage(str(error)) from None
-    except _Usage as error:
+        (b0, b1, nb), (d0, d1, nd), speed, chunk, workers = _checked(args)
+    except (_Usage, SweepError, OutputError) as error:
         return _fail(error)
-    refusal = _output_refusal(args.out)
-    if refusal:
-        return _fail(f'cannot write {args.out}: {refusal}')
-    if args.plot and (refusal := _plot_refusal(args.plot)):
-        return _fail(f'cannot write plots: {refusal}')
+    # checked: from here on xarray (run, dataset) and, in dask_client, Dask
+    from .parts import PartsCache, PartsMismatch, parts_folder
+    from .run import SweepSpec, dask_client, run_sweep
+    try:
+        spec = SweepSpec(linspace_grid('--b-over-a', b0, b1, nb),
+                         linspace_grid('--delta-over-a', d0, d1, nd), args.mass_model,
+                         speed, chunk)
+    except SweepError as error:
+        return _fail(error)
     progress = None if args.quiet else sys.stderr
     try:
         cache = PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
@@ -158,7 +207,7 @@ def main(argv=None):
     try:
         with dask_client(args.scheduler, workers) as client:
             run = run_sweep(spec, client, out=args.out, progress=progress,
-                            keep_parts=args.keep_parts)
+                            keep_parts=args.keep_parts, overwrite=args.overwrite)
     except (SweepError, PartsMismatch) as error:
         if not cache.finished():
             cache.remove()    # nothing to resume: leave no empty cache behind
@@ -177,11 +226,14 @@ def main(argv=None):
           f'{run.computed} chunks computed, {run.resumed} resumed, {run.seconds:.1f} s)',
           file=sys.stderr)
     if args.plot:
-        from ..plotting.sweep_maps import write_maps
         try:
-            written = write_maps(run.dataset, args.plot)
+            written = _write_maps(run.dataset, args.plot, args.overwrite)
         except (OSError, ValueError) as error:
             return _fail(f'cannot write plots to {args.plot}: {error}')
+        except KeyboardInterrupt:
+            print(f'{PROG}: interrupted while drawing the maps; {run.output} is written',
+                  file=sys.stderr)
+            return 130
         print(f'{PROG}: wrote {len(written)} maps to {args.plot}', file=sys.stderr)
     return 0
 

@@ -4,15 +4,15 @@ Coordinates ``b_over_a`` and ``delta_over_a`` (dimensionless, a = 1); one float6
 name of :data:`~twodisk_ros.sweep.quantities.VARIABLES` with ``units`` and ``description``
 attributes, NaN where a body failed; ``failure`` (str, '' on success) says why. The package
 version and the sweep's parameters are global attributes. Files are NetCDF3 (scipy backend),
-written to a temporary name and renamed.
+written to a hidden temporary name and renamed.
 """
 
-import os
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from ..outputs import replacing
 from .quantities import FAMILIES, VARIABLES
 
 __all__ = ['build_dataset', 'write_netcdf', 'read_netcdf']
@@ -61,15 +61,13 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
 
 
 def write_netcdf(dataset, path):
-    """Write ``dataset`` to ``path`` (NetCDF3, scipy backend) atomically; returns the Path."""
+    """Write ``dataset`` to ``path`` (NetCDF3, scipy backend) through a hidden temporary file
+    renamed over it when complete (:func:`~twodisk_ros.outputs.replacing`); returns the Path.
+
+    Whether ``path`` may be replaced is the caller's check (``check_output``)."""
     path = Path(path)
-    tmp = path.with_name(f'.{path.name}.tmp{os.getpid()}')
-    try:
+    with replacing(path) as tmp:
         dataset.to_netcdf(tmp, engine='scipy')
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
     return path
 
 

@@ -14,9 +14,14 @@ import shutil
 
 import numpy as np
 
-__all__ = ['PartsCache', 'PartsMismatch']
+__all__ = ['PartsCache', 'PartsMismatch', 'parts_folder']
 
 MANIFEST = 'manifest.json'
+
+
+def parts_folder(out):
+    """The resume cache of output ``out``: ``out`` + '.parts' (beside it, never the output)."""
+    return Path(str(out) + '.parts')
 
 
 class PartsMismatch(ValueError):

@@ -27,55 +27,17 @@ import time
 import numpy as np
 
 from .. import __version__
+from ..outputs import OutputError, check_output
 from .dataset import build_dataset, write_netcdf
-from .parts import PartsCache
+from .parts import PartsCache, parts_folder
 from .quantities import MASS_MODELS, VARIABLES, timed_chunk
+from .request import DEFAULT_CHUNK_SIZE, SweepError, linspace_grid
 
 __all__ = ['SweepSpec', 'SweepRun', 'SweepError', 'linspace_grid', 'dask_client', 'run_sweep',
            'parts_folder', 'DEFAULT_CHUNK_SIZE', 'CONNECT_TIMEOUT']
 
-#: Bodies per task: ~1 s of work on one core (benchmarks/sweep_rate.py).
-DEFAULT_CHUNK_SIZE = 16
 #: Seconds to reach a scheduler before giving up (s).
 CONNECT_TIMEOUT = 5.0
-
-
-class SweepError(Exception):
-    """A sweep cannot start or go on (bad input, unreachable scheduler, unwritable output)."""
-
-
-def linspace_grid(name, start, stop, n):
-    """The inclusive grid ``numpy.linspace(start, stop, n)`` of a ratio, validated.
-
-    Raises
-    ------
-    SweepError
-        Non-finite or non-positive ends, n < 1, a reversed range, or an empty one (n > 1 with
-        start == stop, or n = 1 with start != stop).
-    """
-    try:
-        start, stop = float(start), float(stop)
-    except (TypeError, ValueError):
-        raise SweepError(f'{name}: START and STOP must be numbers, got {start!r} {stop!r}') \
-            from None
-    if isinstance(n, float) and not n.is_integer():
-        raise SweepError(f'{name}: N must be an integer >= 1, got {n!r}')
-    try:
-        n = int(n)
-    except (TypeError, ValueError):
-        raise SweepError(f'{name}: N must be an integer >= 1, got {n!r}') from None
-    if not (math.isfinite(start) and math.isfinite(stop)):
-        raise SweepError(f'{name}: START and STOP must be finite, got {start!r} {stop!r}')
-    if n < 1:
-        raise SweepError(f'{name}: N must be >= 1, got {n}')
-    if start <= 0:
-        raise SweepError(f'{name}: START must be > 0, got {start!r}')
-    if stop < start:
-        raise SweepError(f'{name}: reversed range, STOP {stop!r} < START {start!r}')
-    if (n > 1) == (stop == start):
-        raise SweepError(f'{name}: empty range: N = {n} points from {start!r} to {stop!r} '
-                         f'(N = 1 needs START = STOP, N > 1 needs START < STOP)')
-    return np.linspace(start, stop, n)
 
 
 @dataclass(frozen=True)
@@ -156,11 +118,6 @@ class SweepRun:
     output: Path = None       #: the NetCDF file written, if any
     chunk_seconds: list = field(default_factory=list)   #: wall time per computed chunk (s)
     chunk_cpu_seconds: list = field(default_factory=list)   #: worker CPU time per chunk (s)
-
-
-def parts_folder(out):
-    """The resume cache of output ``out``: ``out`` + '.parts'."""
-    return Path(str(out) + '.parts')
 
 
 @contextmanager
@@ -245,7 +202,7 @@ class _Progress:
 
 
 def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=False,
-              keep_parts=False):
+              keep_parts=False, overwrite=True):
     """Compute the sweep ``spec`` on the Dask ``client``; resume from ``out``'s cache.
 
     Parameters
@@ -266,10 +223,22 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
         Discard the cache of a different or earlier sweep instead of refusing / resuming.
     keep_parts : bool
         Keep ``out.parts/`` after writing ``out``.
+    overwrite : bool
+        Replace an existing ``out`` (checked again just before writing; the command line
+        checks it before any work too). ``out`` is written through a hidden temporary file
+        renamed over it (:func:`~twodisk_ros.outputs.replacing`): until the new file is
+        complete the old one stays as it was.
 
     Returns
     -------
     SweepRun
+
+    Raises
+    ------
+    SweepError
+        If no body of the grid could be computed (every point masked): nothing is written
+        and the resume cache is removed (unless ``keep_parts``); or if ``out`` cannot be
+        written (the resume cache is kept: run again to write it).
     """
     from distributed import as_completed
 
@@ -300,7 +269,8 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
     computed, chunk_seconds, chunk_cpu = 0, [], []
     try:
         for future in as_completed(futures, loop=client.loop):
-            index = futures[future]
+            # dropping the last reference lets the worker forget the result (saved below)
+            index = futures.pop(future)
             result, seconds, cpu = future.result()
             store(index, result)
             if cache is not None:
@@ -316,13 +286,23 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
         if pending:
             client.cancel(pending)
     arrays['failure'] = arrays['failure'].astype(str)
+    if spec.size and np.all(arrays['failure'] != ''):
+        if cache is not None and not keep_parts:
+            cache.remove()      # nothing worth resuming: the same grid fails the same way
+        first = (f'b/a = {float(b_flat[0])!r}, Delta/a = {float(d_flat[0])!r}: '
+                 f'{arrays["failure"][0]}')
+        raise SweepError(f'no body of the grid could be computed: all {spec.size} points are '
+                         f'masked (e.g. {first}); nothing written')
     dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs())
     written = None
     if out:
         try:
+            check_output(out, overwrite=overwrite)
             written = write_netcdf(dataset, out)
-        except OSError as error:
-            raise SweepError(f'cannot write {out}: {error.strerror or error}') from None
+        except (OSError, OutputError) as error:
+            raise SweepError(f'cannot write {out}: {getattr(error, "strerror", None) or error}'
+                             f'; the finished chunks are kept in {parts_folder(out)}/, run '
+                             f'again to write it') from None
         if not keep_parts:
             cache.remove()
     return SweepRun(dataset, computed, len(done), time.perf_counter() - started, written,

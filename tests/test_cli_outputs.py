@@ -1,0 +1,290 @@
+"""Outputs, runaway requests and --help of ``twodisk-sweep`` and ``twodisk-animate``.
+
+Every command runs as a real entry point in a subprocess. Most run inside a wrapper that
+makes importing Dask, distributed and xarray (and, for the early refusals of
+``twodisk-animate``, scipy and matplotlib) raise: a refusal that still comes out as one line
+with exit 2 was made before any of them was imported (not a timing claim). The runaway
+requests run under an address-space limit (RLIMIT_AS) so that a regression fails with a
+MemoryError instead of eating the machine. Sweeps that do run start a LocalCluster on
+127.0.0.1 only (twodisk_ros.sweep.run.dask_client), stopped by the command itself; the test
+kills the command's process group if it overruns.
+"""
+
+import os
+from pathlib import Path
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, PYTHONPATH=str(REPO), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+           ROS_DOMAIN_ID='15', MPLBACKEND='Agg')
+ENV.pop('DASK_SCHEDULER_ADDRESS', None)
+ENV.pop('TWODISK_DEBUG', None)
+
+SWEEP = 'twodisk_ros.sweep'
+ANIMATE = 'twodisk_ros.plotting.animate_cli'      # twodisk-animate in setup.py
+ANIMATION = 'twodisk_ros.plotting.animation'
+DASK_LIKE = ('dask', 'distributed', 'xarray')
+HEAVY = DASK_LIKE + ('scipy', 'matplotlib')
+REFUSED = 'imported before the command line was checked'
+#: Address space for the runaway requests (B): Python with numpy needs ~0.5 GiB here.
+ADDRESS_SPACE = 2 * 2**30
+# a valid 1-body sweep (the oloid)
+ONE_BODY = ['--b-over-a', '1', '1', '1', '--delta-over-a', '0.5', '0.5', '1']
+
+WRAPPER = '''
+import runpy, sys
+BLOCKED = {blocked!r}
+class _Refuse:
+    def find_spec(self, name, path=None, target=None):
+        if name.split('.')[0] in BLOCKED:
+            raise ImportError(name + ' {refused}')
+sys.meta_path.insert(0, _Refuse())
+sys.argv = [{module!r}, *sys.argv[1:]]
+runpy.run_module({module!r}, run_name='__main__', alter_sys=True)
+'''
+
+
+def _limit_address_space():
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+
+
+def _run(module, *args, cwd, blocked=(), address_space=False, timeout=60):
+    """Run ``python -m module args`` (through the import-blocking wrapper if ``blocked``);
+    returns (CompletedProcess, seconds)."""
+    if blocked:
+        command = [sys.executable, '-c', WRAPPER.format(blocked=tuple(blocked), module=module,
+                                                        refused=REFUSED), *map(str, args)]
+    else:
+        command = [sys.executable, '-m', module, *map(str, args)]
+    start = time.monotonic()
+    proc = subprocess.Popen(command, cwd=cwd, env=ENV, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_limit_address_space if address_space else None)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    finally:
+        if proc.poll() is None:         # the command and anything it started (its group)
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.communicate(timeout=10)
+    return subprocess.CompletedProcess(command, proc.returncode, out, err), \
+        time.monotonic() - start
+
+
+def _one_line_exit_2(result, *words):
+    assert result.returncode == 2, result.stderr[-3000:]
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr[-3000:]
+    assert 'Traceback' not in result.stderr and REFUSED not in result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+    return lines[0]
+
+
+def _listing(folder):
+    return sorted(p.name for p in Path(folder).iterdir())
+
+
+# -- the wrapper itself ----------------------------------------------------------------------
+
+def test_the_wrapper_blocks_dask(tmp_path):
+    # a valid request passes the checks and then needs xarray: the wrapper must stop it
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', tmp_path / 'x.nc', cwd=tmp_path,
+                     blocked=DASK_LIKE)
+    assert result.returncode != 0 and REFUSED in result.stderr
+    assert not (tmp_path / 'x.nc').exists()
+
+
+# -- twodisk-sweep: argument errors before Dask --------------------------------------------
+
+@pytest.mark.parametrize('args, words', [
+    (['--b-over-a', '1', '2', 'x', '--delta-over-a', '0.1', '0.5', '3'], 'integer'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3', '--mass-model',
+      'lamina'], 'invalid choice'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3', '--quite'],
+     'unrecognized arguments'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3', '--workers', 'x'],
+     'integer'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3',
+      '--reference-speed', 'inf'], 'finite'),
+    (['--b-over-a', '1', '2', '3', '--delta-over-a', '0.1', '0.5', '3', '--workers',
+      '100000'], 'per core of this machine'),
+])
+def test_sweep_typo_exits_2_fast_without_dask(tmp_path, args, words):
+    result, seconds = _run(SWEEP, *args, '--out', tmp_path / 'x.nc', cwd=tmp_path,
+                           blocked=DASK_LIKE)
+    _one_line_exit_2(result, words)
+    assert seconds < 1.5, seconds          # upper bound: ~0.15 s measured
+    assert _listing(tmp_path) == []
+
+
+# -- twodisk-sweep: outputs -----------------------------------------------------------------
+
+def test_sweep_refuses_an_existing_output(tmp_path):
+    out = tmp_path / 'family.nc'
+    out.write_bytes(b'an earlier result')
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', out, cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'family.nc exists', '--overwrite')
+    assert out.read_bytes() == b'an earlier result'
+    assert _listing(tmp_path) == ['family.nc']        # no resume cache, no temporary file
+
+
+def test_sweep_refuses_existing_maps(tmp_path):
+    maps = tmp_path / 'maps'
+    maps.mkdir()
+    (maps / 'barrier.png').write_bytes(b'an earlier map')
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', tmp_path / 'x.nc', '--plot', maps,
+                     cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'barrier.png exists', '--overwrite')
+    assert (maps / 'barrier.png').read_bytes() == b'an earlier map'
+    assert _listing(tmp_path) == ['maps'] and _listing(maps) == ['barrier.png']
+
+
+@pytest.mark.parametrize('name', ['family.csv', 'family', 'family.png'])
+def test_sweep_refuses_a_suffix_it_cannot_write(tmp_path, name):
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', tmp_path / name, cwd=tmp_path,
+                     blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'allowed: .nc')
+    assert _listing(tmp_path) == []
+
+
+def test_sweep_without_any_valid_body_is_refused_before_dask(tmp_path):
+    # every Delta/a >= 1: no body of the grid can be built
+    result, _ = _run(SWEEP, '--b-over-a', '0.5', '2', '4', '--delta-over-a', '1', '2', '3',
+                     '--out', tmp_path / 'x.nc', cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'no body of the grid is valid')
+    assert _listing(tmp_path) == []
+
+
+# -- twodisk-sweep: runaway grids -----------------------------------------------------------
+
+@pytest.mark.parametrize('grid, words', [
+    # 5e11 bodies: the old code tried to allocate 74.5 GiB for one linspace
+    (['--b-over-a', '0.2', '3', '10000000000', '--delta-over-a', '0.02', '0.98', '50'],
+     ['500000000000 bodies', 'allowed: at most 10000000 bodies']),
+    # 1e6 bodies: ~3 GiB estimated, above half of the 2 GiB address space
+    (['--b-over-a', '0.2', '3', '1000', '--delta-over-a', '0.02', '0.98', '1000'],
+     ['1000000 bodies', 'GiB of memory; allowed:']),
+])
+def test_sweep_runaway_grid_refused_with_what_it_needs(tmp_path, grid, words):
+    result, seconds = _run(SWEEP, *grid, '--out', tmp_path / 'x.nc', cwd=tmp_path,
+                           blocked=DASK_LIKE, address_space=True)
+    _one_line_exit_2(result, *words)
+    assert seconds < 2, seconds
+    assert _listing(tmp_path) == []
+
+
+# -- twodisk-sweep: runs (Dask) ---------------------------------------------------------------
+
+@pytest.mark.slow
+def test_sweep_without_any_computable_body_is_an_error(tmp_path):
+    # b/a = 1e300 passes the checks, but building the body overflows: every point is masked
+    result, _ = _run(SWEEP, '--b-over-a', '1e300', '1e300', '1', '--delta-over-a', '0.5',
+                     '0.5', '1', '--out', tmp_path / 'x.nc', '--workers', '1', '--quiet',
+                     cwd=tmp_path, timeout=120)
+    _one_line_exit_2(result, 'no body of the grid could be computed', 'nothing written')
+    assert _listing(tmp_path) == []       # no file, no resume cache
+
+
+@pytest.mark.slow
+def test_sweep_overwrite_replaces_outputs_and_still_resumes(tmp_path):
+    out, maps = tmp_path / 'family.nc', tmp_path / 'maps'
+    command = [*ONE_BODY, '--out', out, '--workers', '1', '--quiet']
+    first, _ = _run(SWEEP, *command, '--keep-parts', cwd=tmp_path, timeout=120)
+    assert first.returncode == 0, first.stderr
+    written = out.read_bytes()
+    parts = sorted((tmp_path / 'family.nc.parts').iterdir())
+    assert [p.name for p in parts] == ['chunk-000000.npz', 'manifest.json']
+    out.write_bytes(b'an earlier result')
+    maps.mkdir()
+    (maps / 'barrier.png').write_bytes(b'an earlier map')
+    # without --overwrite: refused before Dask, the output and the resume cache untouched
+    refused, _ = _run(SWEEP, *command, '--plot', maps, cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(refused, 'family.nc exists')
+    assert out.read_bytes() == b'an earlier result'
+    assert sorted((tmp_path / 'family.nc.parts').iterdir()) == parts
+    # with --overwrite: the cache is resumed (not discarded), the outputs are replaced
+    again, _ = _run(SWEEP, *command, '--plot', maps, '--overwrite', cwd=tmp_path, timeout=120)
+    assert again.returncode == 0, again.stderr
+    assert '0 chunks computed, 1 resumed' in again.stderr
+    assert out.read_bytes() == written          # the resumed result is bitwise the same
+    assert (maps / 'barrier.png').read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert len(_listing(maps)) == 15 and not any(n.startswith('.') for n in _listing(maps))
+    assert _listing(tmp_path) == ['family.nc', 'maps']   # cache removed, no temporary
+
+
+# -- twodisk-animate ------------------------------------------------------------------------
+
+def test_animate_refuses_an_existing_output(tmp_path):
+    out = tmp_path / 'run.gif'
+    out.write_bytes(b'an earlier animation')
+    result, _ = _run(ANIMATE, '-o', out, '--stop', '0.2', cwd=tmp_path, blocked=HEAVY)
+    _one_line_exit_2(result, 'run.gif exists', '--overwrite')
+    assert out.read_bytes() == b'an earlier animation'
+    assert _listing(tmp_path) == ['run.gif']
+
+
+def test_animate_overwrite_replaces_the_output(tmp_path):
+    from PIL import Image
+    out = tmp_path / 'run.gif'
+    out.write_bytes(b'an earlier animation')
+    result, _ = _run(ANIMATE, '-o', out, '--stop', '0.2', '--fps', '10', '--size', '160x120',
+                     '--overwrite', cwd=tmp_path, timeout=120)
+    assert result.returncode == 0, result.stderr
+    with Image.open(out) as image:
+        assert image.format == 'GIF' and image.n_frames == 3 and image.size == (160, 120)
+    assert _listing(tmp_path) == ['run.gif']    # no temporary file left
+
+
+@pytest.mark.parametrize('name, words', [
+    ('run.png', '.gif or .mp4'),
+    ('run', '.gif or .mp4'),
+    pytest.param('run.mp4', 'ffmpeg', marks=pytest.mark.skipif(
+        shutil.which('ffmpeg') is not None, reason='ffmpeg is installed: .mp4 is writable')),
+])
+def test_animate_refuses_a_suffix_it_cannot_write(tmp_path, name, words):
+    result, _ = _run(ANIMATE, '-o', tmp_path / name, '--stop', '0.2', cwd=tmp_path,
+                     blocked=HEAVY)
+    _one_line_exit_2(result, words)
+    assert _listing(tmp_path) == []
+
+
+@pytest.mark.parametrize('args, words', [
+    # the old code simulated 2e11 samples: 'internal error: MemoryError ... 1.46 TiB'
+    (['--stop', '1e9'], ['15000000001 frames', 'allowed: at most 3600 frames']),
+    (['--fps', '120', '--stop', '100'], ['12001 frames', 'allowed: at most 3600 frames']),
+    (['--start', '5000', '--stop', '5001'], ['allowed: --stop <= 3600 s']),
+    # 91 frames of 4096x4096: ~15 GiB, above half of the 2 GiB address space
+    (['--stop', '6', '--size', '4096x4096'], ['91 frames of 4096x4096', 'GiB of memory',
+                                             'allowed:']),
+])
+def test_animate_runaway_request_refused_with_what_it_needs(tmp_path, args, words):
+    result, seconds = _run(ANIMATE, '-o', tmp_path / 'run.gif', *args, cwd=tmp_path,
+                           blocked=HEAVY, address_space=True)
+    _one_line_exit_2(result, *words)
+    assert seconds < 2, seconds
+    assert _listing(tmp_path) == []
+
+
+# -- --help --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('module, flag, blocked', [
+    (SWEEP, '--help', HEAVY), (SWEEP, '-h', HEAVY), (ANIMATE, '--help', HEAVY),
+    (ANIMATE, '-h', HEAVY),
+    # the module of the drawing code imports the physics (scipy), not matplotlib
+    (ANIMATION, '--help', DASK_LIKE + ('matplotlib',))])
+def test_help_exits_0_and_writes_nothing(tmp_path, module, flag, blocked):
+    cwd = tmp_path / 'empty'
+    cwd.mkdir()
+    result, seconds = _run(module, flag, cwd=cwd, blocked=blocked)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith('usage:') and '--overwrite' in result.stdout
+    assert result.stderr == ''
+    assert seconds < 5, seconds
+    assert _listing(cwd) == []

@@ -1,0 +1,125 @@
+"""A sweep's request checked before anything is allocated or Dask is imported.
+
+numpy only (no Dask, no xarray, no physics): ``twodisk-sweep`` validates its whole command
+line here, so a typo costs the start of Python, not the start of Dask.
+
+- :func:`grid_range` checks START, STOP, N of a grid (without building it) and
+  :func:`linspace_grid` builds it;
+- :func:`check_size` estimates the memory and work of a grid and refuses a runaway one;
+- :func:`check_some_valid` refuses a grid in which no body can be valid (every Δ/a ≥ 1).
+
+Memory estimate (bytes, measured on this machine with ``benchmarks``-style scripts, peak RSS
+of the client process, rounded up): :data:`BYTES_PER_BODY` for the result arrays, the
+xarray Dataset and its NetCDF encoding (0.3 KiB with empty ``failure`` strings, 0.9 KiB with
+~100-character ones; a failure is at most 200 characters); :data:`BYTES_PER_TASK` per Dask
+task (future, task state and its graph in the client and the local scheduler: 18 KiB peak per
+task for 20 000 tasks); :data:`BYTES_PER_AXIS_VALUE` for the manifest of the resume cache.
+"""
+
+import math
+
+import numpy as np
+
+from ..limits import LimitError, check_memory, describe_bytes
+
+__all__ = ['SweepError', 'linspace_grid', 'grid_range', 'estimate', 'check_size',
+           'check_some_valid', 'DEFAULT_CHUNK_SIZE', 'MAX_BODIES', 'BYTES_PER_BODY',
+           'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE', 'CORE_SECONDS_PER_BODY']
+
+#: Bodies per task: ~1 s of work on one core (benchmarks/sweep_rate.py).
+DEFAULT_CHUNK_SIZE = 16
+#: At most this many bodies in one sweep (~220 core-hours at CORE_SECONDS_PER_BODY).
+MAX_BODIES = 10_000_000
+#: Client memory per body (B): result arrays, Dataset, NetCDF encoding (see the docstring).
+BYTES_PER_BODY = 2048
+#: Client and local-scheduler memory per task (B).
+BYTES_PER_TASK = 20 * 1024
+#: Memory per grid value of the resume cache's manifest (float.hex strings) (B).
+BYTES_PER_AXIS_VALUE = 256
+#: Work per body in a Dask worker (core-seconds; docs/sweeps.md "Cost").
+CORE_SECONDS_PER_BODY = 0.08
+
+
+class SweepError(Exception):
+    """A sweep cannot start or go on (bad input, unreachable scheduler, unwritable output)."""
+
+
+def grid_range(name, start, stop, n):
+    """Checked ``(start, stop, n)`` of the grid ``numpy.linspace(start, stop, n)``.
+
+    Raises
+    ------
+    SweepError
+        Non-finite or non-positive ends, n < 1, a reversed range, or an empty one (n > 1 with
+        start == stop, or n = 1 with start != stop).
+    """
+    try:
+        start, stop = float(start), float(stop)
+    except (TypeError, ValueError):
+        raise SweepError(f'{name}: START and STOP must be numbers, got {start!r} {stop!r}') \
+            from None
+    if isinstance(n, float) and not n.is_integer():
+        raise SweepError(f'{name}: N must be an integer >= 1, got {n!r}')
+    try:
+        n = int(n)
+    except (TypeError, ValueError, OverflowError):
+        raise SweepError(f'{name}: N must be an integer >= 1, got {n!r}') from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SweepError(f'{name}: START and STOP must be finite, got {start!r} {stop!r}')
+    if n < 1:
+        raise SweepError(f'{name}: N must be >= 1, got {n}')
+    if start <= 0:
+        raise SweepError(f'{name}: START must be > 0, got {start!r}')
+    if stop < start:
+        raise SweepError(f'{name}: reversed range, STOP {stop!r} < START {start!r}')
+    if (n > 1) == (stop == start):
+        raise SweepError(f'{name}: empty range: N = {n} points from {start!r} to {stop!r} '
+                         f'(N = 1 needs START = STOP, N > 1 needs START < STOP)')
+    return start, stop, n
+
+
+def linspace_grid(name, start, stop, n):
+    """The inclusive grid ``numpy.linspace(start, stop, n)`` of a ratio, validated
+    (:func:`grid_range`; n is not checked against memory here, see :func:`check_size`)."""
+    start, stop, n = grid_range(name, start, stop, n)
+    return np.linspace(start, stop, n)
+
+
+def estimate(n_b, n_delta, chunk_size):
+    """(bytes of memory, core-seconds of work) of a sweep of ``n_b`` × ``n_delta`` bodies."""
+    bodies = n_b * n_delta
+    tasks = -(-bodies // max(1, int(chunk_size)))
+    memory = (bodies * BYTES_PER_BODY + tasks * BYTES_PER_TASK
+              + (n_b + n_delta) * BYTES_PER_AXIS_VALUE)
+    return memory, bodies * CORE_SECONDS_PER_BODY
+
+
+def _hours(seconds):
+    hours = seconds / 3600
+    return f'{hours:.3g} core-hours' if hours >= 0.1 else f'{seconds:.3g} core-seconds'
+
+
+def check_size(n_b, n_delta, chunk_size):
+    """Refuse a sweep that needs more than :data:`MAX_BODIES` bodies or more memory than
+    :func:`~twodisk_ros.limits.memory_limit` allows (SweepError, one line)."""
+    bodies = n_b * n_delta
+    memory, work = estimate(n_b, n_delta, chunk_size)
+    what = (f'the grid of {n_b} x {n_delta} = {bodies} bodies in tasks of {chunk_size} '
+            f'(~{_hours(work)} of work)')
+    if bodies > MAX_BODIES:
+        raise SweepError(f'{what} would need ~{describe_bytes(memory)} of memory; allowed: '
+                         f'at most {MAX_BODIES} bodies')
+    try:
+        check_memory(memory, what)
+    except LimitError as error:
+        raise SweepError(f'{error} (a larger --chunk-size needs less)') from None
+    return memory, work
+
+
+def check_some_valid(delta_start):
+    """Refuse a Δ/a grid whose every point has Δ/a ≥ 1: no body of it can be built (the disks
+    of such a body do not interlock), so the sweep would compute nothing."""
+    if delta_start >= 1.0:
+        raise SweepError(f'--delta-over-a: every point has Delta/a >= 1 (START = '
+                         f'{delta_start!r}): no body of the grid is valid (needs 0 < Delta/a '
+                         f'< 1)')
