@@ -124,6 +124,10 @@ def replacing(path):
     os.close(handle)
     try:
         yield temporary
+        # mkstemp makes the file private (0600); give it the mode a plain open() would
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)
         os.replace(temporary, text)
     except BaseException:
         with contextlib.suppress(OSError):
