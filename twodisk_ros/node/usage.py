@@ -1,8 +1,11 @@
 """``roller``'s own command line: ``--help``, ``--version``, and nothing else outside ``--ros-args``.
 
-Standard library only (no rclpy, no numpy), so that the help is instant and writes nothing.
-rcl ignores every argument outside a ``--ros-args ... [--]`` section; a node that took
-``roller -p duration:=1.0`` would run the defaults for ever, so such an argument is refused.
+No rclpy, no numpy, so that the help is instant and writes nothing, and a refusal comes
+before any heavy import. rcl ignores every argument outside a ``--ros-args ... [--]``
+section; a node that took ``roller -p duration:=1.0`` would run the defaults for ever, so
+such an argument is refused. Each ``--params-file`` is read once here, within the limits of
+:mod:`~twodisk_ros.node.params_yaml` (PyYAML only), so that a hostile file is refused in a
+fraction of a second and never reaches rcl.
 """
 
 import shlex
@@ -89,8 +92,8 @@ def early_exit(argv, out=None, err=None):
     """The exit status if ``argv`` asks for no run, else None.
 
     ``-h``/``--help`` print the usage and ``--version`` the version (exit 0); any other
-    argument outside ``--ros-args`` gets one line on stderr (exit 2). ``argv[0]`` is the
-    program.
+    argument outside ``--ros-args``, and a ``--params-file`` beyond the loader's limits, get
+    one line on stderr (exit 2). ``argv[0]`` is the program.
     """
     out = out or sys.stdout
     err = err or sys.stderr
@@ -104,4 +107,14 @@ def early_exit(argv, out=None, err=None):
     if outside:
         err.write(f'{PROG}: {_refusal(list(argv)[1:], outside)}\n')
         return 2
+    files = _inside(list(argv)[1:])
+    files = [value for flag, value in zip(files, files[1:]) if flag == '--params-file']
+    if files:
+        from .params_yaml import ArgumentError, load_params_file
+        try:
+            for path in files:
+                load_params_file(path)
+        except ArgumentError as error:
+            err.write(f'{PROG}: {error}\n')
+            return 2
     return None
