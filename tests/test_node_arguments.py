@@ -398,7 +398,8 @@ def test_bounds_are_shared_over_every_file_and_override(tmp_path):
     params = tmp_path / 'half.yaml'
     params.write_text('/**:\n  ros__parameters:\n'
                       + ''.join(f'    u{i}: 1.0\n' for i in range(MAX_ENTRIES // 2)))
-    assert load_params_file(params).entries == MAX_ENTRIES // 2 + 3   # + the document, /** and ros__parameters
+    # the keys, plus the document, '/**' and 'ros__parameters'
+    assert load_params_file(params).entries == MAX_ENTRIES // 2 + 3
     with pytest.raises(ArgumentError, match='in all -p and --params-file arguments'):
         check_arguments(['roller', '--ros-args', '--params-file', str(params),
                          '--params-file', str(params)])

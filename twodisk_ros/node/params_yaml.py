@@ -350,8 +350,10 @@ def load_params_file(path, fqn='/roller'):
         if isinstance(document, Value) and document.text == '':
             continue                    # an empty document
         if not isinstance(document, dict):
+            found = ('a list' if isinstance(document, list)
+                     else f'the {document.type_name} {flat(document.text, 40)!r}')
             raise ArgumentError(f'{where}: expected a mapping of node names to '
-                                f'{{{PARAMS_KEY}: {{...}}}}, got a {type(document).__name__}')
+                                f'{{{PARAMS_KEY}: {{...}}}}, got {found}')
         for node, parameters in _sections(document, where):
             sections.append(node)
             if node_matches(node, fqn):

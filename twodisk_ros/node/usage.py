@@ -1,4 +1,4 @@
-"""``roller``'s own command line: ``--help``, ``--version``, and nothing else outside ``--ros-args``.
+"""``roller``'s own command line: ``--help``, ``--version``; nothing else outside ``--ros-args``.
 
 No rclpy, no numpy, so that the help is instant and writes nothing, and a refusal comes
 before any heavy import. rcl ignores every argument outside a ``--ros-args ... [--]``
