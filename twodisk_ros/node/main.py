@@ -17,8 +17,9 @@ from rclpy.signals import SignalHandlerOptions
 
 from ..io import RecordingError, RecordingExistsError
 from ..io.errors import one_line
-from .arguments import ArgumentError, check_arguments
+from .arguments import ArgumentError, check_arguments, rclpy_type_hint
 from .stop import StopRequest
+from .usage import early_exit
 
 __all__ = ['main', 'EXIT_OK', 'EXIT_INPUT', 'EXIT_IO', 'EXIT_INTERNAL']
 
@@ -59,9 +60,7 @@ def _start(argv, stop):
         name = type(error).__name__
         if 'Parameter' not in name and 'RCL' not in name:
             raise
-        hint = ' (write doubles with a decimal point: 50.0, not 50)' if 'DOUBLE' in str(
-            error) else ''
-        _say(f'invalid parameter: {error}{hint}')
+        _say(f'invalid parameter: {error}{rclpy_type_hint(error)}')
     return None, EXIT_INPUT
 
 
@@ -89,7 +88,8 @@ def main(args=None, stop=None):
     argv = list(sys.argv if args is None else args)
     stop = stop if stop is not None else StopRequest()
     try:
-        return _main(argv, stop)
+        status = early_exit(argv)   # --help, --version, arguments outside --ros-args
+        return status if status is not None else _main(argv, stop)
     finally:
         stop.ignore_from_now()
 
