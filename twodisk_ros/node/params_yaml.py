@@ -343,7 +343,7 @@ def load_params_file(path, fqn='/roller'):
     Bounded: at most :data:`MAX_BYTES` read, :data:`MAX_ENTRIES` entries and :data:`MAX_DEPTH`
     levels, aliases refused before anything expands; time and memory linear in the file.
     """
-    where = f'--params-file {flat(path)}'
+    where = f'--params-file {flat(path, 400)}'
     documents, entries = _documents(_read_text(path, where), where)
     sections, applied, values = [], [], {}
     for document in documents:

@@ -1,0 +1,174 @@
+"""A newcomer's first commands: every entry point answers ``--help``, and the set-up installs
+the package so that the README's commands run from any directory.
+
+``make`` (what ``make test`` runs first) installs twodisk_ros into ``.venv``; these tests run
+the installed console scripts from an empty directory, with no ``PYTHONPATH``, and check that
+``--help`` prints help, exits 0 within a few seconds and leaves no file or directory behind.
+"""
+
+import ast
+import configparser
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+VENV_BIN = Path(sys.executable).parent
+ENV = {key: value for key, value in os.environ.items() if key != 'PYTHONPATH'}
+ENV.update(ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='96', MPLBACKEND='Agg')
+#: --help answers long before this (0.1-1.5 s measured); more means it started working.
+HELP_SECONDS = 5.0
+
+
+def _console_scripts():
+    """The console scripts that setup.py declares (name -> module:function)."""
+    tree = ast.parse((REPO / 'setup.py').read_text(encoding='utf-8'))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
+                    return dict(item.split(' = ') for item in ast.literal_eval(value))
+    raise AssertionError('setup.py declares no console_scripts')
+
+
+def _main_modules():
+    """Every module of the package and of benchmarks/ that runs as a program."""
+    found = []
+    for path in sorted((REPO / 'twodisk_ros').rglob('*.py')):
+        text = path.read_text(encoding='utf-8')
+        if "__name__ == '__main__'" in text or path.name == '__main__.py':
+            parts = path.relative_to(REPO).with_suffix('').parts
+            if parts[-1] == '__main__':
+                parts = parts[:-1]
+            found.append('.'.join(parts))
+    return found
+
+
+SCRIPTS = _console_scripts()
+MODULES = _main_modules()
+BENCHMARKS = sorted(path.name for path in (REPO / 'benchmarks').glob('*.py')
+                    if "__name__ == '__main__'" in path.read_text(encoding='utf-8'))
+
+
+def _help(command, cwd, env=ENV):
+    start = time.monotonic()
+    result = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True,
+                            timeout=60, stdin=subprocess.DEVNULL)
+    return result, time.monotonic() - start
+
+
+def _assert_help(result, elapsed, cwd, label):
+    assert result.returncode == 0, f'{label}: exit {result.returncode}\n{result.stderr[-2000:]}'
+    assert 'usage' in result.stdout.lower(), f'{label} printed no usage:\n{result.stdout}'
+    assert 'Traceback' not in result.stderr, result.stderr
+    assert elapsed < HELP_SECONDS, f'{label} --help took {elapsed:.1f} s'
+    assert list(Path(cwd).iterdir()) == [], f'{label} --help wrote {list(Path(cwd).iterdir())}'
+
+
+def test_setup_installs_every_console_script():
+    """``make`` puts each console script of setup.py into .venv/bin (not only colcon)."""
+    missing = [name for name in SCRIPTS if not (VENV_BIN / name).is_file()]
+    assert not missing, f'not in {VENV_BIN}: {missing} (run make venv)'
+    assert set(SCRIPTS) >= {'roller', 'twodisk-inspect', 'twodisk-animate', 'twodisk-sweep'}
+
+
+def test_setup_installs_the_parameter_files():
+    """The README's ``$VIRTUAL_ENV/share/twodisk_ros/config/...`` paths exist after ``make``."""
+    share = Path(sys.prefix) / 'share' / 'twodisk_ros' / 'config'
+    for path in sorted((REPO / 'config').iterdir()):
+        assert (share / path.name).read_bytes() == path.read_bytes(), path.name
+
+
+@pytest.mark.parametrize('name', sorted(SCRIPTS))
+@pytest.mark.parametrize('flag', ['--help', '-h'])
+def test_console_script_help_from_another_directory(tmp_path, name, flag):
+    result, elapsed = _help([str(VENV_BIN / name), flag], tmp_path)
+    _assert_help(result, elapsed, tmp_path, f'{name} {flag}')
+
+
+@pytest.mark.parametrize('module', MODULES)
+def test_module_help_has_no_side_effects(tmp_path, module):
+    result, elapsed = _help([sys.executable, '-m', module, '--help'], tmp_path)
+    _assert_help(result, elapsed, tmp_path, f'python -m {module} --help')
+
+
+@pytest.mark.parametrize('script', BENCHMARKS)
+def test_benchmark_help_has_no_side_effects(tmp_path, script):
+    env = dict(ENV, PYTHONPATH=str(REPO))
+    result, elapsed = _help([sys.executable, str(REPO / 'benchmarks' / script), '--help'],
+                            tmp_path, env)
+    _assert_help(result, elapsed, tmp_path, f'benchmarks/{script} --help')
+
+
+def test_roller_version(tmp_path):
+    result, _ = _help([str(VENV_BIN / 'roller'), '--version'], tmp_path)
+    version = re.search(r'<version>([^<]+)</version>',
+                        (REPO / 'package.xml').read_text(encoding='utf-8')).group(1)
+    assert result.returncode == 0 and version in result.stdout, result
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_readme_python_block_runs_as_a_saved_script_anywhere(tmp_path):
+    """The README's library example, saved to a file, runs from another directory."""
+    text = (REPO / 'README.md').read_text(encoding='utf-8')
+    blocks = re.findall(r'^```python[ \t]*\n(.*?)^```', text, re.MULTILINE | re.DOTALL)
+    assert blocks
+    for number, code in enumerate(blocks):
+        script = tmp_path / f'example{number}.py'
+        script.write_text(code, encoding='utf-8')
+        result = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=ENV,
+                                capture_output=True, text=True, timeout=300)
+        assert result.returncode == 0, result.stderr[-3000:]
+
+
+def test_readme_names_only_commands_that_exist():
+    """Every ``.venv/bin/X`` and every console script the README names is installed."""
+    text = (REPO / 'README.md').read_text(encoding='utf-8')
+    for name in re.findall(r'\.venv/bin/([\w-]+)', text):
+        assert (VENV_BIN / name).is_file(), f'README names .venv/bin/{name}'
+
+
+def test_setup_cfg_keeps_the_ros2_run_layout():
+    """colcon installs the scripts where ``ros2 run`` looks (lib/twodisk_ros)."""
+    config = configparser.ConfigParser()
+    config.read(REPO / 'setup.cfg')
+    assert config['install']['install_scripts'] == '$base/lib/twodisk_ros'
+
+
+def test_readme_quick_start_commands_run_from_another_directory(tmp_path):
+    """The README's "from any directory" block, as written, in an empty directory.
+
+    Only the checkout's path is filled in; no PYTHONPATH, no active venv beforehand.
+    """
+    text = (REPO / 'README.md').read_text(encoding='utf-8')
+    blocks = re.findall(r'^```sh[ \t]*\n(.*?)^```', text, re.MULTILINE | re.DOTALL)
+    block = next(b for b in blocks if 'source /path/to/twodisk_ros/.venv/bin/activate' in b)
+    script = 'set -euo pipefail\n' + block.replace('/path/to/twodisk_ros', str(REPO))
+    env = {key: value for key, value in ENV.items() if key not in ('VIRTUAL_ENV',)}
+    env['PATH'] = ':'.join(p for p in env.get('PATH', '').split(':')
+                           if not p.startswith(str(VENV_BIN)))
+    result = subprocess.run(['bash', '-c', script], cwd=tmp_path, env=env,
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    for name in ('run.mcap', 'run.png', 'run.csv', 'run.gif'):
+        assert (tmp_path / name).stat().st_size > 0, name
+    assert 'usage' in result.stdout.lower()
+
+
+def test_replaced_outputs_get_the_mode_of_a_plain_open(tmp_path):
+    """Outputs written through ``outputs.replacing`` are not left private (mkstemp's 0600)."""
+    from twodisk_ros.outputs import replacing
+    target = tmp_path / 'out.txt'
+    umask = os.umask(0o022)
+    try:
+        with replacing(target) as temporary:
+            Path(temporary).write_text('x')
+    finally:
+        os.umask(umask)
+    assert target.stat().st_mode & 0o777 == 0o644
+    assert [p.name for p in tmp_path.iterdir()] == ['out.txt']
