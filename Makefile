@@ -7,6 +7,8 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_DOMAIN_ID ?= 73
 export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 export MPLBACKEND := Agg
+# where make demo writes (a test runs it into a temporary directory)
+OUT ?= out
 
 .PHONY: venv test demo figures bench clean
 
@@ -33,12 +35,12 @@ test: venv
 
 ## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
 demo: venv
-	mkdir -p out
+	mkdir -p $(OUT)
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
-	    -p realtime:=false -p duration:=20.0 -p record:=out/oloid.mcap -p overwrite:=true
-	$(PY) -m twodisk_ros.inspect_mcap out/oloid.mcap --plot out/oloid.png --overwrite
-	$(PY) -m twodisk_ros.plotting.animation out/oloid.mcap -o out/oloid.gif \
-	    --stop 6 --fps 15 --size 480x360
+	    -p realtime:=false -p duration:=20.0 -p record:=$(OUT)/oloid.mcap -p overwrite:=true
+	$(PY) -m twodisk_ros.inspect_mcap $(OUT)/oloid.mcap --plot $(OUT)/oloid.png --overwrite
+	$(PY) -m twodisk_ros.plotting.animation $(OUT)/oloid.mcap -o $(OUT)/oloid.gif \
+	    --stop 6 --fps 15 --size 480x360 --overwrite
 
 ## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
 figures: venv

@@ -172,3 +172,16 @@ def test_replaced_outputs_get_the_mode_of_a_plain_open(tmp_path):
         os.umask(umask)
     assert target.stat().st_mode & 0o777 == 0o644
     assert [p.name for p in tmp_path.iterdir()] == ['out.txt']
+
+
+@pytest.mark.slow
+def test_make_demo_works_twice(tmp_path):
+    """``make demo`` (the README's first command) succeeds, and again in the same place."""
+    out = tmp_path / 'out'
+    for run in (1, 2):
+        env = {k: v for k, v in ENV.items() if k not in ('MAKEFLAGS', 'MFLAGS', 'MAKELEVEL')}
+        result = subprocess.run(['make', '-C', str(REPO), 'demo', f'OUT={out}'], env=env,
+                                capture_output=True, text=True, timeout=600)
+        assert result.returncode == 0, f'run {run}:\n{result.stdout[-2000:]}{result.stderr[-2000:]}'
+        assert 'result: PASS' in result.stdout, result.stdout[-2000:]
+    assert sorted(p.name for p in out.iterdir()) == ['oloid.gif', 'oloid.mcap', 'oloid.png']
