@@ -349,13 +349,14 @@ class McapRecorder:
                 for stamp, row in zip(stamps, zip(*messages)):
                     for channel, data in zip(channels, row):
                         add(channel, stamp, data, stamp)
+                    if not self._published:   # the first sample is on disk before the rest
+                        self._publish_first()
             for state in states:
                 state.message_count += len(stamps)
             self._message_count += len(stamps) * len(states)
             first, last = min(stamps), max(stamps)
             self._first_ns = first if self._first_ns is None else min(self._first_ns, first)
             self._last_ns = last if self._last_ns is None else max(self._last_ns, last)
-            self._publish_first()
 
     def flush(self) -> None:
         """End the chunk in progress now, so that everything written so far is on disk."""
@@ -448,7 +449,11 @@ class McapRecorder:
                                        '(not replaced)')
 
     def _publish_first(self):
-        """After the first message: end its chunk and give the file its name (lock held)."""
+        """After the first message: end its chunk, give the file its name (lock held).
+
+        From here on a killed process or a full disk leaves the recording readable under
+        its name, the old file (if any) replaced by one that holds at least a message.
+        """
         if not self._published:
             with self._io('write'):
                 self._writer.flush()

@@ -429,10 +429,7 @@ class Roller(Node):
         """
         if self._recorder is None:
             return False
-        if self.samples_published == 0:
-            return self._recorder.discard()
-        self._recorder.close()
-        return True
+        return self._recorder.discard()   # closed as it is once it holds a sample
 
     def end_line(self):
         """One line on what the run did (samples, times, the file, warnings), for the log."""

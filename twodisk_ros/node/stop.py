@@ -4,6 +4,7 @@ Imported first by the entry point, before numpy, scipy and rclpy, so that a sign
 start-up is already handled.
 """
 
+import os
 import signal
 
 __all__ = ['StopNow', 'StopRequest']
@@ -19,17 +20,20 @@ class StopNow(BaseException):
 class StopRequest:
     """SIGINT and SIGTERM set a flag; the loops end at a sample boundary.
 
-    During start-up (between :meth:`allow_abort` and :meth:`forbid_abort`: table building
-    can take seconds) a *second* signal raises :class:`StopNow` in the main thread, so the
-    process ends at once; nothing has been recorded then. Outside it a repeated signal
-    changes nothing: the run still ends cleanly and the recording is finished. SIGXFSZ (a
-    file-size limit) is ignored so that writing past the limit is an I/O error the recorder
-    reports, not a killed process.
+    During start-up a *second* signal ends the process at once (nothing has been recorded
+    then): while the entry point still imports (before :meth:`allow_abort`) by exiting 0
+    on the spot, nothing having been created yet; from :meth:`allow_abort` to
+    :meth:`forbid_abort` (table building can take seconds) by raising :class:`StopNow` in
+    the main thread, which ``main`` catches after discarding what was built. Later a
+    repeated signal changes nothing: the run still ends cleanly and the recording is
+    finished. SIGXFSZ (a file-size limit) is ignored so that writing past the limit is an
+    I/O error the recorder reports, not a killed process.
     """
 
     def __init__(self):
         self.requested = None
         self.abortable = False
+        self.importing = True     # until main() starts: nothing exists that needs cleaning up
         self.install()
 
     def install(self):
@@ -43,6 +47,12 @@ class StopRequest:
         name = signal.Signals(signum).name
         if self.requested is None:
             self.requested = name
+        elif self.importing:
+            # the entry point is still importing numpy, scipy and rclpy: no file, no node
+            # exists yet, and an exception here would escape the import as a traceback
+            os.write(2, f'roller: stopped by {self.requested} during start-up: no recording '
+                        'written\n'.encode())
+            os._exit(0)
         elif self.abortable:
             self.abortable = False      # one StopNow only: the clean-up is not cut short
             raise StopNow(name)
@@ -52,6 +62,7 @@ class StopRequest:
 
     def allow_abort(self):
         """From now on a second signal raises :class:`StopNow` (start-up work)."""
+        self.importing = False
         self.abortable = True
 
     def forbid_abort(self):
@@ -64,6 +75,6 @@ class StopRequest:
         Python's finalization resets signals that have Python handlers to their default
         action (a SIGTERM would then kill the exiting process); ignored ones stay ignored.
         """
-        self.abortable = False
+        self.importing = self.abortable = False
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, signal.SIG_IGN)
