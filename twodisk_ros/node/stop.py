@@ -49,10 +49,10 @@ class StopRequest:
             self.requested = name
         elif self.importing:
             # the entry point is still importing numpy, scipy and rclpy: no file, no node
-            # exists yet, and an exception here would escape the import as a traceback
+            # exists yet; SystemExit leaves the import and the interpreter quietly, exit 0
             os.write(2, f'roller: stopped by {self.requested} during start-up: no recording '
                         'written\n'.encode())
-            os._exit(0)
+            raise SystemExit(0)
         elif self.abortable:
             self.abortable = False      # one StopNow only: the clean-up is not cut short
             raise StopNow(name)
