@@ -50,6 +50,7 @@ class StopRequest:
         elif self.importing:
             # the entry point is still importing numpy, scipy and rclpy: no file, no node
             # exists yet; SystemExit leaves the import and the interpreter quietly, exit 0
+            self.ignore_from_now()      # (Python's finalization must not die of a third)
             os.write(2, f'roller: stopped by {self.requested} during start-up: no recording '
                         'written\n'.encode())
             raise SystemExit(0)
