@@ -17,11 +17,21 @@ Times are integer nanoseconds; a message's log time and publish time are both it
 Each chunk is handed to the operating system as soon as it is complete, so a process that is
 killed leaves every message before its last, unfinished chunk readable by
 :func:`twodisk_ros.io.reader.read_recording`.
+
+The file is written under a hidden temporary name beside it (``.run.1a2b3c4d.partial.mcap``)
+and takes its own name when its first message is on disk (the chunk holding it is ended at
+once), or at :meth:`McapRecorder.close` if it holds none. So an existing file is replaced
+only by a recording that holds a message, a recorder that is :meth:`~McapRecorder.discard`-ed
+before its first message leaves the old file byte for byte as it was, and a path that is not
+a regular file (a directory, a device, a FIFO) is never opened, replaced or removed.
 """
 
+import contextlib
 import operator
 import os
 import re
+import secrets
+import stat
 import threading
 from dataclasses import dataclass
 from importlib import metadata as _importlib_metadata
@@ -129,13 +139,15 @@ class McapRecorder:
     compression : {'zstd', 'lz4', 'none'}, optional
         Chunk compression.
     overwrite : bool, optional
-        Replace an existing file (default); if False an existing file is refused with
-        :class:`RecordingExistsError`, as ``ros2 bag record`` refuses an existing bag.
+        Replace an existing regular file (default) when the new one holds its first
+        message; if False an existing file is refused with :class:`RecordingExistsError`,
+        as ``ros2 bag record`` refuses an existing bag.
 
     Raises
     ------
     RecordingError
-        If ``path`` cannot be written (missing directory, a directory, no permission).
+        If ``path`` cannot be written (missing directory, not a regular file such as a
+        directory or a FIFO, no permission).
 
     Examples
     --------
@@ -154,11 +166,13 @@ class McapRecorder:
         if compression not in _COMPRESSION:
             raise ValueError(f'compression must be one of {sorted(_COMPRESSION)}, '
                              f'got {compression!r}')
+        self._overwrite = bool(overwrite)
+        self._check_target()
+        self._published = False
+        self._target = os.path.realpath(self._path)   # through a symbolic link, as open()
+        self._temporary = _temporary_name(self._target)
         try:
-            self._raw = open(self._path, 'wb' if overwrite else 'xb', buffering=0)
-        except FileExistsError:
-            raise RecordingExistsError(f'cannot write recording {self._path}: the file exists '
-                                       '(not replaced)') from None
+            self._raw = open(self._temporary, 'xb', buffering=0)
         except OSError as error:
             raise RecordingError(
                 f'cannot write recording {self._path}: '
@@ -182,12 +196,18 @@ class McapRecorder:
         except BaseException:
             self._closed = True
             self._raw.close()
+            self._remove_temporary()
             raise
 
     @property
     def path(self) -> str:
-        """The file written."""
+        """The file written (its final name)."""
         return self._path
+
+    @property
+    def published(self) -> bool:
+        """Whether the recording has taken its final name (:attr:`path`) yet."""
+        return self._published
 
     @property
     def message_count(self) -> int:
@@ -293,6 +313,7 @@ class McapRecorder:
             self._message_count += 1
             self._first_ns = stamp if self._first_ns is None else min(self._first_ns, stamp)
             self._last_ns = stamp if self._last_ns is None else max(self._last_ns, stamp)
+            self._publish_first()
 
     def channel_id(self, topic: str) -> int:
         """The MCAP channel id of a registered topic (for :meth:`write_interleaved`)."""
@@ -328,6 +349,8 @@ class McapRecorder:
                 for stamp, row in zip(stamps, zip(*messages)):
                     for channel, data in zip(channels, row):
                         add(channel, stamp, data, stamp)
+                    if not self._published:   # the first sample is on disk before the rest
+                        self._publish_first()
             for state in states:
                 state.message_count += len(stamps)
             self._message_count += len(stamps) * len(states)
@@ -364,8 +387,35 @@ class McapRecorder:
                     self._writer.add_metadata('rosbag2', self._bag_metadata())
                     self._writer.add_metadata('twodisk_ros', dict(self._metadata))
                     self._writer.finish()
-            finally:
+            except BaseException:
                 self._raw.close()
+                self._remove_temporary()   # nothing readable of it took the final name
+                raise
+            self._raw.close()
+            if not self._published:        # no message: an empty recording, as rosbag2's
+                try:
+                    self._publish()
+                except BaseException:
+                    self._remove_temporary()
+                    raise
+
+    def discard(self) -> bool:
+        """Close without publishing if no message has been written: the path is untouched.
+
+        The temporary file is removed and an existing file at :attr:`path` is left byte for
+        byte as it was. A recording that already holds messages is closed as by
+        :meth:`close`. Returns True if the recording was kept (it had messages).
+        """
+        with self._lock:
+            if self._published or self._closed:
+                kept = self._published
+            else:
+                self._closed = True
+                self._raw.close()
+                self._remove_temporary()
+                return False
+        self.close()
+        return kept
 
     def __enter__(self):
         return self
@@ -380,6 +430,46 @@ class McapRecorder:
                 f'{self._message_count} messages>')
 
     # -- internals -------------------------------------------------------------------------
+
+    def _check_target(self):
+        """Refuse a path that is not a regular file, or an existing one without overwrite."""
+        try:
+            info = os.stat(self._path)
+        except FileNotFoundError:
+            return
+        except OSError as error:
+            raise RecordingError(f'cannot write recording {self._path}: '
+                                 f'{os_error_reason(self._path, error, writing=True)}') from None
+        if not stat.S_ISREG(info.st_mode):
+            kind = 'a directory' if stat.S_ISDIR(info.st_mode) else 'not a regular file'
+            raise RecordingError(f'cannot write recording {self._path}: it is {kind} '
+                                 '(a recording replaces regular files only)')
+        if not self._overwrite:
+            raise RecordingExistsError(f'cannot write recording {self._path}: the file exists '
+                                       '(not replaced)')
+
+    def _publish_first(self):
+        """After the first message: end its chunk, give the file its name (lock held).
+
+        From here on a killed process or a full disk leaves the recording readable under
+        its name, the old file (if any) replaced by one that holds at least a message.
+        """
+        if not self._published:
+            with self._io('write'):
+                self._writer.flush()
+            self._publish()
+
+    def _publish(self):
+        """Rename the temporary file to :attr:`path` (checked again: never over a non-file)."""
+        with self._io('write'):
+            self._check_target()
+            os.replace(self._temporary, self._target)
+        self._published = True
+
+    def _remove_temporary(self):
+        if not self._published:
+            with contextlib.suppress(OSError):
+                os.remove(self._temporary)
 
     def _check_open(self):
         if self._closed:
@@ -402,6 +492,13 @@ class McapRecorder:
                   for topic, state in self._topics.items()]
         return bag_metadata(self._path, topics, self._message_count, self._first_ns,
                             self._last_ns)
+
+
+def _temporary_name(path):
+    """A hidden name beside ``path``: ``.run.1a2b3c4d.partial.mcap`` for ``run.mcap``."""
+    directory, name = os.path.split(os.path.abspath(path))
+    stem, suffix = os.path.splitext(name)
+    return os.path.join(directory, f'.{stem}.{secrets.token_hex(4)}.partial{suffix}')
 
 
 def _check_metadata(metadata):

@@ -18,7 +18,7 @@ from rclpy.signals import SignalHandlerOptions
 from ..io import RecordingError, RecordingExistsError
 from ..io.errors import one_line
 from .arguments import ArgumentError, check_arguments, rclpy_type_hint
-from .stop import StopRequest
+from .stop import StopNow, StopRequest
 from .usage import early_exit
 
 __all__ = ['main', 'EXIT_OK', 'EXIT_INPUT', 'EXIT_IO', 'EXIT_INTERNAL']
@@ -65,6 +65,7 @@ def _start(argv, stop):
 
 
 def _run(node, stop):
+    stop.forbid_abort()    # samples are being recorded: a second signal changes nothing
     if not node.settings.realtime:
         node.run_batch(keep_going=lambda: not stop)
     else:
@@ -88,8 +89,12 @@ def main(args=None, stop=None):
     argv = list(sys.argv if args is None else args)
     stop = stop if stop is not None else StopRequest()
     try:
+        stop.allow_abort()   # start-up: a second signal ends the process at once
         status = early_exit(argv)   # --help, --version, arguments outside --ros-args
         return status if status is not None else _main(argv, stop)
+    except StopNow:
+        _say(f'stopped by {stop.requested} during start-up: no recording written')
+        return EXIT_OK
     finally:
         stop.ignore_from_now()
 
@@ -109,25 +114,42 @@ def _main(argv, stop):
         node, status = _start(argv, stop)
         if node is not None and not stop:
             _run(node, stop)
+    except StopNow:
+        if node is None:
+            raise                                 # main says it: nothing was built
     except RecordingError as error:
         _say(error)
         status = EXIT_IO
     except Exception as error:  # noqa: BLE001 - one line, never a traceback
         status = _internal(error)
     finally:
+        stop.forbid_abort()   # the clean-up is never cut short
         if node is not None:
-            try:
-                kept = node.close()
-                if not kept and node.settings.record:
-                    _say(f'stopped before the first sample: no recording written to '
-                         f'{node.settings.record}')
-            except RecordingError as error:
-                if status == EXIT_OK:
-                    _say(error)
-                    status = EXIT_IO
+            status = _close(node, status)
             node.destroy_node()
         rclpy.try_shutdown()
         stop.install()   # rclpy's shutdown restored the default handlers: a late signal is ours
+    return status
+
+
+def _close(node, status):
+    """Finish the recording and log the run's last line (or why nothing was recorded).
+
+    Returns the exit code: EXIT_IO if the recording could not be finished.
+    """
+    try:
+        kept = node.close()
+    except RecordingError as error:
+        if status == EXIT_OK:
+            _say(error)
+            return EXIT_IO
+        return status
+    if node.samples_published:
+        node.get_logger().info(node.end_line())
+    elif not kept:
+        record = node.settings.record
+        where = f': no recording written to {record}' if record else ''
+        _say(f'stopped before the first sample{where}')
     return status
 
 

@@ -13,7 +13,6 @@ States are computed in blocks ahead of time and encoded to CDR in one vectorised
 
 from collections import deque
 import math
-import os
 import time
 
 import numpy as np
@@ -29,8 +28,9 @@ from visualization_msgs.msg import MarkerArray
 
 from .. import __version__
 from ..io import McapRecorder, cdr
+from ..outputs import check_output
 from ..io.cdr_markers import encode_markers
-from . import messages
+from . import messages, run_summary
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
 from .simulation import Simulation
 
@@ -91,16 +91,15 @@ class Roller(Node):
             self.declare_parameter(p.name, _ros_value(p), _descriptor(p))
         values = {p.name: self.get_parameter(p.name).value for p in PARAMETERS}
         self.settings = DEFAULTS.with_values(**values).checked()
+        if self.settings.record:   # before any work; never a file the node did not create
+            check_output(self.settings.record, overwrite=self.settings.overwrite,
+                         suffixes=('.mcap',), option='-p overwrite:=true')
         self.simulation = Simulation(self.settings)
         self._recorder = None
         self._pubs = {topic: self.create_publisher(kind, topic, QOS_DEPTH)
                       for topic, kind in TOPIC_TYPES.items()}
         if self.settings.record:
-            self._recorder = McapRecorder(self.settings.record, metadata=self._metadata(),
-                                          overwrite=self.settings.overwrite)
-            for topic, kind in TOPIC_TYPES.items():
-                publisher = self._pubs[topic]
-                self._recorder.add_topic(publisher.topic_name, kind, publisher.qos_profile)
+            self._open_recorder()
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
         self._dropped_reported = 0      # samples_dropped at the last diagnostics
@@ -119,6 +118,20 @@ class Roller(Node):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         if self.settings.realtime:
             self._timer = self.create_timer(1.0 / self.settings.rate, self._on_timer)
+        self.get_logger().info(run_summary.start_line(self.settings))
+
+    def _open_recorder(self):
+        """The recorder of ``record``, under a temporary name until its first sample."""
+        try:
+            self._recorder = McapRecorder(self.settings.record, metadata=self._metadata(),
+                                          overwrite=self.settings.overwrite)
+            for topic, kind in TOPIC_TYPES.items():
+                publisher = self._pubs[topic]
+                self._recorder.add_topic(publisher.topic_name, kind, publisher.qos_profile)
+        except BaseException:      # also a start-up cut short by a second signal
+            if self._recorder is not None:
+                self._recorder.discard()
+            raise
 
     # -- parameters -------------------------------------------------------------------------
     @property
@@ -410,16 +423,22 @@ class Roller(Node):
     def close(self):
         """Finish the recording (idempotent); RecordingError if it cannot be written.
 
-        A recording that never received a sample (stopped during start-up) is removed:
-        nothing was recorded. Returns True if a recording was kept.
+        A recording that never received a sample (stopped during start-up) is discarded:
+        its temporary file is removed and an existing file at ``record`` is left as it was.
+        Returns True if a recording was kept.
         """
         if self._recorder is None:
             return False
-        self._recorder.close()
-        if self.samples_published == 0 and os.path.exists(self._recorder.path):
-            os.remove(self._recorder.path)
-            return False
-        return True
+        return self._recorder.discard()   # closed as it is once it holds a sample
+
+    def end_line(self):
+        """One line on what the run did (samples, times, the file, warnings), for the log."""
+        recorder, invalid = self._recorder, self.simulation.invalid
+        return run_summary.end_line(
+            self.samples_published, max(self._tick - 1, 0) / self.settings.rate,
+            time.monotonic() - self._wall_start,
+            recorder.path if recorder is not None and recorder.published else None,
+            invalid.reason if invalid is not None else None, self.samples_dropped)
 
 
 class _PathHistory:

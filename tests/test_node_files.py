@@ -1,0 +1,280 @@
+"""``roller``'s record file and its process, through the real entry point in a subprocess.
+
+- a path that is not a regular file (FIFO, directory, symbolic link to a FIFO) or has another
+  suffix than ``.mcap`` is refused at start-up, one line, exit 2, left as it was;
+- ``overwrite:=true`` replaces the old file only with a recording that holds a sample: a stop
+  before the first sample leaves it byte for byte, and no temporary file behind;
+- a second SIGINT / SIGTERM during a long start-up ends the process at once, exit 0;
+- one INFO line when the run starts and one when it ends.
+
+Subprocess nodes use ROS domain 78; discovery is localhost-only.
+"""
+
+import os
+from pathlib import Path
+import queue
+import re
+import signal
+import stat
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from twodisk_ros.io import read_recording
+
+pytestmark = pytest.mark.ros
+
+REPO = Path(__file__).resolve().parents[1]
+OLD = b'an old recording the user wants to keep\n'
+#: a body whose tables take many seconds to build (about 18 s on the development machine)
+SLOW_BODY = ('-p', 'a:=0.1', '-p', 'b:=0.001', '-p', 'delta:=0.099')
+
+
+def node_env():
+    return dict(os.environ, PYTHONPATH=str(REPO), ROS_DOMAIN_ID='78',
+                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+
+
+def roller(*params):
+    return subprocess.Popen(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
+         'config/oloid.yaml', *params], cwd=REPO, env=node_env(), stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True)
+
+
+def finish(process, timeout=30.0):
+    """(exit code, stderr); a process still running after ``timeout`` s fails the test."""
+    try:
+        _, err = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        pytest.fail(f'the node did not end within {timeout} s: {err[-2000:]}')
+    return process.returncode, err
+
+
+class StderrLines:
+    """The lines a running process writes to stderr, read by a thread."""
+
+    def __init__(self, process):
+        self.lines = queue.Queue()
+        self.seen = []
+        self._thread = threading.Thread(target=self._read, args=(process.stderr,), daemon=True)
+        self._thread.start()
+
+    def _read(self, stream):
+        for line in stream:
+            self.lines.put(line)
+
+    def wait_for(self, text, timeout):
+        """True once a line containing ``text`` was written, False after ``timeout`` s."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            try:
+                line = self.lines.get(timeout=0.05)
+            except queue.Empty:
+                continue
+            self.seen.append(line)
+            if text in line:
+                return True
+        return False
+
+    def rest(self):
+        self._thread.join(timeout=10.0)
+        while not self.lines.empty():
+            self.seen.append(self.lines.get())
+        return ''.join(self.seen)
+
+
+def wait(process, timeout=30.0):
+    """Exit code of a process whose stderr a :class:`StderrLines` reads."""
+    try:
+        return process.wait(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+        pytest.fail(f'the node did not end within {timeout} s')
+
+
+def left_over(folder, *expected):
+    """Files in ``folder`` besides ``expected`` (a temporary file left behind would show)."""
+    return sorted(set(os.listdir(folder)) - set(expected))
+
+
+# -- files the node did not create -----------------------------------------------------------
+
+def _fifo(folder):
+    path = folder / 'pipe.mcap'
+    os.mkfifo(path)
+    return path, stat.S_ISFIFO
+
+
+def _directory(folder):
+    path = folder / 'folder.mcap'
+    path.mkdir()
+    return path, stat.S_ISDIR
+
+
+def _link_to_fifo(folder):
+    fifo = folder / 'target-pipe'
+    os.mkfifo(fifo)
+    path = folder / 'link.mcap'
+    path.symlink_to(fifo)
+    return path, stat.S_ISFIFO
+
+
+@pytest.mark.parametrize('make', [_fifo, _directory, _link_to_fifo],
+                         ids=['fifo', 'directory', 'symlink-to-fifo'])
+def test_a_path_that_is_not_a_regular_file_is_refused_even_with_overwrite(tmp_path, make):
+    """Exit 2 with one line before any work; the FIFO or directory stays as it was.
+
+    (Before: a FIFO was opened for writing, which blocks until a reader comes, and was
+    removed by a stop before the first sample.)
+    """
+    path, is_kind = make(tmp_path)
+    before = sorted(os.listdir(tmp_path))
+    code, err = finish(roller('-p', 'realtime:=false', '-p', 'duration:=0.1',
+                              '-p', f'record:={path}', '-p', 'overwrite:=true'), timeout=20.0)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and 'Traceback' not in err, err
+    assert str(path) in lines[0] and 'regular file' in lines[0], err
+    assert is_kind(os.stat(path).st_mode)
+    assert sorted(os.listdir(tmp_path)) == before
+
+
+def test_a_record_file_must_end_in_mcap(tmp_path):
+    target = tmp_path / 'run.bag'
+    code, err = finish(roller('-p', 'realtime:=false', '-p', 'duration:=0.1',
+                              '-p', f'record:={target}'))
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and '.mcap' in lines[0], err
+    assert os.listdir(tmp_path) == []
+
+
+# -- overwrite: the old file goes only when the new one holds a sample -----------------------
+
+def test_overwrite_and_a_stop_before_the_first_sample_keep_the_old_file(tmp_path):
+    """A real-time run at 0.01 Hz has its first sample after 100 s; SIGINT before it.
+
+    (Before: the old file was truncated when the node opened it, then removed.)
+    """
+    target = tmp_path / 'run.mcap'
+    target.write_bytes(OLD)
+    process = roller('-p', 'rate:=0.01', '-p', f'record:={target}', '-p', 'overwrite:=true')
+    err = StderrLines(process)
+    started = err.wait_for('recording to', timeout=20.0)
+    time.sleep(0.3)                      # the node is built; its first tick is 100 s away
+    process.send_signal(signal.SIGINT)
+    code = wait(process)
+    text = err.rest()
+    assert started, text
+    assert code == 0 and 'Traceback' not in text, text
+    assert 'stopped before the first sample: no recording written' in text, text
+    assert target.read_bytes() == OLD
+    assert left_over(tmp_path, 'run.mcap') == []
+
+
+def test_overwrite_replaces_the_old_file_once_a_sample_is_on_disk(tmp_path):
+    """SIGKILL a real-time run: the file under its name is the new recording, readable."""
+    target = tmp_path / 'run.mcap'
+    target.write_bytes(OLD)
+    process = roller('-p', 'rate:=200.0', '-p', f'record:={target}', '-p', 'overwrite:=true')
+    err = StderrLines(process)
+    try:
+        assert err.wait_for('recording to', timeout=20.0), err.rest()
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline and target.read_bytes() == OLD:
+            time.sleep(0.05)
+        time.sleep(1.0)                  # a few chunks more
+    finally:
+        process.kill()
+        process.wait(timeout=10.0)
+        err.rest()
+    recording = read_recording(target, decode=lambda topic: False)
+    assert recording.truncated                   # killed: no summary, but readable
+    assert recording.topics['/pose'].message_count > 0
+    assert left_over(tmp_path, 'run.mcap') == []
+
+
+# -- a second signal during a long start-up --------------------------------------------------
+
+@pytest.mark.slow
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
+@pytest.mark.parametrize('delay', [0.3, 3.0], ids=['during-imports', 'during-tables'])
+def test_a_second_signal_ends_a_long_start_up_at_once(tmp_path, sig, delay):
+    """The tables of SLOW_BODY take many seconds; two signals end the process within 1.5 s.
+
+    At 0.3 s the interpreter is still importing; at 3 s the node is building its tables.
+    (Before: the start-up went on to its end, then the node exited.)
+    """
+    target = tmp_path / 'run.mcap'
+    target.write_bytes(OLD)
+    process = roller(*SLOW_BODY, '-p', 'realtime:=false', '-p', 'duration:=1.0',
+                     '-p', f'record:={target}', '-p', 'overwrite:=true')
+    time.sleep(delay)
+    assert process.poll() is None, 'the start-up was not slow: choose a slower body'
+    process.send_signal(sig)
+    time.sleep(0.05)
+    process.send_signal(sig)
+    second = time.monotonic()
+    code, err = finish(process, timeout=5.0)
+    took = time.monotonic() - second
+    lines = err.strip().splitlines()
+    assert code == 0 and 'Traceback' not in err, err
+    assert took < 1.5, f'{took:.2f} s after the second signal'
+    assert len(lines) == 1 and 'no recording written' in lines[0], err
+    assert target.read_bytes() == OLD
+    assert left_over(tmp_path, 'run.mcap') == []
+
+
+def test_one_signal_during_start_up_still_writes_nothing(tmp_path):
+    """The first signal only sets the flag: start-up ends, the node stops, nothing written."""
+    target = tmp_path / 'run.mcap'
+    process = roller('-p', 'realtime:=false', '-p', 'duration:=1.0', '-p', f'record:={target}')
+    time.sleep(0.2)
+    process.send_signal(signal.SIGTERM)
+    code, err = finish(process)
+    assert code == 0 and 'Traceback' not in err and 'no recording written' in err, err
+    assert os.listdir(tmp_path) == []
+
+
+# -- what the node says ----------------------------------------------------------------------
+
+def _size(text):
+    number, unit = text.split()
+    return float(number) * {'B': 1, 'kB': 1e3, 'MB': 1e6, 'GB': 1e9}[unit]
+
+
+def test_one_line_at_start_and_one_at_the_end(tmp_path):
+    target = tmp_path / 'run.mcap'
+    code, err = finish(roller('-p', 'realtime:=false', '-p', 'duration:=2.0',
+                              '-p', 'friction:=0.01', '-p', f'record:={target}'))
+    lines = [line for line in err.strip().splitlines() if not line.startswith('[ERROR] ')]
+    assert code == 0 and len(lines) == 2, err   # (the ERROR line of the first slip besides)
+    start, end = lines
+    assert start.startswith('[INFO] ') and '[roller]: ' in start, err
+    for words in ('a=0.1 m', 'b=0.1 m', 'delta=0.05 m', 'laminae mass model', 'dynamic mode',
+                  'at 100 Hz', 'batch of 2 s', f'recording to {target}'):
+        assert words in start, (words, start)
+    assert end.startswith('[INFO] ') and '[roller]: ' in end, err
+    recording = read_recording(target, decode=lambda topic: False)
+    samples = recording.topics['/pose'].message_count
+    assert samples == 201
+    assert f'published {samples} samples (2 s of simulated time)' in end, end
+    match = re.search(rf'recorded {re.escape(str(target))} \(([^)]+)\)', end)
+    assert match, end
+    # the size is printed to 3 significant digits: within 0.5 % of the file's
+    assert abs(_size(match.group(1)) - target.stat().st_size) <= 0.005 * target.stat().st_size
+    # friction 0.01 is far below what rolling needs: the first slip is named
+    assert 'outside the rolling model' in end and 'slip' in end, end
+
+
+def test_without_recording_the_lines_say_so():
+    code, err = finish(roller('-p', 'realtime:=false', '-p', 'duration:=0.5'))
+    lines = err.strip().splitlines()
+    assert code == 0 and len(lines) == 2, err
+    assert 'not recording' in lines[0] and 'not recorded' in lines[1], err
+    assert 'published 51 samples' in lines[1], err
