@@ -19,6 +19,7 @@ import difflib
 import re
 
 from .parameters import BY_NAME, ROS_OWN
+from .usage import split_ros_args
 from .params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
 
 __all__ = ['ArgumentError', 'check_arguments', 'node_fqn', 'params_file_values',
@@ -37,15 +38,7 @@ _KIND_WORDS = {float: 'a double', int: 'an integer', bool: 'a bool (true or fals
 
 def _ros_sections(argv):
     """The arguments inside every ``--ros-args ... [--]`` section."""
-    inside, section = False, []
-    for arg in argv:
-        if arg == '--ros-args':
-            inside = True
-        elif arg == '--' and inside:
-            inside = False
-        elif inside:
-            section.append(arg)
-    return section
+    return split_ros_args(argv)[0]
 
 
 def node_fqn(section):

@@ -372,4 +372,8 @@ def parse_value(text, name, where):
     value = documents[0]
     if isinstance(value, list):
         return _list_value(value, name, where)
+    if value.value == '' and not any(isinstance(event, yaml.ScalarEvent) and event.style
+                                     for event in _events(text, where)):
+        # an empty plain scalar (``---``): rcl finds no value there; '' is the empty string
+        raise ArgumentError(f"{where}: no value (write '' for an empty string)")
     return Value(value.value, flat(text.strip()), 0)

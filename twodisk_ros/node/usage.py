@@ -43,29 +43,27 @@ _ROS_FLAGS = ('-p', '--param', '--params-file', '-r', '--remap', '--log-level',
               '--log-config-file', '--log-file-name', '-e', '--enclave')
 
 
-def outside_ros_args(args):
-    """The arguments (program name excluded) outside every ``--ros-args ... [--]`` section."""
-    outside, inside = [], False
+def split_ros_args(args):
+    """(inside, outside): the arguments inside every ``--ros-args ... [--]`` section, and the
+    others, each in order (the markers themselves dropped)."""
+    inside, outside, within = [], [], False
     for arg in args:
         if arg == '--ros-args':
-            inside = True
-        elif arg == '--' and inside:
-            inside = False
-        elif not inside:
-            outside.append(arg)
-    return outside
+            within = True
+        elif arg == '--' and within:
+            within = False
+        else:
+            (inside if within else outside).append(arg)
+    return inside, outside
+
+
+def outside_ros_args(args):
+    """The arguments (program name excluded) outside every ``--ros-args ... [--]`` section."""
+    return split_ros_args(args)[1]
 
 
 def _inside(args):
-    inside, kept = False, []
-    for arg in args:
-        if arg == '--ros-args':
-            inside = True
-        elif arg == '--' and inside:
-            inside = False
-        elif inside:
-            kept.append(arg)
-    return kept
+    return split_ros_args(args)[0]
 
 
 def _shown(text, limit=160):
