@@ -312,7 +312,10 @@ def _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre):
         well = dynamics.tabulated_well(centre)
         if margin < -LIBRATION_MARGIN * scale:
             return LibrationSolution(well, u0 - centre, u_dot0, n)
-        libration = LibrationSolution(well, u0 - centre, u_dot0, min(n, BAND_NODES))
+        try:
+            libration = LibrationSolution(well, u0 - centre, u_dot0, min(n, BAND_NODES))
+        except RuntimeError:     # dt/dφ not positive and finite on the grid: at the barrier
+            return None
         if libration.resolved:
             return libration
     return None
