@@ -115,7 +115,7 @@ def _dimensionless(a, b_over_a, delta_over_a):
 
 
 @settings(max_examples=25, deadline=None)
-@given(exponent=st.floats(math.log10(LENGTH_RANGE[0]) + 2, math.log10(LENGTH_RANGE[1])),
+@given(exponent=st.floats(math.log10(LENGTH_RANGE[0]) + 2, math.log10(LENGTH_RANGE[1]) - 1),
        b_over_a=st.floats(0.3, 3.0), delta_over_a=st.floats(0.05, 0.95))
 def test_results_are_scale_invariant(exponent, b_over_a, delta_over_a):
     # independent reference: the same body at a = 1 m (the geometry has no scale)
