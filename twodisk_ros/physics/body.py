@@ -42,7 +42,14 @@ import numpy as np
 
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 
-__all__ = ['TwoDiskBody', 'PhaseGeometry']
+__all__ = ['LENGTH_RANGE', 'TwoDiskBody', 'PhaseGeometry']
+
+#: Allowed a, b and Δ (m). Every result is scale-invariant (θ_max, z_G / a, S / a, periods
+#: × √(g/a) agree with the unit body's to ≤ 3e-13 from 1e-35 to 1e35 m, tests/
+#: test_extreme_bodies.py), but the closed forms hold a⁴, N³ ~ a⁶ and M a², which overflow
+#: or underflow float64 outside ~[1e-70, 1e70] (geometry) and ~[1e-40, 1e40] (dynamics:
+#: the equilibria were misclassified at 1e-40). The range keeps a margin of 1e5 below both.
+LENGTH_RANGE = (1e-30, 1e30)
 
 
 def _check_parameter(name, value, low, high, rule):
@@ -100,6 +107,12 @@ class TwoDiskBody:
         a = _check_parameter('a', a, 0.0, math.inf, '> 0 (metres)')
         b = _check_parameter('b', b, 0.0, math.inf, '> 0 (metres)')
         delta = _check_parameter('delta', delta, 0.0, a, f'with 0 < delta < a = {a!r} (metres)')
+        low, high = LENGTH_RANGE
+        for name, value in (('a', a), ('b', b), ('delta', delta)):
+            if not low <= value <= high:
+                raise ValueError(f'{name} must be in [{low:g}, {high:g}] m (the closed forms '
+                                 f'hold fourth and sixth powers of the lengths, which leave '
+                                 f'the float range beyond), got {value!r}')
         self.a, self.b, self.delta = a, b, delta
         # Paper, after eq. (2): the range of θ (and ψ), cos θ_max = −a²/√(a⁴ + 4aΔb² + 4Δ²b²),
         # written as atan2 (acos of ≈ −1 would lose digits for thin disks and small Δ).

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from .cycle import TWO_PI
-from .spectral import (refine_grid, spectral_antiderivative, spectral_derivative,
+from .spectral import (STALL, refine_grid, spectral_antiderivative, spectral_derivative,
                        spectral_tail, upsample)
 from .tables import HermiteTable
 
@@ -224,6 +224,10 @@ class LibrationSolution(PhaseSolution):
     #: spectral tail at which u(φ) and t(φ) count as resolved: above the noise plateau of
     #: the tabulated V′ (~1e-13 of its peak), far below any truncation that matters
     TAIL = 1e-11
+    #: tails below this that stop shrinking under doubling are the noise of the tabulated V′
+    #: (~5e-11 for b/a = 0.01, Δ/a = 1e-3, whose 2¹⁸-node tables carry more rounding), not
+    #: missing resolution: refining further cost seconds and changed u(t) by < 1e-12 rad
+    NOISE = 1e-8
     _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(20)
 
     def __init__(self, well, delta0, u_dot0, max_nodes):
@@ -239,11 +243,19 @@ class LibrationSolution(PhaseSolution):
         self._depth = depth = 0.5 * m0 * v0**2 + rise0     # (E − V*) / s², no cancellation
         self._bounds = (well.low / s, well.high / s)
 
+        tails = []
+
         def sample(n):
             x, dx_dphi, dt_dphi = self._samples(n)
-            return max(spectral_tail(dx_dphi), spectral_tail(dt_dphi)), (x, dx_dphi, dt_dphi)
+            tails.append(max(spectral_tail(dx_dphi), spectral_tail(dt_dphi)))
+            return tails[-1], (x, dx_dphi, dt_dphi)
         n, (x, dx_dphi, dt_dphi) = refine_grid(sample, 128, max(128, max_nodes),
-                                           tolerance=self.TAIL)
+                                           tolerance=self.TAIL, floor=self.NOISE)
+        #: the spectral tail of the tables in φ; ``resolved``: below TAIL or at the noise
+        #: floor of the tabulated V′ (False: the grid reached ``max_nodes`` still converging)
+        self.tail = tails[-1]
+        self.resolved = self.tail < self.TAIL or (
+            len(tails) > 1 and self.tail <= self.NOISE and self.tail > STALL * tails[-2])
         x, dx_dphi, dt_dphi = (upsample(f, 4) for f in (x, dx_dphi, dt_dphi))
         n *= 4
         self._x = HermiteTable.periodic(x, dx_dphi, spectral_derivative(dx_dphi))

@@ -1,0 +1,147 @@
+"""Bodies at the corners of the allowed range, and at extreme scales.
+
+* b/a = 0.01, Δ/a → 1 is thin and nearly neutral: V varies by ~2e-8 M g L over a cycle, so
+  every motion lies in the table method's separatrix band (defined in M g L). It used to be
+  DOP853 through the sharp features of m(u) (~50 s of start-up for 0.5 s of motion); the
+  quadrature is resolved there and is now used. Reference: t(u) = ∫ √(m / (2(E − V))) du by
+  scipy's adaptive quad on the closed forms (no table, no solver of the package).
+* b/a = 0.01, Δ/a = 1e-3 librates: the tables in φ stop refining at the noise floor of the
+  tabulated V′ (they were refined to 2¹⁸ nodes for nothing, ~6 s).
+* Scale invariance: θ_max, z_G / a at the equilibria and the advance per cycle S / a do not
+  depend on the scale; outside LENGTH_RANGE a ValueError names the range.
+"""
+
+import math
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from scipy.integrate import quad
+
+from twodisk_ros.physics import RollingCycle, RollingDynamics, TwoDiskBody, equilibria
+from twodisk_ros.physics.body import LENGTH_RANGE
+from twodisk_ros.physics.mass_models import laminae
+from twodisk_ros.physics.motion import MotionStream, simulate_phase
+from twodisk_ros.physics.solvers import LibrationSolution
+from twodisk_ros.physics.startup import NOTICE_SECONDS, startup_estimate
+
+GRAVITY = 9.81
+
+
+def _dynamics(abd):
+    return RollingDynamics(TwoDiskBody(*abd), laminae(*abd, 1.0), GRAVITY)
+
+
+def _start(dyn, theta0=0.3, omega0=3.0):
+    u0 = float(dyn.body.phase_from_theta(theta0, 1))
+    return u0, dyn.initial_phase_rate(u0, omega0)
+
+
+def test_thin_nearly_neutral_body_rolls_in_closed_form():
+    # the node's default start (theta0 0.3, omega0 3) on the body of the issue: a = 0.1,
+    # b = 0.001, delta = 0.0999999 m; E is 3e-6 M g L above max V, 150 × the depth of V
+    abd = (0.1, 0.001, 0.0999999)
+    dyn = _dynamics(abd)
+    u0, u_dot0 = _start(dyn)
+    begin = time.process_time()
+    stream = MotionStream(dyn, u0, u_dot0)            # what the node builds (a 10 s chunk)
+    assert time.process_time() - begin < 5.0          # hang guard: 0.04 s measured, 50 s before
+    assert stream.sample(np.array([0.0]))[0][0] == pytest.approx(u0, abs=1e-15)
+    t = np.linspace(0.0, 0.5, 6)
+    motion = simulate_phase(dyn, t, u0, u_dot0)
+    assert motion.solver == 'quadrature'
+    # independent reference: the time to reach each sampled phase, by adaptive quadrature
+    # of the closed forms (quad's error estimate ≤ 2e-14 s); measured ≤ 1.6e-13 s
+    energy = 0.5 * float(dyn.effective_mass(u0)) * u_dot0**2 + float(dyn.potential(u0))
+
+    def inverse_speed(v):
+        return math.sqrt(float(dyn.effective_mass(v))
+                         / (2 * (energy - float(dyn.potential(v)))))
+    for t_k, u_k in zip(t[1:], motion.phase[1:]):
+        t_ref, _ = quad(inverse_speed, u0, u_k, limit=2000, epsabs=1e-14, epsrel=1e-13)
+        assert abs(t_ref - t_k) <= 1e-11 * t_k        # claim: t(u) to 1e-11 relative
+    assert motion.energy_drift <= 1e-13
+
+
+def test_ordinary_body_near_the_barrier_keeps_dop853():
+    # the band's resolution test does not take the quadrature where it is not resolved:
+    # the Oloid 1e-5 M g L above its barrier (1/|u̇| peaks sharply at the top of V)
+    abd = (0.1, 0.1, 0.05)
+    dyn = _dynamics(abd)
+    top = max(eq.phase for eq, period in dyn.equilibria_with_periods() if period is None)
+    mass = float(dyn.tabulated(top)[0])
+    u_dot0 = math.sqrt(2e-5 * dyn.energy_scale / mass)
+    motion = simulate_phase(dyn, np.linspace(0.0, 0.2, 5), top, u_dot0)
+    assert motion.solver == 'DOP853'
+
+
+def test_thin_body_libration_stops_at_the_noise_floor():
+    abd = (1.0, 0.01, 0.001)
+    dyn = _dynamics(abd)
+    u0, u_dot0 = _start(dyn)
+    t = np.linspace(0.0, 10.0, 401)
+    begin = time.process_time()
+    motion = simulate_phase(dyn, t, u0, u_dot0)
+    assert time.process_time() - begin < 2.0          # hang guard: 0.06 s measured, 6 s before
+    assert motion.solver == 'libration' and motion.sol.resolved
+    # the grid refined to its cap (2¹⁸ nodes, as before) gives the same motion: the extra
+    # nodes only resampled the noise (measured 5.9e-9 rad over 10 s, ~50 cycles of u)
+    full = LibrationSolution(dyn.tabulated_well(motion.sol.centre), u0 - motion.sol.centre,
+                             u_dot0, dyn.table_size)
+    full_phase = full(t)[0]
+    assert np.max(np.abs(motion.phase - full_phase)) <= 2e-8
+
+
+def test_startup_estimate_names_the_costly_bodies():
+    costly = startup_estimate(TwoDiskBody(1.0, 0.01, 0.001))
+    assert costly.resolution == 65536
+    assert costly.seconds > NOTICE_SECONDS
+    assert costly.message.startswith('building tables for an extreme body (b/a = 0.01')
+    assert f'about {costly.seconds:.0f} s' in costly.message
+    assert startup_estimate(TwoDiskBody.oloid(0.1)).message is None
+    # the estimate is the grid the cycle then uses
+    assert RollingCycle(TwoDiskBody(1.0, 0.05, 0.02)).resolution == startup_estimate(
+        TwoDiskBody(1.0, 0.05, 0.02)).resolution
+
+
+# ------------------------------------------------------------------------- scale invariance
+def _dimensionless(a, b_over_a, delta_over_a):
+    body = TwoDiskBody(a, b_over_a * a, delta_over_a * a)
+    found = equilibria(body)
+    cycle = RollingCycle(body)
+    return np.array([body.theta_max] + [eq.height / a for eq in found]
+                    + [eq.phase for eq in found] + [abs(cycle.displacement.shift) / a])
+
+
+@settings(max_examples=25, deadline=None)
+@given(exponent=st.floats(math.log10(LENGTH_RANGE[0]) + 2, math.log10(LENGTH_RANGE[1]) - 1),
+       b_over_a=st.floats(0.3, 3.0), delta_over_a=st.floats(0.05, 0.95))
+def test_results_are_scale_invariant(exponent, b_over_a, delta_over_a):
+    # independent reference: the same body at a = 1 m (the geometry has no scale)
+    reference = _dimensionless(1.0, b_over_a, delta_over_a)
+    scaled = _dimensionless(10.0**exponent, b_over_a, delta_over_a)
+    np.testing.assert_allclose(scaled, reference, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize('a', [LENGTH_RANGE[0] / 0.3, LENGTH_RANGE[1]])
+def test_scale_invariance_at_the_ends_of_the_range(a):
+    # Δ = 0.3 a and b = 0.7 a at the lower end, a itself at the upper end
+    np.testing.assert_allclose(_dimensionless(a, 0.7, 0.3), _dimensionless(1.0, 0.7, 0.3),
+                               rtol=1e-12)
+
+
+@pytest.mark.parametrize('args, name', [
+    ((1e200, 1e200, 5e199), 'a'), ((1e-200, 1e-200, 5e-201), 'a'),
+    ((1.0, 1e31, 0.5), 'b'), ((1.0, 1e-31, 0.5), 'b'), ((1e-29, 1e-29, 1e-31), 'delta')])
+def test_lengths_outside_the_range_are_refused(args, name):
+    with pytest.raises(ValueError, match=rf'^{name} must be in \[1e-30, 1e\+30\] m'):
+        TwoDiskBody(*args)
+
+
+@pytest.mark.parametrize('args', [
+    (math.nan, 1.0, 0.5), (1.0, math.inf, 0.5), (1.0, 1.0, 1.0), (1.0, 1.0, 0.0),
+    (-1.0, 1.0, 0.5), (0.0, 1.0, 0.5), ('1', 1.0, 0.5), (None, 1.0, 0.5), (1.0, 1.0, [0.5])])
+def test_bad_parameters_are_value_errors(args):
+    with pytest.raises(ValueError, match=r'^(a|b|delta) must be '):
+        TwoDiskBody(*args)
