@@ -145,3 +145,23 @@ def test_lengths_outside_the_range_are_refused(args, name):
 def test_bad_parameters_are_value_errors(args):
     with pytest.raises(ValueError, match=r'^(a|b|delta) must be '):
         TwoDiskBody(*args)
+
+
+@pytest.mark.ros
+def test_the_node_says_what_an_extreme_body_costs_before_paying_it():
+    """The costliest allowed body logs its start-up estimate first, then starts and ends."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    repo = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(repo), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+               ROS_DOMAIN_ID='79')
+    result = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'a:=0.1', '-p',
+         'b:=0.001', '-p', 'delta:=0.0001', '-p', 'realtime:=false', '-p', 'duration:=0.05'],
+        env=env, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    lines = result.stderr.splitlines()
+    assert 'building tables for an extreme body (b/a = 0.01, delta/a = 0.001' in lines[0]
+    assert 'rolling a=0.1 m' in lines[1] and 'published 6 samples' in lines[2]

@@ -33,6 +33,8 @@ from ..io.cdr_markers import encode_markers
 from . import messages, run_summary
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
 from .simulation import Simulation
+from ..physics.body import TwoDiskBody
+from ..physics.startup import startup_estimate
 
 __all__ = ['Roller']
 
@@ -94,6 +96,9 @@ class Roller(Node):
         if self.settings.record:   # before any work; never a file the node did not create
             check_output(self.settings.record, overwrite=self.settings.overwrite,
                          suffixes=('.mcap',), option='-p overwrite:=true')
+        cost = startup_estimate(TwoDiskBody(self.settings.a, self.settings.b, self.settings.delta))
+        if cost.message:      # an extreme body: say what the tables cost while it is paid
+            self.get_logger().info(cost.message)
         self.simulation = Simulation(self.settings)
         self._recorder = None
         self._pubs = {topic: self.create_publisher(kind, topic, QOS_DEPTH)
