@@ -65,3 +65,21 @@ def test_readme_blocks_do_not_write_one_output_twice():
                 assert (index, value) not in written, (
                     f'{value} written by {written[(index, value)]!r} and {" ".join(words)!r}')
                 written[(index, value)] = ' '.join(words)
+
+
+def test_parameter_table_into_a_closed_pipe_has_no_traceback():
+    """``python -m twodisk_ros.node.parameters | head -3`` printed a BrokenPipeError
+    traceback (the reader closes the pipe before the table is written)."""
+    import os
+    import subprocess
+    import sys
+    read, write = os.pipe()
+    os.close(read)                # the reader is gone before the table is written
+    try:
+        result = subprocess.run([sys.executable, '-m', 'twodisk_ros.node.parameters'],
+                                stdout=write, stderr=subprocess.PIPE, text=True, timeout=60,
+                                env=dict(os.environ, PYTHONPATH=str(REPO)))
+    finally:
+        os.close(write)
+    assert 'Traceback' not in result.stderr and result.stderr == ''
+    assert result.returncode == 0
