@@ -169,3 +169,22 @@ def test_traces_take_the_palette(figures, tmp_path):
     png = tmp_path / 'x.png'
     plot_inspection(inspection, png)
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def test_drift_scale_is_in_the_label_not_above_the_axis(figures):
+    """The drift (~1e-15) was labelled by matplotlib's '1e-15' above the axis, which ran into
+    the panel's title on the Two-Circle-Roller; the power of ten is now in the y label and
+    each tick label times it is the tick's value."""
+    for name in ('tcr', 'kinematic'):
+        _, figure = figures[name]
+        drift = axes_named(figure, 'drift')
+        assert drift.yaxis.get_offset_text().get_text() == ''
+        label = drift.get_ylabel()
+        exponent = int(label.split('×10$^{')[1].split('}$')[0])
+        assert -17 <= exponent <= -9      # round-off drifts, as the tests above show
+        for tick in drift.yaxis.get_major_ticks():
+            text = tick.label1.get_text().replace('\u2212', '-')
+            if text and drift.get_ylim()[0] <= tick.get_loc() <= drift.get_ylim()[1]:
+                # the label is the tick's value / 10**exponent, to its 6 printed digits
+                assert float(text) * 10.0 ** exponent == pytest.approx(tick.get_loc(),
+                                                                       rel=1e-5, abs=1e-30)

@@ -301,4 +301,9 @@ if __name__ == '__main__':
         prog='python -m twodisk_ros.node.parameters',
         description="Print the roller node's parameter table (Markdown, as in the README)."
     ).parse_args()
-    print(markdown_table())   # the README's table
+    import os
+    import sys
+    try:
+        print(markdown_table(), flush=True)   # the README's table
+    except BrokenPipeError:   # `| head`: the reader left; no traceback (Python docs' recipe)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -178,15 +178,15 @@ def _drift_panel(drift, inspection):
     for t, values, label, style in found['curves']:
         drift.plot(t, values, label=label, **style)
     drift.set_title(found['title'])
-    drift.set_ylabel(found['ylabel'])
+    _power_in_label(drift, found['ylabel'])
     drift.set_xlabel('t (s)')
-    drift.ticklabel_format(axis='y', style='sci', scilimits=(-3, 3), useOffset=False)
     check = next((c for c in inspection.checks if c.name == found['check']), None)
-    note = None
+    note = None   # the legend's title: the FD check quoted, then what L or |ω₀| is
     if check is not None and check.value is not None:
         tolerance = '' if check.tolerance is None else f' (tolerance {check.tolerance:.2g})'
         note = (f'the check from the poses alone (central differences) is FD-limited:\n'
                 f'max {found["symbol"]} = {check.value:.2g}{tolerance}')
+    note = found['definition'] if note is None else f'{note}\n{found["definition"]}'
     drift.legend(title=note, loc='upper center', bbox_to_anchor=(0.5, 0.0), ncol=1,
                  borderaxespad=BELOW, fontsize='small', title_fontsize='small', frameon=False)
 
@@ -204,7 +204,7 @@ def invariant_drift(inspection):
     -------
     dict or None
         ``curves``: list of (t in s, values, label, line style); ``title``, ``ylabel``,
-        ``symbol``; ``check``: the name of the inspector's FD check of the same invariant.
+        ``symbol``, ``definition`` (of the scale in the label, e.g. L); ``check``: the name of the inspector's FD check of the same invariant.
     """
     data = inspection.series
     params = inspection.summary.get('parameters') or {}
@@ -223,10 +223,10 @@ def invariant_drift(inspection):
                        'E reported in /diagnostics', dict(ls='none', marker='s', ms=3,
                                                             color='tab:red')))
     size = _body_size(params, data)
-    unit = f'L = {size:.4g} m = body size' if size else 'L = body size'
+    unit = f'L = {size:.4g} m: the body size' if size else 'L: the body size'
     return {'curves': curves, 'title': 'energy drift of the recorded state',
-            'ylabel': f'(E − E₀) / (M g L),  {unit}', 'symbol': '|E − E₀| / (M g L)',
-            'check': 'energy'}
+            'ylabel': '(E − E₀) / (M g L)', 'symbol': '|E − E₀| / (M g L)',
+            'definition': unit, 'check': 'energy'}
 
 
 def _speed_drift(inspection, params):
@@ -244,8 +244,8 @@ def _speed_drift(inspection, params):
                         '|ω| = |u̇| |ω_u(u)| at the recorded rolling_state',
                         dict(color='tab:purple', lw=1.0))],
             'title': 'drift of |ω| (the invariant of kinematic mode)',
-            'ylabel': '(|ω| − |ω₀|) / |ω₀|,  |ω₀| = |omega0|',
-            'symbol': '||ω| − |ω₀|| / |ω₀|', 'check': 'angular_speed'}
+            'ylabel': '(|ω| − |ω₀|) / |ω₀|', 'symbol': '||ω| − |ω₀|| / |ω₀|',
+            'definition': f'|ω₀| = |omega0| = {target:.4g} rad/s', 'check': 'angular_speed'}
 
 
 def _recorded_state(inspection):
@@ -386,6 +386,27 @@ def _shade(axes, stretches, data):
 def _plain_ticks(axes):
     """Plain tick labels on y: no offset such as '1e-13+7.07e-2' above the axis."""
     axes.ticklabel_format(axis='y', useOffset=False, style='plain')
+
+
+def _power_in_label(axes, label):
+    """y tick labels as plain numbers, their power of ten in the axis label ``label``.
+
+    Matplotlib's own scientific format writes it as '1e-15' above the axis, where it runs
+    into the panel's title; here the label reads ``... [×10⁻¹⁵]`` (tick value × 10⁻¹⁵ = the
+    quantity). Values within 1e-3 … 1e4 keep plain ticks and the bare label.
+    """
+    from matplotlib.ticker import FuncFormatter
+    low, high = axes.get_ylim()
+    peak = max(abs(low), abs(high))
+    exponent = math.floor(math.log10(peak)) if math.isfinite(peak) and peak > 0 else 0
+    if -3 <= exponent <= 3:
+        _plain_ticks(axes)
+        axes.set_ylabel(label)
+        return
+    scale = 10.0 ** exponent
+    axes.yaxis.set_major_formatter(FuncFormatter(
+        lambda value, _: f'{value / scale:.6g}'.replace('-', '\u2212')))
+    axes.set_ylabel(f'{label}  [×10$^{{{exponent}}}$]')
 
 
 def _number(value):
