@@ -371,3 +371,23 @@ def test_any_parameters_give_a_valid_lamina_or_one_line(kind, a, b, c):
     n = lamina.normal(s)
     support = lamina.support(n)
     assert np.max(np.abs(lamina.point(support.parameter) - support.point)) <= 1e-12 * size
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(count=st.integers(0, 40), scale=st.floats(1e-3, 1e3), wobble=st.floats(0, 0.2),
+       seed=st.integers(0, 2**32 - 1), shuffle=st.booleans())
+def test_any_points_give_an_outline_or_one_line(count, scale, wobble, seed, shuffle):
+    # points on an ellipse, disturbed radially and perhaps shuffled
+    rng = np.random.default_rng(seed)
+    s = np.sort(rng.uniform(0, 2 * np.pi, count))
+    p = Ellipse(scale, 0.7 * scale).point(s) * (1 + wobble * rng.uniform(-1, 1, count))[:, None]
+    if shuffle:
+        rng.shuffle(p)
+    try:
+        outline = Outline.from_points(p)
+    except ValueError as error:
+        assert str(error) and '\n' not in str(error)
+        return
+    # accepted: the promise holds (fit error within the tolerance, strictly convex)
+    assert outline.fit_error <= 1e-3 * outline.size * 1.01
+    assert np.min(outline.radius_of_curvature(np.linspace(0, np.pi, 1001))) > 0

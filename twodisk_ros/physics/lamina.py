@@ -391,7 +391,8 @@ class Egg(SupportLamina):
         try:
             eps = float(epsilon)
         except (TypeError, ValueError):
-            raise ValueError(f'epsilon must be a real number with {rule}, got {epsilon!r}') from None
+            raise ValueError(f'epsilon must be a real number with {rule}, '
+                             f'got {epsilon!r}') from None
         if not (math.isfinite(eps) and abs(eps) < limit):
             raise ValueError(f'epsilon must be finite with {rule}, got {epsilon!r}')
         self.epsilon = eps

@@ -136,7 +136,8 @@ class Outline(SupportLamina):
         if least > tol and loose is not None and (loose[1] <= tol or loose[1] < least / 2):
             j = int(np.argmin(loose[5]))
             raise ValueError(f'points are not strictly convex: the best convex fit misses them by '
-                             f'{least:.3g} m (tolerance {tol:.3g} m), a closer one has h + h\'\' <= 0 '
+                             f'{least:.3g} m (tolerance {tol:.3g} m), a closer one has '
+                             'h + h\'\' <= 0 '
                              f'near {_where(loose[6][j])} (axis at x = 0): a flat piece or '
                              'a corner')
         if not fits:
