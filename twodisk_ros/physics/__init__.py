@@ -8,6 +8,10 @@ Modules, from geometry to motion (docs/physics.md derives each):
 - :mod:`~twodisk_ros.physics.mass_models` (with :mod:`~twodisk_ros.physics.hull`): inertia;
 - :mod:`~twodisk_ros.physics.dynamics`: the equation of motion in u;
 - :mod:`~twodisk_ros.physics.solvers`, :mod:`~twodisk_ros.physics.motion`: u(t);
+- :mod:`~twodisk_ros.physics.startup`: what a body's tables will cost, before paying it;
+- :mod:`~twodisk_ros.physics.lamina` (with :mod:`~twodisk_ros.physics.lamina_fit`): laminae
+  of any symmetric convex shape (ellipse, superellipse, egg, a fitted outline): the
+  foundation of general bodies, not yet used by the body, cycle or node;
 - :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
   :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
 """
