@@ -11,7 +11,8 @@ Modules, from geometry to motion (docs/physics.md derives each):
 - :mod:`~twodisk_ros.physics.startup`: what a body's tables will cost, before paying it;
 - :mod:`~twodisk_ros.physics.lamina` (with :mod:`~twodisk_ros.physics.lamina_fit`): laminae
   of any symmetric convex shape (ellipse, superellipse, egg, a fitted outline): the
-  foundation of general bodies, not yet used by the body, cycle or node;
+  foundation of general bodies, with :mod:`~twodisk_ros.physics.general_body` (their
+  contact geometry from the support function); not yet used by the cycle, dynamics or node;
 - :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
   :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
 """
