@@ -8,13 +8,16 @@ offline on any machine.
 """
 
 import contextlib
+import errno
 import io
 import os
+import stat
 from dataclasses import dataclass, field
 from typing import Any
 
 from mcap_ros2.decoder import DecoderFactory
 
+from ..limits import describe_bytes, memory_limit
 from .errors import RecordingError, os_error_reason
 from .mcap_scan import MAGIC, reason_of, scan_mcap
 
@@ -150,8 +153,7 @@ def read_recording(path, *, decode=None) -> Recording:
     """
     path = os.fspath(path)
     try:
-        with open(path, 'rb') as stream:
-            data = stream.read()
+        data = _read_regular_file(path)
     except OSError as error:
         reason = os_error_reason(path, error, writing=False)
         raise RecordingError(f'cannot read recording {path}: {reason}') from None
@@ -169,6 +171,30 @@ def read_recording(path, *, decode=None) -> Recording:
         recording.metadata[record.name] = dict(record.metadata)
     _decode(scan, recording, decode)
     return recording
+
+
+def _read_regular_file(path):
+    """The bytes of ``path``; RecordingError if it is not a regular file or cannot fit.
+
+    Opened without blocking (a FIFO nobody writes to would block ``open`` forever) and
+    checked on the open descriptor: a FIFO, a device (``/dev/zero`` never ends) or a socket
+    is refused before anything is read, as is a file larger than the memory a command may
+    use (:func:`twodisk_ros.limits.memory_limit`).
+    """
+    fd = os.open(path, os.O_RDONLY | getattr(os, 'O_NONBLOCK', 0))
+    with open(fd, 'rb') as stream:
+        info = os.fstat(fd)
+        if stat.S_ISDIR(info.st_mode):
+            raise IsADirectoryError(errno.EISDIR, 'it is a directory')
+        if not stat.S_ISREG(info.st_mode):
+            raise RecordingError(f'cannot read recording {path}: not a regular file (a FIFO, '
+                                 'a device or a socket is not read)')
+        limit, reason = memory_limit()
+        if info.st_size > limit:
+            raise RecordingError(f'cannot read recording {path}: {describe_bytes(info.st_size)}'
+                                 f', more than the {describe_bytes(limit)} it may use ({reason})')
+        os.set_blocking(fd, True)
+        return stream.read()
 
 
 def _decode(scan, recording, decode):

@@ -29,14 +29,17 @@ import sys
 import tempfile
 
 from ..outputs import OutputError, check_output, check_output_dir
-from .request import (DEFAULT_CHUNK_SIZE, SweepError, check_size, check_some_valid, grid_range,
-                      linspace_grid)
+from .request import (DEFAULT_CHUNK_SIZE, MAX_BODIES, SweepError, check_size, check_some_valid,
+                      grid_range, linspace_grid)
 
 __all__ = ['main', 'PROG', 'MAX_WORKERS_PER_CORE']
 
 PROG = 'twodisk-sweep'
 #: A local cluster has at most this many worker processes per core of the machine.
 MAX_WORKERS_PER_CORE = 4
+#: Largest --reference-speed, in sqrt(g/a) (far beyond rolling speeds; its square stays finite
+#: in every force of the map).
+MAX_REFERENCE_SPEED = 1000.0
 
 
 class _Parser(argparse.ArgumentParser):
@@ -134,10 +137,14 @@ def _checked(args):
     b = _grid_range('--b-over-a', args.b_over_a)
     d = _grid_range('--delta-over-a', args.delta_over_a)
     speed = _number('--reference-speed', args.reference_speed)
-    if not (speed >= 0 and speed != float('inf')):
-        raise _Usage(f'--reference-speed must be finite and >= 0, got {args.reference_speed!r}')
+    if not 0 <= speed <= MAX_REFERENCE_SPEED:
+        raise _Usage(f'--reference-speed must be finite, 0 <= W <= {MAX_REFERENCE_SPEED:g}, '
+                     f'got {args.reference_speed!r}')
     chunk = (DEFAULT_CHUNK_SIZE if args.chunk_size is None
              else _integer('--chunk-size', args.chunk_size))
+    if chunk > MAX_BODIES:
+        raise _Usage(f'--chunk-size must be an integer from 1 to {MAX_BODIES} (the most '
+                     f'bodies of a sweep), got {args.chunk_size!r}')
     check_size(b[2], d[2], chunk)
     check_some_valid(d[0])
     if os.path.isdir(args.out):       # said first: the suffix is not the problem then

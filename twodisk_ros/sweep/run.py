@@ -120,6 +120,18 @@ class SweepRun:
     chunk_cpu_seconds: list = field(default_factory=list)   #: worker CPU time per chunk (s)
 
 
+def _check_address(address):
+    """SweepError (one line) for an address Dask cannot parse, before a Client exists: a
+    Client that fails on it leaves a half-built object whose finalizer waits 10 s and prints
+    a traceback at exit."""
+    from distributed.comm.addressing import get_address_host_port
+    try:
+        get_address_host_port(address)
+    except ValueError as error:
+        raise SweepError(f'scheduler address {address!r} is not valid ({error}); allowed: '
+                         'tcp://HOST:PORT, tls://HOST:PORT or HOST:PORT') from None
+
+
 @contextmanager
 def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
     """A ``distributed.Client``: to ``scheduler``, to Dask's configured address, or local.
@@ -147,6 +159,7 @@ def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
     cluster = None
     try:
         if address:
+            _check_address(address)
             try:
                 client = Client(address, timeout=f'{timeout}s', set_as_default=False)
             except (OSError, TimeoutError, ValueError) as error:
