@@ -65,7 +65,7 @@ def _start(argv, stop):
 
 
 def _run(node, stop):
-    stop.forbid_abort()    # samples are being recorded: a second signal changes nothing
+    stop.forbid_abort()    # samples are being recorded: a signal ends the run at a sample
     if not node.settings.realtime:
         node.run_batch(keep_going=lambda: not stop)
     else:
@@ -89,7 +89,7 @@ def main(args=None, stop=None):
     argv = list(sys.argv if args is None else args)
     stop = stop if stop is not None else StopRequest()
     try:
-        stop.allow_abort()   # start-up: a second signal ends the process at once
+        stop.allow_abort()   # start-up: a signal ends the process at once
         status = early_exit(argv)   # --help, --version, arguments outside --ros-args
         return status if status is not None else _main(argv, stop)
     except StopNow:

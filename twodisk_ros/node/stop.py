@@ -20,11 +20,12 @@ class StopNow(BaseException):
 class StopRequest:
     """SIGINT and SIGTERM set a flag; the loops end at a sample boundary.
 
-    During start-up a *second* signal ends the process at once (nothing has been recorded
-    then): while the entry point still imports (before :meth:`allow_abort`) by exiting 0
-    on the spot, nothing having been created yet; from :meth:`allow_abort` to
-    :meth:`forbid_abort` (table building can take seconds) by raising :class:`StopNow` in
-    the main thread, which ``main`` catches after discarding what was built. Later a
+    During start-up a signal ends the process at once (nothing has been recorded then):
+    while the entry point still imports (before :meth:`allow_abort`) the first one sets the
+    flag, which ``main`` checks before any work, and a second exits 0 on the spot, nothing
+    having been created yet; from :meth:`allow_abort` to :meth:`forbid_abort` (table
+    building can take seconds) the first one raises :class:`StopNow` in the main thread,
+    which ``main`` catches after discarding what was built. Later a
     repeated signal changes nothing: the run still ends cleanly and the recording is
     finished. SIGXFSZ (a file-size limit) is ignored so that writing past the limit is an
     I/O error the recorder reports, not a killed process.
@@ -45,6 +46,12 @@ class StopRequest:
 
     def _handle(self, signum, frame):
         name = signal.Signals(signum).name
+        if self.abortable:
+            # start-up work (tables can take seconds): nothing is recorded yet, so even the
+            # first signal ends it at once
+            self.requested = self.requested or name
+            self.abortable = False      # one StopNow only: the clean-up is not cut short
+            raise StopNow(name)
         if self.requested is None:
             self.requested = name
         elif self.importing:
@@ -54,15 +61,12 @@ class StopRequest:
             os.write(2, f'roller: stopped by {self.requested} during start-up: no recording '
                         'written\n'.encode())
             raise SystemExit(0)
-        elif self.abortable:
-            self.abortable = False      # one StopNow only: the clean-up is not cut short
-            raise StopNow(name)
 
     def __bool__(self):
         return self.requested is not None
 
     def allow_abort(self):
-        """From now on a second signal raises :class:`StopNow` (start-up work)."""
+        """From now on a signal raises :class:`StopNow` (start-up work)."""
         self.importing = False
         self.abortable = True
 
