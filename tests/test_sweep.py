@@ -361,17 +361,38 @@ def test_unreachable_scheduler_exit_2_fast(tmp_path):
     assert not (tmp_path / 'x.nc.parts').exists()
 
 
+#: The sweep's command line (cli.main, as ``python -m twodisk_ros.sweep`` runs it) with its
+#: client paused for good after saving chunk K (argv[1]): the test's SIGINT then always
+#: arrives mid-sweep, however fast the chunks are (no race with the sweep's end).
+_PAUSED_CLI = """
+import sys, time
+import twodisk_ros.sweep.run as run
+real, pause_after = run.run_sweep, int(sys.argv[1])
+def paused(*args, **kwargs):
+    def on_chunk(index, computed):
+        if computed == pause_after:
+            time.sleep(120)          # the SIGINT arrives here; 120 s: the test times out first
+    return real(*args, on_chunk=on_chunk, **kwargs)
+run.run_sweep = paused
+from twodisk_ros.sweep.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
 @pytest.mark.slow
 def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
     out = tmp_path / 'map.nc'
-    cmd = [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', *B_GRID, '--delta-over-a',
-           *D_GRID, '--out', str(out), '--chunk-size', '1', '--workers', '1', '--quiet']
+    args = ['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out),
+            '--chunk-size', '1', '--workers', '1', '--quiet']
+    saved_before_signal = 2
     parts = parts_folder(out)
-    proc = subprocess.Popen(cmd, env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen([sys.executable, '-c', _PAUSED_CLI, str(saved_before_signal), *args],
+                            env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 60
-        while len(list(parts.glob('chunk-*.npz'))) < 2 and proc.poll() is None \
-                and time.monotonic() < deadline:
+        while len(list(parts.glob('chunk-*.npz'))) < saved_before_signal:
+            assert proc.poll() is None, proc.communicate()[1]
+            assert time.monotonic() < deadline, 'the first chunks never appeared'
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
         err = proc.communicate(timeout=60)[1]
@@ -379,15 +400,15 @@ def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
         if proc.poll() is None:
             proc.kill()
             proc.wait(timeout=10)
-    saved = len(list(parts.glob('chunk-*.npz')))
-    if proc.returncode == 0:
-        pytest.skip('the sweep finished before the signal arrived')
     assert proc.returncode == 130, err
     assert 'interrupted' in err and 'Traceback' not in err
-    assert saved >= 2 and not out.exists()
-    again = subprocess.run(cmd, env=ENV, cwd=tmp_path, capture_output=True, text=True,
-                           timeout=120)
+    assert len(err.strip().splitlines()) == 1, err
+    # the client was paused after saving exactly that many chunks: no more, no fewer
+    assert len(list(parts.glob('chunk-*.npz'))) == saved_before_signal and not out.exists()
+    again = subprocess.run([sys.executable, '-m', 'twodisk_ros.sweep', *args], env=ENV,
+                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
     total = len(_spec().b_over_a) * len(_spec().delta_over_a)
-    assert f'{total - saved} chunks computed, {saved} resumed' in again.stderr
+    assert (f'{total - saved_before_signal} chunks computed, {saved_before_signal} resumed'
+            in again.stderr)
     _same(read_netcdf(out), local)
