@@ -34,7 +34,10 @@ from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client, ru
 from twodisk_ros.sweep.worker import SweepWorkerSetup
 
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
-RATE_GRID = (16, 12)       # bodies timed serially (by stage) and on 1 and 2 workers
+STAGE_GRID = (16, 12)      # bodies timed serially by stage
+RATE_GRID = (24, 16)       # bodies timed serially and on 1 and 2 workers: 24 chunks of 16,
+                           # so the 2-worker run's tail (one worker idle while the other
+                           # ends its last chunk) stays a few % of its wall time
 EMPTY_TASKS = 400
 REPEATS = 3                # rounds of serial / 1 worker / 2 workers (medians)
 
@@ -52,7 +55,7 @@ def _noop(x):
 
 
 def stage_costs():
-    b, d = _grid(RATE_GRID)
+    b, d = _grid(STAGE_GRID)
     timings = {}
     start, cpu = time.perf_counter(), time.process_time()
     for bi in b:
