@@ -3,12 +3,18 @@
 Measured on one representative map, b/a ∈ [0.2, 3], Δ/a ∈ [0.05, 0.95] (no masked point):
 
 1. the cost per body split by quantity (stage), serial, in this process (no Dask);
-2. the scheduling overhead per task (empty tasks on a 2-worker LocalCluster) and the client's
+2. the rate inside a Dask worker against the serial rate, and 2 workers against 1, side by
+   side in one run, before (a bare worker, as Dask's nanny starts it) and after the sweep's
+   worker set-up (:class:`~twodisk_ros.sweep.worker.SweepWorkerSetup`, which ``run_sweep``
+   registers); ``REPEATS`` rounds, each measuring serial, 1 and 2 workers in turn, medians
+   reported. "Inside a worker" is the tasks' own wall time (sum over chunks), so the
+   scheduler is left out; "N workers" is the wall time from the first submission to the last
+   result. CPU/wall below 1 means other jobs took the cores (contention, not Dask): the
+   ratios are also given in CPU time per body, which contention disturbs far less;
+3. the scheduling overhead per task (empty tasks on a 2-worker LocalCluster) and the client's
    cost per finished chunk (saving it to the resume cache);
-3. bodies per second with 1 and 2 worker processes (start-up excluded and reported apart:
-   the cluster and the workers' first import of the physics), and the parallel efficiency rate(2) / (2 rate(1));
-   (CPU/wall in the tasks below 1 means other jobs took the cores: contention, not Dask);
-4. the wall time of a 100 × 100 map, extrapolated from the measured 2-worker rate;
+4. an end-to-end ``run_sweep`` (resume cache, NetCDF file) on 2 workers, and the wall time of
+   a 100 × 100 map extrapolated from it;
 5. a projection for a 1000 × 1000 map on N workers (model printed with the numbers).
 
 Run: ``python benchmarks/sweep_rate.py`` (PYTHONPATH = the repository). Every cluster
@@ -23,12 +29,17 @@ import time
 import numpy as np
 
 from twodisk_ros.sweep.parts import PartsCache
-from twodisk_ros.sweep.quantities import STAGES, body_quantities, chunk_quantities
+from twodisk_ros.sweep.quantities import STAGES, body_quantities, chunk_quantities, timed_chunk
 from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client, run_sweep
+from twodisk_ros.sweep.worker import SweepWorkerSetup
 
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
-RATE_GRID = (16, 12)       # bodies timed serially (by stage) and on 1 and 2 workers
+STAGE_GRID = (16, 12)      # bodies timed serially by stage
+RATE_GRID = (24, 16)       # bodies timed serially and on 1 and 2 workers: 24 chunks of 16,
+                           # so the 2-worker run's tail (one worker idle while the other
+                           # ends its last chunk) stays a few % of its wall time
 EMPTY_TASKS = 400
+REPEATS = 3                # rounds of serial / 1 worker / 2 workers (medians)
 
 
 def _grid(shape):
@@ -44,7 +55,7 @@ def _noop(x):
 
 
 def stage_costs():
-    b, d = _grid(RATE_GRID)
+    b, d = _grid(STAGE_GRID)
     timings = {}
     start, cpu = time.perf_counter(), time.process_time()
     for bi in b:
@@ -73,18 +84,101 @@ def client_cost_per_chunk():
         return (time.perf_counter() - start) / 50
 
 
-def rate(workers):
-    b, d = _grid(RATE_GRID)
-    spec = SweepSpec(b, d)
+def _timed_tasks(client, spec):
+    """Submit every chunk of ``spec`` as a bare task; (wall, Σ task wall, Σ task CPU) in s."""
+    b, d = spec.points()
+    start = time.perf_counter()
+    futures = [client.submit(timed_chunk, b[part], d[part], pure=False)
+               for part in spec.chunks()]
+    results = client.gather(futures)
+    wall = time.perf_counter() - start
+    return wall, sum(r[1] for r in results), sum(r[2] for r in results)
+
+
+def serial_rate():
+    """(wall, CPU) per body (s) of the chunks of the rate grid, in this process."""
+    spec = SweepSpec(*_grid(RATE_GRID))
+    b, d = spec.points()
+    start, cpu = time.perf_counter(), time.process_time()
+    for part in spec.chunks():
+        chunk_quantities(b[part], d[part])
+    return (time.perf_counter() - start) / spec.size, (time.process_time() - cpu) / spec.size
+
+
+def worker_rates(workers):
+    """{'before'|'after': (wall per body, task wall per body, task CPU per body)} (s).
+
+    One LocalCluster: bare workers first (Dask's defaults), then the same tasks after
+    registering the sweep's worker plugin, exactly as ``run_sweep`` does.
+    """
+    spec = SweepSpec(*_grid(RATE_GRID))
+    found = {}
+    with dask_client(workers=workers) as client:
+        client.wait_for_workers(workers)
+        client.run(_import_physics)
+        warm = SweepSpec(*_grid((1, 2 * workers)), chunk_size=1)
+        for label in ('before', 'after'):
+            if label == 'after':
+                client.register_plugin(SweepWorkerSetup())
+            _timed_tasks(client, warm)          # first calls (caches, lazy imports) apart
+            found[label] = tuple(x / spec.size for x in _timed_tasks(client, spec))
+    return found
+
+
+def end_to_end(workers=2):
+    """run_sweep with a NetCDF file on a fresh cluster: (SweepRun, start-up s, overhead s)."""
+    import twodisk_ros.sweep.dataset  # noqa: F401  (xarray's import is not the sweep's work)
+    spec = SweepSpec(*_grid(RATE_GRID))
     start = time.perf_counter()
     with dask_client(workers=workers) as client:
         client.wait_for_workers(workers)
         client.run(_import_physics)
         startup = time.perf_counter() - start
-        overhead = task_overhead(client) if workers == 2 else math.nan
+        overhead = task_overhead(client)
         with tempfile.TemporaryDirectory() as folder:
             run = run_sweep(spec, client, out=folder + '/map.nc', progress=None)
-    return spec.size / run.seconds, run.seconds, startup, overhead, run
+    return run, startup, overhead
+
+
+def _median(rows, index):
+    return float(np.median([row[index] for row in rows]))
+
+
+def rate_table():
+    """Serial, 1 and 2 workers before/after the worker set-up, REPEATS rounds; prints medians.
+
+    Returns the median per-body costs {key: (wall, task wall, task CPU)} (s), with key
+    'serial' (wall, wall, CPU) and (workers, 'before'|'after').
+    """
+    rounds = {}
+    loads = [os.getloadavg()[0]]
+    for _ in range(REPEATS):
+        wall, cpu = serial_rate()
+        rounds.setdefault('serial', []).append((wall, wall, cpu))
+        for workers in (1, 2):
+            for label, costs in worker_rates(workers).items():
+                rounds.setdefault((workers, label), []).append(costs)
+        loads.append(os.getloadavg()[0])
+    med = {key: tuple(_median(rows, i) for i in range(3)) for key, rows in rounds.items()}
+    n = RATE_GRID[0] * RATE_GRID[1]
+    print(f'rates, {n} bodies in chunks of {DEFAULT_CHUNK_SIZE}, medians of {REPEATS} rounds '
+          f'(load average {", ".join(f"{x:.2f}" for x in loads)} over the rounds):')
+    serial_wall, _, serial_cpu = med['serial']
+    print(f'  serial (this process, no Dask): {1e3 * serial_wall:.1f} ms/body wall, '
+          f'{1e3 * serial_cpu:.1f} ms/body CPU')
+    for label, text in (('before', 'bare Dask workers (before)'),
+                        ('after', 'with SweepWorkerSetup (after)')):
+        one, two = med[(1, label)], med[(2, label)]
+        print(f'  {text}:')
+        for workers, (wall, task, cpu) in ((1, one), (2, two)):
+            print(f'    {workers} worker(s): {1 / wall:6.2f} bodies/s; inside a worker '
+                  f'{1e3 * task:.1f} ms/body wall, {1e3 * cpu:.1f} ms/body CPU '
+                  f'(CPU/wall {cpu / task:.2f})')
+        print(f'    rate inside a worker / serial rate: {serial_wall / one[1]:.2f} (wall), '
+              f'{serial_cpu / one[2]:.2f} (CPU)   [target >= 0.90]')
+        print(f'    2 workers / 1 worker: {one[0] / two[0]:.2f} (wall rate)   '
+              f'[target >= 1.80; needs 2 idle cores]')
+    return med
 
 
 def main():
@@ -94,30 +188,25 @@ def main():
     print(f'  total {1e3 * per_body:.1f} ms per body (wall; CPU/wall {share:.2f})')
     for stage, seconds in stages.items():
         print(f'  {stage:16s} {1e3 * seconds:7.2f} ms  ({100 * seconds / per_body:4.1f} %)')
+    med = rate_table()
     save = client_cost_per_chunk()
     print(f'client: saving one {DEFAULT_CHUNK_SIZE}-body chunk to the resume cache: '
           f'{1e3 * save:.2f} ms')
-    results = {}
-    for workers in (1, 2):
-        results[workers] = rate(workers)
-        r, seconds, startup, _, run = results[workers]
-        print(f'{workers} worker(s): {r:.2f} bodies/s ({RATE_GRID[0]}x{RATE_GRID[1]} = '
-              f'{RATE_GRID[0] * RATE_GRID[1]} bodies in {seconds:.2f} s, chunks of '
-              f'{DEFAULT_CHUNK_SIZE}: median task {np.median(run.chunk_seconds):.2f} s, '
-              f'CPU/wall in the tasks {sum(run.chunk_cpu_seconds) / sum(run.chunk_seconds):.2f}'
-              f'); cluster start-up {startup:.2f} s')
-    overhead = results[2][3]
-    efficiency = results[2][0] / (2 * results[1][0])
-    print(f'parallel efficiency with 2 workers: {efficiency:.2f} (rate(2) / (2 rate(1))); '
-          f'1 worker against serial without Dask: {results[1][0] * per_body:.2f}')
+    run, startup, overhead = end_to_end(2)
+    rate2 = run.dataset['b_over_a'].size * run.dataset['delta_over_a'].size / run.seconds
+    print(f'end to end, run_sweep on 2 workers with the resume cache and the NetCDF file: '
+          f'{rate2:.2f} bodies/s ({run.seconds:.2f} s; median task '
+          f'{np.median(run.chunk_seconds):.2f} s, CPU/wall in the tasks '
+          f'{sum(run.chunk_cpu_seconds) / sum(run.chunk_seconds):.2f}); cluster start-up '
+          f'{startup:.2f} s')
     print(f'scheduler round trip of an empty task (2 workers): {1e3 * overhead:.2f} ms')
-    map_100 = 100 * 100 / results[2][0]
+    map_100 = 100 * 100 / rate2
     print(f'100 x 100 map on 2 workers: ~{map_100:.0f} s ({map_100 / 60:.1f} min), '
-          f'extrapolated from the measured 2-worker rate (+ {results[2][2]:.1f} s start-up)')
-    # Projection: each worker spends c per body (from the 1-worker run, which includes the
-    # per-task overhead) on B / N bodies; the client handles every chunk serially (save +
-    # round trip), which bounds the rate from below whatever N is.
-    c = 1.0 / results[1][0]
+          f'extrapolated from the end-to-end 2-worker rate (+ {startup:.1f} s start-up)')
+    # Projection: each worker spends c per body (the 1-worker wall cost with the worker
+    # set-up, which includes the per-task overhead) on B / N bodies; the client handles every
+    # chunk serially (save + round trip), which bounds the rate from below whatever N is.
+    c = med[(1, 'after')][0]
     bodies = 1000 * 1000
     chunks = math.ceil(bodies / DEFAULT_CHUNK_SIZE)
     client_floor = chunks * (save + overhead)
