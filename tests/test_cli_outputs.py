@@ -184,9 +184,10 @@ def test_sweep_runaway_grid_refused_with_what_it_needs(tmp_path, grid, words):
 
 @pytest.mark.slow
 def test_sweep_without_any_computable_body_is_an_error(tmp_path):
-    # b/a = 1e300 passes the checks, but building the body overflows: every point is masked
-    result, _ = _run(SWEEP, '--b-over-a', '1e300', '1e300', '1', '--delta-over-a', '0.5',
-                     '0.5', '1', '--out', tmp_path / 'x.nc', '--workers', '1', '--quiet',
+    # Delta/a = 1e-300 passes the command-line checks, but the body refuses a length below
+    # its range (1e-30 m at a = 1): every point is masked
+    result, _ = _run(SWEEP, '--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300',
+                     '1e-300', '1', '--out', tmp_path / 'x.nc', '--workers', '1', '--quiet',
                      cwd=tmp_path, timeout=120)
     _one_line_exit_2(result, 'no body of the grid could be computed', 'nothing written')
     assert _listing(tmp_path) == []       # no file, no resume cache

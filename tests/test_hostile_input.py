@@ -4,6 +4,7 @@ traceback, no hang (subprocess timeouts), nothing of the user's destroyed."""
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -152,3 +153,18 @@ def test_record_through_a_symlink_to_a_fifo_is_refused_and_kept(fifo, tmp_path):
             'duration:=0.05', '-p', f'record:={link}', '-p', 'overwrite:=true', cwd=tmp_path,
             says='is a FIFO')
     assert link.is_symlink() and fifo.is_fifo()
+
+
+@pytest.mark.parametrize('b_range', [('0.001', '3'), ('0.2', '300')])
+def test_sweep_refuses_shapes_outside_the_stated_range(tmp_path, b_range):
+    """b/a beyond [0.01, 100] (the node's range) is refused before any work (9 such bodies
+    took 100 s before)."""
+    start = time.monotonic()
+    result = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', *b_range, '3',
+         '--delta-over-a', '0.5', '0.5', '1', '--out', str(tmp_path / 'x.nc')],
+        env=dict(os.environ, PYTHONPATH=str(REPO)), capture_output=True, text=True, timeout=60)
+    lines = result.stderr.strip().splitlines()
+    assert result.returncode == 2 and len(lines) == 1, result.stderr
+    assert 'b/a must be within [0.01, 100]' in lines[0]
+    assert time.monotonic() - start < 5 and list(tmp_path.iterdir()) == []
