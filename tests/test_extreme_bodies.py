@@ -13,11 +13,12 @@
 
 import math
 import time
+import warnings
 
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
-from scipy.integrate import quad
+from scipy.integrate import IntegrationWarning, quad
 
 from twodisk_ros.physics import RollingCycle, RollingDynamics, TwoDiskBody, equilibria
 from twodisk_ros.physics.body import LENGTH_RANGE
@@ -91,6 +92,70 @@ def test_thin_body_libration_stops_at_the_noise_floor():
                              u_dot0, dyn.table_size)
     full_phase = full(t)[0]
     assert np.max(np.abs(motion.phase - full_phase)) <= 2e-8
+
+
+def _node_start(**values):
+    """The node's physics for these parameters, and the CPU time (s) of its first 0.5 s."""
+    from twodisk_ros.node.parameters import DEFAULTS      # the node's contract, no rclpy
+    from twodisk_ros.node.simulation import Simulation
+    begin = time.process_time()
+    simulation = Simulation(DEFAULTS.with_values(**values))
+    t = np.arange(1, 51) / 100.0                          # the first 0.5 s at 100 Hz
+    sample = simulation.sample(t)
+    return simulation, t, sample, time.process_time() - begin
+
+
+def test_thin_body_at_one_millimetre_starts_in_closed_form():
+    # issue 19: a = 1 mm, b/a = 0.01, delta/a = 1 - 1e-6 at the default start (theta0 0.3,
+    # omega0 3 rad/s). E - V is 1e-5 of V there; its rounding left 1/|u̇| a flat spectral
+    # floor of ~5e-12 that failed the band's resolution test, and DOP853 ran > 5 min of CPU
+    # for its first 10 s. Measured now: 1.5 s (table building included).
+    simulation, t, sample, seconds = _node_start(a=0.001, b=0.00001, delta=0.000999999)
+    assert seconds < 20.0                                 # hang guard, > 300 s before
+    assert simulation.stream.solver == 'quadrature'
+    # independent reference: the time to reach each sampled phase, by adaptive quadrature
+    # of the closed forms (no table, no solver of the package). Its integrand carries the
+    # rounding of E − V (1e-16 V / (E − V) ~ 1e-11 relative; quad warns of roundoff), so
+    # the bound is 1e-10 relative (measured 3.4e-11)
+    dyn = simulation.dynamics
+    u0, u_dot0 = _start(dyn)
+    energy = 0.5 * float(dyn.effective_mass(u0)) * u_dot0**2 + float(dyn.potential(u0))
+
+    def inverse_speed(v):
+        return math.sqrt(float(dyn.effective_mass(v))
+                         / (2 * (energy - float(dyn.potential(v)))))
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', IntegrationWarning)
+        for t_k, u_k in zip(t[9::10], sample.phase[9::10]):
+            t_ref, _ = quad(inverse_speed, u0, u_k, limit=2000, epsabs=1e-14, epsrel=1e-13)
+            assert abs(t_ref - t_k) <= 1e-10 * t_k
+    # and DOP853 on the closed forms at rtol 1e-13 over 0.1 s: u to 1.5e-11 rad measured
+    # (1e-12: 5.9e-11, the reference's own error), the claim of ~1e-11 for poses
+    reference = simulate_phase(dyn, t[:10], u0, u_dot0, method='direct', tolerance=1e-13)
+    assert np.max(np.abs(sample.phase[:10] - reference.phase)) <= 1e-10
+    assert max(simulation.invariant(sample, i)[2] for i in range(len(t))) <= 1e-13
+
+
+@pytest.mark.slow
+def test_thin_body_at_rest_near_the_barrier_starts_without_a_10_s_chunk():
+    # issue 19: a = 0.1, b/a = 0.01, delta/a = 1 - 1e-6, omega0 = 0: at rest 8e-11 M g L
+    # below the barrier, a libration the tables in φ cannot resolve (tail 2e-4 at 2¹⁴
+    # nodes), so DOP853 on the tables. Its first 10 s chunk cost ~31 s of CPU before the
+    # first sample; the stream now integrates only what is asked for. Measured: 2.8 s.
+    simulation, t, sample, seconds = _node_start(a=0.1, b=0.001, delta=0.0999999, omega0=0.0)
+    assert seconds < 20.0                                 # hang guard, 31 s before
+    assert simulation.stream.solver == 'DOP853'
+    # reference: DOP853 on the closed forms (method direct) at rtol 1e-12. The claim near
+    # the separatrix (tests/test_libration.py): |δ − δ_ref| ≤ 3e-8 A; measured 1.5e-9 A,
+    # the same against rtol 1e-13 (the tables' part, not the reference's)
+    dyn = simulation.dynamics
+    u0, _ = _start(dyn, omega0=0.0)
+    reference = simulate_phase(dyn, np.concatenate([[0.0], t]), u0, 0.0, method='direct',
+                               tolerance=1e-12)
+    centre = reference.sol.centre
+    amplitude = abs(u0 - centre)
+    assert np.max(np.abs(sample.phase - reference.phase[1:])) <= 3e-8 * amplitude
+    assert max(simulation.invariant(sample, i)[2] for i in range(len(t))) <= 1e-11
 
 
 def test_startup_estimate_names_the_costly_bodies():

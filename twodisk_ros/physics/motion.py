@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
 from .solvers import (LibrationSolution, OdeSolution, QuadratureSolution, RestSolution)
-from .spectral import spectral_tail
+from .spectral import STALL, spectral_tail
 
 __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMotion',
            'simulate', 'simulate_phase']
@@ -50,6 +50,8 @@ ROLLING_MARGIN = 1e-3
 BAND_NODES = 16384
 #: and a rolling motion uses the quadrature if 1/|u̇| is resolved to this on half its grid
 HALF_GRID_TAIL = 1e-11
+#: or if it is at the noise floor of its samples below this (see _resolved)
+ROLLING_NOISE = 1e-9
 #: amplitudes up to this fraction of the local well's radius use the local well model
 LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
@@ -179,28 +181,45 @@ def simulate_phase(dynamics, t_eval, u0, u_dot0, *, mode='dynamic', method='tabl
     _check_choice('mode', mode, MODES)
     _check_choice('method', method, METHODS)
     t_eval = np.asarray(t_eval, dtype=float)
-    if mode == 'kinematic':
-        omega = float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
-        return _simulate_kinematic(dynamics, t_eval, float(u0), omega, method, tolerance)
-    return _simulate_dynamic(dynamics, t_eval, float(u0), float(u_dot0), method, tolerance)
+    u0, u_dot0 = float(u0), float(u_dot0)
+    closed = _closed_form(dynamics, mode, method, u0, u_dot0)
+    if closed is not None:
+        return _motion(dynamics, mode, method, t_eval, closed)
+    sol, nfev = _ode(dynamics, mode, method, float(t_eval[-1]), u0, u_dot0, tolerance)
+    return _motion(dynamics, mode, method, t_eval, sol, nfev)
 
 
 class MotionStream:
     """Samples of one motion at increasing times, for as long as asked (the node's source).
 
-    A closed-form solution is evaluated at any time; an ODE solution covers ``chunk``
-    seconds and is continued from its end state when the samples go past it.
+    A closed-form solution is evaluated at any time. Otherwise DOP853 is run lazily, in
+    segments that cover the times asked for and at least ``lookahead`` seconds beyond the
+    last segment, at most ``chunk`` seconds each, each continued from the end state of the
+    one before: the first samples cost only the integration up to them (a 10 s segment
+    through the sharp features of a thin body cost ~30 s of CPU), and the choice between
+    closed form and ODE is made once.
     """
 
     def __init__(self, dynamics, u0, u_dot0, *, mode='dynamic', method='table',
-                 tolerance=1e-10, chunk=10.0):
+                 tolerance=1e-10, chunk=10.0, lookahead=0.5):
+        _check_choice('mode', mode, MODES)
+        _check_choice('method', method, METHODS)
         self.dynamics, self.mode, self.method, self.tolerance = dynamics, mode, method, tolerance
-        self._chunk = float(chunk)
+        self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
         self._start = 0.0
-        motion = simulate_phase(dynamics, [0.0, self._chunk], u0, u_dot0, mode=mode,
-                                method=method, tolerance=tolerance)
-        self._sol = motion.sol
-        self.initial_energy = float(motion.energy[0])
+        u0, u_dot0 = float(u0), float(u_dot0)
+        closed = _closed_form(dynamics, mode, method, u0, u_dot0)
+        #: the solution from ``_start`` on: closed form, or the ODE's segment so far
+        self._sol = closed if closed is not None else OdeSolution(None, [u0, u_dot0], 0.0)
+        self._end_state = (u0, u_dot0)
+        self.initial_energy = float(dynamics.energy(u0, u_dot0))
+        #: right-hand-side evaluations of the ODE segments so far (0 for a closed form)
+        self.nfev = 0
+
+    @property
+    def solver(self):
+        """Name of the solver: 'quadrature', 'libration', 'rest' or 'DOP853'."""
+        return self._sol.name if self._sol.closed_form else 'DOP853'
 
     def sample(self, t):
         """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
@@ -213,11 +232,13 @@ class MotionStream:
             t = t[~inside]
             if not t.size:
                 break
-            u_end, u_dot_end = self._sol(end - self._start)
+            if self._sol.t_end > 0:
+                self._end_state = tuple(float(x) for x in self._sol(self._sol.t_end))
             self._start = end
-            self._sol = simulate_phase(self.dynamics, [0.0, self._chunk], u_end, u_dot_end,
-                                       mode=self.mode, method=self.method,
-                                       tolerance=self.tolerance).sol
+            span = min(self._chunk, max(float(t[-1]) - end, self._lookahead))
+            self._sol, nfev = _ode(self.dynamics, self.mode, self.method, span,
+                                   *self._end_state, self.tolerance)
+            self.nfev += nfev
         joined = np.concatenate(pieces, axis=1)
         return joined[0], joined[1]
 
@@ -229,44 +250,58 @@ def _motion(dynamics, mode, method, t, sol, nfev=0):
                          solver=sol.name, sol=sol)
 
 
-def _simulate_kinematic(dynamics, t_eval, u0, omega0, method, tolerance):
-    if omega0 == 0:
-        return _motion(dynamics, 'kinematic', method, t_eval, RestSolution(u0))
-    speed = abs(omega0)
-    direction = math.copysign(1.0, omega0)
-    if method == 'table':
-        quad = QuadratureSolution(u0, direction,
+def _closed_form(dynamics, mode, method, u0, u_dot0):
+    """The solution of this motion known at any time, or None (then :func:`_ode`)."""
+    if mode == 'kinematic':
+        omega = u_dot0 * float(dynamics.angular_speed_per_phase(u0))
+        if omega == 0:
+            return RestSolution(u0)
+        if method != 'table':
+            return None
+        speed = abs(omega)
+        return QuadratureSolution(u0, math.copysign(1.0, omega),
                                   lambda u: dynamics.tabulated(u)[..., 2] / speed,
                                   dynamics.table_size)
-        return _motion(dynamics, 'kinematic', method, t_eval, quad)
-
-    def rate(u):
-        return direction * speed / dynamics.angular_speed_per_phase(u)
-
-    def rhs(t, y):
-        return [float(rate(y[0]))]
-    sol, nfev = _solve(rhs, t_eval, [u0], tolerance, 1.0, rate=rate)
-    return _motion(dynamics, 'kinematic', method, t_eval, sol, nfev)
-
-
-def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
     if dynamics.flat:
-        return _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance)
+        return _flat_closed_form(dynamics, u0, u_dot0, method)
     small = _small_libration(dynamics, u0, u_dot0)
     if small is not None:
-        return _motion(dynamics, 'dynamic', method, t_eval, small)
+        return small
     if u_dot0 == 0 and dynamics.is_equilibrium(u0):
-        return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
+        return RestSolution(u0)
+    if method != 'table':
+        return None
     f0 = dynamics.tabulated(u0)
     energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
     margin = energy - dynamics.barrier
-    n = dynamics.table_size
     centre = dynamics.well(u0)[0] if margin < 0 else None
-    if method == 'table':
-        closed = _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre)
-        if closed is not None:
-            return _motion(dynamics, 'dynamic', method, t_eval, closed)
+    return _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre)
 
+
+def _ode(dynamics, mode, method, t_end, u0, u_dot0, tolerance):
+    """DOP853 from (u0 (rad), u_dot0 (rad/s)) over [0, t_end] (s): (OdeSolution, nfev).
+
+    For a motion without a closed form (:func:`_closed_form` gave None).
+    """
+    if mode == 'kinematic':
+        omega = u_dot0 * float(dynamics.angular_speed_per_phase(u0))
+        speed, direction = abs(omega), math.copysign(1.0, omega)
+
+        def rate(u):
+            return direction * speed / dynamics.angular_speed_per_phase(u)
+
+        def rhs(t, y):
+            return [float(rate(y[0]))]
+        return _solve(rhs, t_end, [u0], tolerance, 1.0, rate=rate)
+    if dynamics.flat:
+        def rhs(t, y):
+            m, dm = (float(x) for x in dynamics.effective_mass_jet(y[0]))
+            return [y[1], -0.5 * dm * y[1] ** 2 / m]
+        return _solve(rhs, t_end, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
+    f0 = dynamics.tabulated(u0)
+    energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
+    centre = dynamics.well(u0)[0] if energy < dynamics.barrier else None
+    if method == 'table':
         def rhs(t, y):
             u = y[0] if centre is None else centre + y[0]
             f = dynamics.tabulated(u)
@@ -279,15 +314,13 @@ def _simulate_dynamic(dynamics, t_eval, u0, u_dot0, method, tolerance):
             dv = float(dynamics.potential_slope(u))
             return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
     if centre is None:
-        sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
-    else:
-        # an oscillation: integrate δ = u − u*, so that rtol and atol act on the displacement
-        frequency = math.sqrt(dynamics.potential_curvature(centre) / float(f0[0]))
-        delta0 = u0 - centre
-        amplitude = math.hypot(delta0, u_dot0 / frequency)
-        sol, nfev = _solve(rhs, t_eval, [delta0, u_dot0], tolerance,
-                           np.array([amplitude, amplitude * frequency]), centre=centre)
-    return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+        return _solve(rhs, t_end, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
+    # an oscillation: integrate δ = u − u*, so that rtol and atol act on the displacement
+    frequency = math.sqrt(dynamics.potential_curvature(centre) / float(f0[0]))
+    delta0 = u0 - centre
+    amplitude = math.hypot(delta0, u_dot0 / frequency)
+    return _solve(rhs, t_end, [delta0, u_dot0], tolerance,
+                  np.array([amplitude, amplitude * frequency]), centre=centre)
 
 
 def _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre):
@@ -326,10 +359,22 @@ def _resolved(function, n):
     and resolved: already on every other node its spectral tail is below HALF_GRID_TAIL, so
     on all n it is converged far below (spectra of analytic functions shrink geometrically).
     The tail on the n nodes themselves would show the rounding of E − V instead (~1e-13 when
-    E − V is 1 % of V)."""
+    E − V is 1 % of V).
+
+    Or resolved down to that rounding: the tail on every other node is below ROLLING_NOISE
+    and did not shrink by STALL from every fourth node. A geometric spectrum ρᵏ whose tail
+    shrinks by less than STALL under a doubling has a tail above STALL² (its tail at N/4
+    modes is the square of that ratio), so a small tail that stalls is noise: for a thin,
+    nearly neutral body (b/a = 0.01, Δ/a → 1) at a = 1 mm and 3 rad/s, E − V is 1e-5 of V
+    and its rounding puts a flat floor of ~5e-12 under the spectrum of 1/|u̇| from mode 100
+    on (tails 1.6e-11, 1.2e-11 on 2¹⁵, 2¹⁶ nodes), and DOP853 ran > 5 min for its 10 s."""
     samples = function(TWO_PI * np.arange(n) / n)
-    return bool(np.all(np.isfinite(samples)) and np.all(samples > 0)
-                and spectral_tail(samples[::2]) < HALF_GRID_TAIL)
+    if not (np.all(np.isfinite(samples)) and np.all(samples > 0)):
+        return False
+    half = spectral_tail(samples[::2])
+    if half < HALF_GRID_TAIL:
+        return True
+    return bool(half < ROLLING_NOISE and half > STALL * spectral_tail(samples[::4]))
 
 
 def _small_libration(dynamics, u0, u_dot0):
@@ -354,29 +399,23 @@ def _small_libration(dynamics, u0, u_dot0):
     return LibrationSolution(local, delta0, u_dot0, dynamics.table_size)
 
 
-def _simulate_flat(dynamics, t_eval, u0, u_dot0, method, tolerance):
+def _flat_closed_form(dynamics, u0, u_dot0, method):
     """V constant (g = 0 or z_G constant): ½ m(u) u̇² is conserved, the body rolls on."""
     if u_dot0 == 0:
-        return _motion(dynamics, 'dynamic', method, t_eval, RestSolution(u0))
-    if method == 'table':
-        m0 = float(dynamics.tabulated(u0)[0])
+        return RestSolution(u0)
+    if method != 'table':
+        return None
+    m0 = float(dynamics.tabulated(u0)[0])
 
-        def inverse_speed(u):
-            return np.sqrt(dynamics.tabulated(u)[..., 0] / m0) / abs(u_dot0)
-        quad = QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed,
-                                  dynamics.table_size)
-        return _motion(dynamics, 'dynamic', method, t_eval, quad)
-
-    def rhs(t, y):
-        m, dm = (float(x) for x in dynamics.effective_mass_jet(y[0]))
-        return [y[1], -0.5 * dm * y[1] ** 2 / m]
-    sol, nfev = _solve(rhs, t_eval, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
-    return _motion(dynamics, 'dynamic', method, t_eval, sol, nfev)
+    def inverse_speed(u):
+        return np.sqrt(dynamics.tabulated(u)[..., 0] / m0) / abs(u_dot0)
+    return QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed,
+                              dynamics.table_size)
 
 
-def _solve(rhs, t_eval, y0, tolerance, scale, rate=None, centre=None):
-    """DOP853 over [0, t_eval[-1]]: (OdeSolution, right-hand-side evaluations)."""
-    t_end = float(t_eval[-1])
+def _solve(rhs, t_end, y0, tolerance, scale, rate=None, centre=None):
+    """DOP853 over [0, t_end] (s): (OdeSolution, right-hand-side evaluations)."""
+    t_end = float(t_end)
     if t_end == 0.0:
         return OdeSolution(None, y0, t_end, rate, centre), 0
     result = solve_ivp(rhs, (0.0, t_end), y0, method='DOP853', rtol=tolerance,
