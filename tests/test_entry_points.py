@@ -6,7 +6,6 @@ the installed console scripts from an empty directory, with no ``PYTHONPATH``, a
 ``--help`` prints help, exits 0 within a few seconds and leaves no file or directory behind.
 """
 
-import ast
 import configparser
 import os
 import re
@@ -14,6 +13,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+from package_helpers import console_scripts
 
 import pytest
 
@@ -26,14 +27,7 @@ HELP_SECONDS = 5.0
 
 
 def _console_scripts():
-    """The console scripts that setup.py declares (name -> module:function)."""
-    tree = ast.parse((REPO / 'setup.py').read_text(encoding='utf-8'))
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Dict):
-            for key, value in zip(node.keys, node.values):
-                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
-                    return dict(item.split(' = ') for item in ast.literal_eval(value))
-    raise AssertionError('setup.py declares no console_scripts')
+    return console_scripts()
 
 
 def _main_modules():

@@ -7,10 +7,11 @@ refused: outputs are never replaced without ``--overwrite``). Static checks of R
 Quick start block itself runs for real in tests/test_entry_points.py.
 """
 
-import ast
 import re
 import shlex
 from pathlib import Path
+
+from package_helpers import console_scripts
 
 REPO = Path(__file__).resolve().parents[1]
 README = (REPO / 'README.md').read_text(encoding='utf-8')
@@ -21,13 +22,7 @@ OUTPUT_OPTIONS = ('-o', '--out', '--plot', '--csv', '--npz')
 
 
 def _console_scripts():
-    tree = ast.parse((REPO / 'setup.py').read_text(encoding='utf-8'))
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Dict):
-            for key, value in zip(node.keys, node.values):
-                if isinstance(key, ast.Constant) and key.value == 'console_scripts':
-                    return {item.split(' = ')[0] for item in ast.literal_eval(value)}
-    raise AssertionError('setup.py declares no console_scripts')
+    return set(console_scripts())
 
 
 def _commands():
