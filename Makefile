@@ -28,8 +28,8 @@ $(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
 	install -m 644 config/* $(VENV)/share/twodisk_ros/config/
 	touch $@
 
-## Run the whole test suite (what CI runs), one pytest worker per core (a test module stays
-## on one worker: each module has its own ROS domain).
+## Run the whole test suite (what CI runs), one pytest worker per core. A test module stays
+## on one worker: the modules whose nodes subscribe each use a ROS domain of their own.
 test: venv
 	$(PY) -m pytest -n auto --dist loadfile
 

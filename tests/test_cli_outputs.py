@@ -120,7 +120,7 @@ def test_sweep_typo_exits_2_fast_without_dask(tmp_path, args, words):
     result, seconds = _run(SWEEP, *args, '--out', tmp_path / 'x.nc', cwd=tmp_path,
                            blocked=DASK_LIKE)
     _one_line_exit_2(result, words)
-    assert seconds < 1.5, seconds          # upper bound: ~0.15 s measured
+    assert seconds < 5.0, seconds          # catches Dask being started: ~0.15 s measured
     assert _listing(tmp_path) == []
 
 

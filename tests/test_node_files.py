@@ -190,6 +190,7 @@ def test_overwrite_replaces_the_old_file_once_a_sample_is_on_disk(tmp_path):
         deadline = time.monotonic() + 10.0
         while time.monotonic() < deadline and target.read_bytes() == OLD:
             time.sleep(0.05)
+        assert target.read_bytes() != OLD, 'the old file was not replaced within 10 s'
         time.sleep(1.0)                  # a few chunks more
     finally:
         process.kill()
@@ -232,11 +233,26 @@ def test_a_signal_ends_a_long_start_up_at_once(tmp_path, sig, phase, count):
     took = time.monotonic() - last
     lines = err.strip().splitlines()
     assert code == 0 and 'Traceback' not in err, before + err
-    assert took < 1.5 + (1.5 if phase == 'during-imports' and count == 1 else 0), \
+    # measured 0.06-0.5 s; the bound leaves room for a loaded machine and still catches the
+    # old behaviour (the start-up ran to its end: seconds to minutes)
+    assert took < 3.0 + (3.0 if phase == 'during-imports' and count == 1 else 0), \
         f'{took:.2f} s after the last signal'   # (one signal: the imports end first)
     assert len(lines) == 1 and 'no recording written' in lines[0], before + err
     assert target.read_bytes() == OLD
     assert left_over(tmp_path, 'run.mcap') == []
+
+
+def _wait_for_handlers(pid, timeout=10.0):
+    """Wait until the process catches SIGTERM (its handlers are in: /proc/PID/status)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        with open(f'/proc/{pid}/status', encoding='ascii') as status:
+            caught = next(int(line.split()[1], 16) for line in status
+                          if line.startswith('SigCgt:'))
+        if caught & (1 << (signal.SIGTERM - 1)):
+            return
+        time.sleep(0.002)
+    raise AssertionError(f'no SIGTERM handler within {timeout} s')
 
 
 def _read_until(process, text, timeout):
@@ -259,7 +275,7 @@ def test_one_signal_during_start_up_still_writes_nothing(tmp_path):
     """The first signal only sets the flag: start-up ends, the node stops, nothing written."""
     target = tmp_path / 'run.mcap'
     process = roller('-p', 'realtime:=false', '-p', 'duration:=1.0', '-p', f'record:={target}')
-    time.sleep(0.2)
+    _wait_for_handlers(process.pid)       # (before: Python's default action, exit -15)
     process.send_signal(signal.SIGTERM)
     code, err = finish(process)
     assert code == 0 and 'Traceback' not in err and 'no recording written' in err, err

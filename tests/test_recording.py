@@ -615,3 +615,26 @@ def test_unclosed_recorder_file_is_readable_while_open(tmp_path):
     assert [m.log_time_ns for m in partial.messages] == [T0 + i for i in
                                                          range(len(partial.messages))]
     assert len(read_recording(path).messages) == 100
+
+
+@pytest.mark.parametrize('where', ['after-open', 'starting'])
+def test_an_interrupt_while_the_recorder_opens_leaves_no_temporary_file(tmp_path, monkeypatch,
+                                                                        where):
+    """A signal's exception (KeyboardInterrupt here, StopNow in the node) that lands right
+    after the hidden temporary file is created, or while the header is written, removes it:
+    the directory holds only the old recording, byte for byte."""
+    from twodisk_ros.io import writer as writer_module
+    target = tmp_path / 'run.mcap'
+    target.write_bytes(b'old recording')
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    if where == 'after-open':
+        monkeypatch.setattr(writer_module.threading, 'Lock', interrupt)
+    else:
+        monkeypatch.setattr(writer_module, 'Writer', interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        writer_module.McapRecorder(str(target), overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['run.mcap']
+    assert target.read_bytes() == b'old recording'

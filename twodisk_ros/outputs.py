@@ -106,6 +106,21 @@ def check_output_dir(path, *, overwrite=False, names=(), option='--overwrite'):
     return path
 
 
+def _umask():
+    """The process's umask, read without changing it where Linux tells it (os.umask sets
+    it, for a moment, for every thread)."""
+    try:
+        with open('/proc/self/status', encoding='ascii') as status:
+            for line in status:
+                if line.startswith('Umask:'):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
+
+
 @contextlib.contextmanager
 def replacing(path):
     """Write ``path`` through a hidden temporary file beside it, renamed over it at the end.
@@ -125,9 +140,7 @@ def replacing(path):
     try:
         yield temporary
         # mkstemp makes the file private (0600); give it the mode a plain open() would
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(temporary, 0o666 & ~umask)
+        os.chmod(temporary, 0o666 & ~_umask())
         os.replace(temporary, text)
     except BaseException:
         with contextlib.suppress(OSError):

@@ -177,14 +177,17 @@ class McapRecorder:
             raise RecordingError(
                 f'cannot write recording {self._path}: '
                 f'{os_error_reason(self._path, error, writing=True)}') from None
-        self._lock = threading.Lock()
+        except BaseException:          # a signal's exception right after the file appeared
+            self._remove_temporary()
+            raise
         self._closed = False
-        self._topics: dict[str, _TopicState] = {}
-        self._schemas: dict[str, int] = {}
-        self._message_count = 0
-        self._first_ns = None
-        self._last_ns = None
         try:
+            self._lock = threading.Lock()
+            self._topics: dict[str, _TopicState] = {}
+            self._schemas: dict[str, int] = {}
+            self._message_count = 0
+            self._first_ns = None
+            self._last_ns = None
             self._writer = Writer(_WriteThrough(self._raw),
                                   chunk_size=operator.index(chunk_size),
                                   compression=_COMPRESSION[compression])

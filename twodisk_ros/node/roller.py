@@ -108,8 +108,17 @@ class Roller(Node):
         self._recorder = None
         self._pubs = {topic: self.create_publisher(kind, topic, QOS_DEPTH)
                       for topic, kind in TOPIC_TYPES.items()}
-        if self.settings.record:
-            self._open_recorder()
+        try:
+            if self.settings.record:
+                self._open_recorder()
+            self._init_run_state()
+        except BaseException:   # (a signal's StopNow too): no hidden temporary file is left
+            if self._recorder is not None:
+                self._recorder.discard()
+            raise
+
+    def _init_run_state(self):
+        """The counters, history, clocks and callbacks of a run (after the recorder)."""
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
         self._dropped_reported = 0      # samples_dropped at the last diagnostics
