@@ -52,4 +52,4 @@ bench: venv
 	$(PY) benchmarks/run_all.py --overwrite
 
 clean:
-	rm -rf $(VENV) out build install log .pytest_cache .hypothesis
+	rm -rf $(VENV) out build install log .pytest_cache .hypothesis twodisk_ros.egg-info
