@@ -489,7 +489,7 @@ def test_unwritable_paths_raise_at_construction(tmp_path, monkeypatch):
     def refuse(*args, **kwargs):
         raise PermissionError(13, 'Permission denied', str(denied))
 
-    monkeypatch.setattr(writer, 'open', refuse, raising=False)
+    monkeypatch.setattr(writer, 'temporary_beside', refuse)   # where the file is created
     with pytest.raises(RecordingError) as error:
         McapRecorder(denied)
     assert_one_line_naming(error, denied, 'permission denied')

@@ -25,7 +25,7 @@ import os
 import stat
 import tempfile
 
-__all__ = ['OutputError', 'check_output', 'check_output_dir', 'replacing']
+__all__ = ['OutputError', 'check_output', 'check_output_dir', 'replacing', 'temporary_beside']
 
 
 class OutputError(ValueError):
@@ -121,6 +121,23 @@ def _umask():
     return umask
 
 
+def temporary_beside(path):
+    """(descriptor, name) of a new hidden file beside ``path``, open for writing:
+    ``.run.1a2b3c4d.partial.mcap`` for ``run.mcap`` (the suffix kept: writers choose the
+    format from it), with the mode a plain ``open()`` would give (not mkstemp's 0600)."""
+    directory, name = os.path.split(os.path.abspath(os.fspath(path)))
+    stem, suffix = os.path.splitext(name)
+    handle, temporary = tempfile.mkstemp(prefix=f'.{stem}.', suffix=f'.partial{suffix}',
+                                         dir=directory)
+    try:
+        os.fchmod(handle, 0o666 & ~_umask())
+    except BaseException:
+        os.close(handle)
+        os.remove(temporary)
+        raise
+    return handle, temporary
+
+
 @contextlib.contextmanager
 def replacing(path):
     """Write ``path`` through a hidden temporary file beside it, renamed over it at the end.
@@ -130,18 +147,11 @@ def replacing(path):
     replaces ``path`` atomically; on any exception (also KeyboardInterrupt) it is removed and
     ``path`` is left as it was. Call :func:`check_output` first.
     """
-    text = os.fspath(path)
-    directory, name = os.path.split(os.path.abspath(text))
-    stem, suffix = os.path.splitext(name)
-    # the suffix is kept: writers choose the format from it (PNG, GIF, NetCDF)
-    handle, temporary = tempfile.mkstemp(prefix=f'.{stem}.', suffix=f'.partial{suffix}',
-                                         dir=directory)
+    handle, temporary = temporary_beside(path)
     os.close(handle)
     try:
         yield temporary
-        # mkstemp makes the file private (0600); give it the mode a plain open() would
-        os.chmod(temporary, 0o666 & ~_umask())
-        os.replace(temporary, text)
+        os.replace(temporary, os.fspath(path))
     except BaseException:
         with contextlib.suppress(OSError):
             os.remove(temporary)

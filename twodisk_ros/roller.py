@@ -23,7 +23,7 @@ def main(args=None):
         _STOP.ignore_from_now()
         return status
     from .node.main import main as run   # rclpy, numpy: only for a run
-    return run(argv, stop=_STOP)
+    return run(argv, stop=_STOP, answered=True)
 
 
 if __name__ == '__main__':

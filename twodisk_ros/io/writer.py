@@ -29,8 +29,6 @@ a regular file (a directory, a device, a FIFO) is never opened, replaced or remo
 import contextlib
 import operator
 import os
-import re
-import secrets
 import stat
 import threading
 from dataclasses import dataclass
@@ -39,6 +37,8 @@ from typing import Mapping
 
 from mcap.writer import CompressionType, Writer
 
+from .. import __version__
+from ..outputs import temporary_beside
 from . import msgdefs
 from .errors import (RecordingError, RecordingExistsError, io_errors, one_line,
                      os_error_reason)
@@ -67,21 +67,7 @@ def _version(dist):
         return None
 
 
-def _package_version():
-    """Return the twodisk_ros version: installed metadata, else the source tree's package.xml."""
-    version = _version('twodisk_ros')
-    if version:
-        return version
-    package_xml = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, 'package.xml')
-    try:
-        with open(package_xml, encoding='utf-8') as stream:
-            match = re.search(r'<version>\s*([^<\s]+)\s*</version>', stream.read())
-    except OSError:
-        match = None
-    return match.group(1) if match else 'unknown'
-
-
-LIBRARY = (f'twodisk_ros {_package_version()} rosbag2-compatible writer '
+LIBRARY = (f'twodisk_ros {__version__} rosbag2-compatible writer '
            f'(ros2 {ROS_DISTRO}; mcap-python {_version("mcap") or "unknown"})')
 
 
@@ -170,9 +156,10 @@ class McapRecorder:
         self._check_target()
         self._published = False
         self._target = os.path.realpath(self._path)   # through a symbolic link, as open()
-        self._temporary = _temporary_name(self._target)
+        self._temporary = None
         try:
-            self._raw = open(self._temporary, 'xb', buffering=0)
+            handle, self._temporary = temporary_beside(self._target)
+            self._raw = os.fdopen(handle, 'wb', buffering=0)
         except OSError as error:
             raise RecordingError(
                 f'cannot write recording {self._path}: '
@@ -470,7 +457,7 @@ class McapRecorder:
         self._published = True
 
     def _remove_temporary(self):
-        if not self._published:
+        if not self._published and self._temporary is not None:
             with contextlib.suppress(OSError):
                 os.remove(self._temporary)
 
@@ -495,13 +482,6 @@ class McapRecorder:
                   for topic, state in self._topics.items()]
         return bag_metadata(self._path, topics, self._message_count, self._first_ns,
                             self._last_ns)
-
-
-def _temporary_name(path):
-    """A hidden name beside ``path``: ``.run.1a2b3c4d.partial.mcap`` for ``run.mcap``."""
-    directory, name = os.path.split(os.path.abspath(path))
-    stem, suffix = os.path.splitext(name)
-    return os.path.join(directory, f'.{stem}.{secrets.token_hex(4)}.partial{suffix}')
 
 
 def _check_metadata(metadata):

@@ -80,17 +80,19 @@ def _run(node, stop):
         node.finish_samples()
 
 
-def main(args=None, stop=None):
+def main(args=None, stop=None, answered=False):
     """Run the node; returns the exit code (module doc).
 
     ``stop`` is the :class:`StopRequest` installed by the entry point before the heavy
-    imports (one is installed here if not given).
+    imports (one is installed here if not given); ``answered``: the entry point has already
+    run :func:`~.usage.early_exit` on these arguments.
     """
     argv = list(sys.argv if args is None else args)
     stop = stop if stop is not None else StopRequest()
     try:
         stop.allow_abort()   # start-up: a signal ends the process at once
-        status = early_exit(argv)   # --help, --version, arguments outside --ros-args
+        # --help, --version, arguments outside --ros-args (the entry point answered them)
+        status = None if answered else early_exit(argv)
         return status if status is not None else _main(argv, stop)
     except StopNow:
         _say(f'stopped by {stop.requested} during start-up: no recording written')
