@@ -57,7 +57,7 @@ def test_recorded_parameters_outside_the_contract_are_problems():
 
 def test_descriptors_follow_the_contract():
     pytest.importorskip('rclpy')
-    from twodisk_ros.node.roller import _descriptor
+    from twodisk_ros.node.descriptors import descriptor as _descriptor
     for p in PARAMETERS:
         d = _descriptor(p)
         assert d.read_only == p.read_only

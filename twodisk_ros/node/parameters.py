@@ -22,6 +22,8 @@ from ..physics.motion import METHODS, MODES
 __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings',
            'markdown_table', 'parse_recorded']
 
+#: The disk frames' names are body_frame + these (as in twodisk_ros.model.frames).
+DISK_SUFFIXES = ('_disk_a', '_disk_b')
 B_OVER_A = (0.01, 100.0)             # allowed b/a
 DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
 
@@ -100,8 +102,12 @@ PARAMETERS = (
     Parameter('tolerance', float, 1e-10, '', 'relative ODE tolerance; a drift of the '
               'invariant (energy, or |omega| in kinematic mode) above it is a WARN',
               1e-13, 1e-3, physics=True),
-    Parameter('frame_id', str, 'world', '', 'frame of poses, points, paths and markers '
-              '(non-empty, no spaces)'),
+    Parameter('frame_id', str, 'world', '', 'frame of poses, points, paths and markers, '
+              'parent of body_frame on /tf (non-empty, no spaces)'),
+    Parameter('body_frame', str, 'twodisk_body', '', 'the body frame at G on /tf (child of '
+              'frame_id, the orientation of pose); the disk frames on /tf_static are '
+              'body_frame_disk_a, body_frame_disk_b (non-empty, no spaces, no leading /, '
+              'none of them frame_id)'),
     Parameter('path_length', int, 1000, '', 'poses kept in each Path', 1, 100000),
     Parameter('record', str, '', '', 'MCAP file to record every published message to, '
               "'' = off", read_only=True),
@@ -168,12 +174,30 @@ def _check_together(s):
                          f'{s.gravity!r}')
     if not s.frame_id or re.search(r'\s', s.frame_id):
         raise ValueError(f'frame_id must be non-empty without spaces, got {s.frame_id!r}')
+    _check_body_frame(s.body_frame, s.frame_id)
     if s.mass_model == 'custom':
         moments = s.principal_moments
         if min(moments) <= 0:
             raise ValueError('principal_moments must be 3 numbers > 0 kg m^2 for '
                              f'mass_model custom, got {list(moments)!r}')
     s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
+
+
+def _check_body_frame(body_frame, frame_id):
+    """The body's frame names are usable tf2 frame ids below ``frame_id``; else ValueError.
+
+    tf2 refuses an empty frame id and one with a leading ``/``; a space breaks the URDF's
+    names and the tools that take frames on a command line; a name equal to ``frame_id``
+    would make the world frame its own child (a loop in the TF tree).
+    """
+    if (not body_frame or re.search(r'\s', body_frame) or not body_frame.isprintable()
+            or body_frame.startswith('/')):
+        raise ValueError('body_frame must be a non-empty frame name without spaces, control '
+                         f'characters or a leading "/", got {body_frame!r}')
+    names = (body_frame,) + tuple(body_frame + suffix for suffix in DISK_SUFFIXES)
+    if frame_id in names:
+        raise ValueError(f'body_frame must differ from frame_id: the body\'s frames '
+                         f'{", ".join(names)} include frame_id {frame_id!r}')
 
 
 class _SettingsMethods:

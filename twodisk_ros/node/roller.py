@@ -4,7 +4,10 @@ Topics (relative names, so namespaces work), frames per REP-103, SI units:
 ``pose`` (PoseStamped, body frame at G), ``contact_a`` / ``contact_b`` (PointStamped),
 ``rolling_state`` (JointState: theta, psi, phase), ``wrench_a`` / ``wrench_b``
 (WrenchStamped: the ground's force on the body at A / B), ``path_a`` / ``path_b`` /
-``path_g`` (Path, ≤ 2 Hz), ``markers`` (MarkerArray, ≤ 10 Hz) and ``/diagnostics`` (1 Hz).
+``path_g`` (Path, ≤ 2 Hz), ``markers`` (MarkerArray, ≤ 10 Hz), ``/diagnostics`` (1 Hz), the
+body frame on ``/tf`` (at ``rate``, the values of ``pose``), the disk frames on ``/tf_static``
+and the URDF on ``robot_description`` (latched: :mod:`~twodisk_ros.node.frames_publisher`), and
+the simulated time on ``/clock`` (:mod:`~twodisk_ros.node.sim_clock`).
 Run: ``ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml``.
 
 States are computed in blocks ahead of time and encoded to CDR in one vectorised step
@@ -17,8 +20,7 @@ import time
 
 import numpy as np
 from rclpy.node import Node
-from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
-                                SetParametersResult)
+from rcl_interfaces.msg import SetParametersResult
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PointStamped, PoseStamped, WrenchStamped
@@ -26,12 +28,17 @@ from nav_msgs.msg import Path
 from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 
+from rosgraph_msgs.msg import Clock
+
 from .. import __version__
 from ..io import McapRecorder, cdr
 from ..outputs import check_output
 from ..io.cdr_markers import encode_markers
-from . import messages, run_summary
+from . import messages, run_summary, sim_clock
+from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
+from .descriptors import descriptor, ros_value
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
+from .path_history import PathHistory
 from .simulation import Simulation
 from ..physics.body import TwoDiskBody
 from ..physics.startup import startup_estimate
@@ -50,34 +57,12 @@ TOPIC_TYPES = {
     'pose': PoseStamped, 'contact_a': PointStamped, 'contact_b': PointStamped,
     'rolling_state': JointState, 'wrench_a': WrenchStamped, 'wrench_b': WrenchStamped,
     'path_a': Path, 'path_b': Path, 'path_g': Path, 'markers': MarkerArray,
-    '/diagnostics': DiagnosticArray,
+    '/diagnostics': DiagnosticArray, TF_TOPIC: TFMessage,
 }
+#: QoS other than keep last QOS_DEPTH (tf2's broadcaster QoS for /tf)
+TOPIC_QOS = {TF_TOPIC: TF_QOS}
 #: topics that need the contact forces of every sample
 NEED_FORCES = ('wrench_a', 'wrench_b', 'markers', '/diagnostics')
-
-
-def _descriptor(p):
-    """The ROS ParameterDescriptor of a contract entry."""
-    unit = f' ({p.unit})' if p.unit else ''
-    descriptor = ParameterDescriptor(description=f'{p.description}{unit}; {p.rule}',
-                                     read_only=p.read_only)
-    if p.kind is int and p.choices is not None:
-        low, high = min(p.choices), max(p.choices)
-        step = (high - low) if len(p.choices) == 2 else 1
-        descriptor.integer_range = [IntegerRange(from_value=low, to_value=high, step=step)]
-    elif p.kind is int:
-        descriptor.integer_range = [IntegerRange(from_value=int(p.low), to_value=int(p.high),
-                                                 step=1)]
-    elif p.kind is float and math.isfinite(p.high):
-        descriptor.floating_point_range = [FloatingPointRange(from_value=float(p.low),
-                                                              to_value=float(p.high))]
-    if p.choices is not None and p.kind is str:
-        descriptor.additional_constraints = f'one of {", ".join(p.choices)}'
-    return descriptor
-
-
-def _ros_value(p):
-    return [float(x) for x in p.default] if p.kind is tuple else p.default
 
 
 class Roller(Node):
@@ -90,8 +75,9 @@ class Roller(Node):
     def __init__(self, **kwargs):
         super().__init__('roller', **kwargs)
         for p in PARAMETERS:
-            self.declare_parameter(p.name, _ros_value(p), _descriptor(p))
+            self.declare_parameter(p.name, ros_value(p), descriptor(p))
         values = {p.name: self.get_parameter(p.name).value for p in PARAMETERS}
+        sim_clock.check_use_sim_time(self.get_parameter(sim_clock.USE_SIM_TIME).value)
         self.settings = DEFAULTS.with_values(**values).checked()
         if self.settings.record:   # before any work; never a file the node did not create
             check_output(self.settings.record, overwrite=self.settings.overwrite,
@@ -106,8 +92,11 @@ class Roller(Node):
                 'of a thin body): it is integrated numerically (DOP853), 0.5 s ahead at a '
                 'time, at a higher cost per sample')
         self._recorder = None
-        self._pubs = {topic: self.create_publisher(kind, topic, QOS_DEPTH)
+        self._pubs = {topic: self.create_publisher(kind, topic, TOPIC_QOS.get(topic, QOS_DEPTH))
                       for topic, kind in TOPIC_TYPES.items()}
+        self._pubs[sim_clock.CLOCK_TOPIC] = self.create_publisher(
+            Clock, sim_clock.CLOCK_TOPIC, sim_clock.CLOCK_QOS)     # published, not recorded
+        self._latched = LatchedTopics(self, describe(self.settings, self.simulation.body))
         try:
             if self.settings.record:
                 self._open_recorder()
@@ -122,8 +111,8 @@ class Roller(Node):
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
         self._dropped_reported = 0      # samples_dropped at the last diagnostics
-        self.messages_built = {topic: 0 for topic in TOPIC_TYPES}
-        self._history = _PathHistory(self.settings.path_length)
+        self.messages_built = {topic: 0 for topic in self._pubs}
+        self._history = PathHistory(self.settings.path_length)
         self._tick = 0                  # global sample index: simulated time tick / rate
         self._motion_tick = 0           # tick at which the motion (re)started
         self._next = {'path': 0.0, 'marker': 0.0, 'diagnostics': 0.0}
@@ -147,6 +136,9 @@ class Roller(Node):
             for topic, kind in TOPIC_TYPES.items():
                 publisher = self._pubs[topic]
                 self._recorder.add_topic(publisher.topic_name, kind, publisher.qos_profile)
+            for topic, publisher in self._latched.publishers.items():
+                self._recorder.add_topic(publisher.topic_name, publisher.msg_type,
+                                         publisher.qos_profile)
         except BaseException:      # also a start-up cut short by a second signal
             if self._recorder is not None:
                 self._recorder.discard()
@@ -164,6 +156,12 @@ class Roller(Node):
         return metadata
 
     def _on_set_parameters(self, parameters):
+        try:   # (called before rclpy's own use_sim_time callback, which it can stop)
+            for p in parameters:
+                if p.name == sim_clock.USE_SIM_TIME:
+                    sim_clock.check_use_sim_time(p.value)
+        except ValueError as error:
+            return SetParametersResult(successful=False, reason=str(error))
         changes = {p.name: p.value for p in parameters if p.name in BY_NAME}
         read_only = [name for name in changes if BY_NAME[name].read_only]
         if read_only:
@@ -174,14 +172,16 @@ class Roller(Node):
             candidate = base.with_values(**changes).checked()
             simulation = (Simulation(candidate) if candidate.physics_differs(self.settings)
                           else None)
+            description = describe(candidate, (simulation or self.simulation).body)
         except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
             return SetParametersResult(successful=False, reason=' '.join(str(error).split()))
-        self._pending = (candidate, simulation)
+        self._pending = (candidate, simulation, description)
         return SetParametersResult(successful=True)
 
     def _apply_pending(self):
-        (candidate, simulation), self._pending = self._pending, None
+        (candidate, simulation, description), self._pending = self._pending, None
         self.settings = candidate
+        self._latched.take(description)
         self._history.length = candidate.path_length
         if simulation is not None:
             self.simulation = simulation
@@ -193,7 +193,7 @@ class Roller(Node):
             self.simulation.update(candidate)
             if self._block is not None:     # the prepared samples, encoded again
                 first, sample, stamps, _ = self._block
-                self._block = (first, sample, stamps, self._encode(sample, stamps))
+                self._block = (first, sample, stamps, self._encode(first, sample, stamps))
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
 
@@ -214,14 +214,26 @@ class Roller(Node):
                                     f'{self.simulation.invalid.reason}; the rolling solution '
                                     'is published on, marked invalid in /diagnostics')
         stamps = self._start_ns + np.round(ticks * (1e9 / rate)).astype(np.int64)
-        return sample, stamps, self._encode(sample, stamps)
+        return sample, stamps, self._encode(first, sample, stamps)
 
-    def _encode(self, sample, stamps):
-        """CDR bytes of the per-sample topics somebody wants: {topic: [bytes per sample]}."""
+    def _encode(self, first, sample, stamps):
+        """CDR bytes of the per-sample topics somebody wants: {topic: [bytes per sample]}.
+
+        ``first``: the global tick of the block's first sample. /clock comes first (it is
+        published before each sample's messages) and may skip samples (None).
+        """
         frame = self.settings.frame_id
+        encoded = {}
+        if self._pubs[sim_clock.CLOCK_TOPIC].get_subscription_count() > 0:
+            column = sim_clock.encode_clock_column(first, stamps,
+                                                   sim_clock.clock_step(self.settings.rate))
+            encoded[sim_clock.CLOCK_TOPIC] = column
+            self.messages_built[sim_clock.CLOCK_TOPIC] += sum(x is not None for x in column)
         encoders = {
             'pose': lambda: cdr.encode_pose_stamped(stamps, frame, sample.position_g,
                                                     sample.quaternion),
+            TF_TOPIC: lambda: cdr.encode_tf_message(stamps, frame, self.settings.body_frame,
+                                                    sample.position_g, sample.quaternion),
             'contact_a': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_a),
             'contact_b': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_b),
             'rolling_state': lambda: cdr.encode_joint_state(
@@ -234,20 +246,29 @@ class Roller(Node):
                                                                      sample.forces.force_a)
             encoders['wrench_b'] = lambda: cdr.encode_wrench_stamped(stamps, frame,
                                                                      sample.forces.force_b)
-        encoded = {topic: encode() for topic, encode in encoders.items() if self._wanted(topic)}
-        for topic, column in encoded.items():
-            self.messages_built[topic] += len(column)
+        for topic, encode in encoders.items():
+            if self._wanted(topic):
+                encoded[topic] = encode()
+                self.messages_built[topic] += len(encoded[topic])
         return encoded
 
     def _emit(self, sample, stamps, encoded, start, stop):
-        """Publish and record samples [start, stop) of a prepared block, sample by sample."""
-        subscribed = [topic for topic in encoded
+        """Publish and record samples [start, stop) of a prepared block, sample by sample.
+
+        The latched topics go first when they changed, stamped with the first sample's stamp.
+        """
+        if self._latched.due:
+            self._latched.send(int(stamps[start]), None if self._recorder is None
+                               else self._recorder.write_serialized)
+        subscribed = [(self._pubs[topic].publish, encoded[topic]) for topic in encoded
                       if self._pubs[topic].get_subscription_count() > 0]
         for i in range(start, stop):
-            for topic in subscribed:
-                self._pubs[topic].publish(encoded[topic][i])
-        if self._recorder is not None and encoded:
-            topics = list(encoded)
+            for publish, column in subscribed:
+                data = column[i]
+                if data is not None:      # (/clock skips samples above CLOCK_MAX_RATE)
+                    publish(data)
+        topics = [topic for topic in encoded if topic != sim_clock.CLOCK_TOPIC]
+        if self._recorder is not None and topics:
             self._recorder.write_interleaved(
                 [self._pubs[t].topic_name for t in topics],
                 [encoded[t][start:stop] for t in topics], stamps[start:stop])
@@ -459,25 +480,3 @@ class Roller(Node):
             recorder.path if recorder is not None and recorder.published else None,
             invalid.reason if invalid is not None else None, self.samples_dropped)
 
-
-class _PathHistory:
-    """The last ``length`` samples of A, B and G (stamps in ns, world positions in m)."""
-
-    def __init__(self, length):
-        self.length = length
-        self.clear()
-
-    def clear(self):
-        self._stamps = np.zeros(0, dtype=np.int64)
-        self._points = {key: np.zeros((0, 3)) for key in 'abg'}
-
-    def tail(self, key, stamps, points):
-        """The last ``length`` stamps and points of ``key`` followed by the given ones."""
-        n = self.length
-        return (np.concatenate([self._stamps, stamps])[-n:],
-                np.concatenate([self._points[key], points])[-n:])
-
-    def extend(self, stamps, a, b, g):
-        self._stamps = np.concatenate([self._stamps, stamps])[-self.length:]
-        for key, points in zip('abg', (a, b, g)):
-            self._points[key] = np.concatenate([self._points[key], points])[-self.length:]
