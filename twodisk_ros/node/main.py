@@ -41,7 +41,12 @@ def _internal(error):
 
 def _start(argv, stop):
     """rclpy and the node, or (None, exit code) after one line on stderr."""
-    from .roller import Roller   # after the arguments are known to be well formed
+    try:
+        from .roller import Roller   # after the arguments are known to be well formed
+    except ImportError as error:     # a message package missing from this environment
+        _say(f'cannot load the node: {error} (the set-up installs every message package '
+             'the node publishes, tf2_msgs included: see README.md, Quick start)')
+        return None, EXIT_INTERNAL
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         stop.install()

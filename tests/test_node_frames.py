@@ -1,0 +1,349 @@
+"""The body in ROS tools: /tf, /tf_static and robot_description from a ``roller`` process.
+
+The node runs as a process; this test process is the second process that subscribes, as
+RViz or a tf2 listener would. Transforms are checked bit for bit against ``pose`` (the same
+arrays) and, independently, against the physics: each recorded contact point, carried
+through /tf and /tf_static into its disk's frame, lies on that disk's rim
+x²/a² + y²/b² = 1, z = 0. Subprocess nodes use ROS domain 32; discovery is localhost-only.
+"""
+
+import os
+
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+
+from pathlib import Path  # noqa: E402
+import signal  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+import xml.etree.ElementTree as ElementTree  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import rclpy  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: E402
+from rcl_interfaces.srv import SetParameters  # noqa: E402
+
+from geometry_msgs.msg import PointStamped, PoseStamped  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import String  # noqa: E402
+from tf2_msgs.msg import TFMessage  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+REPO = Path(__file__).resolve().parents[1]
+DOMAIN = 32
+RATE = 50.0
+PERIOD_NS = 20_000_000
+#: an elliptic body, so that a swapped x and y of a disk frame shows on the rim
+BODY = {'a': 0.1, 'b': 0.07, 'delta': 0.05}
+#: tf2_ros's StaticListenerQoS: what a late-joining tf2 listener asks for
+LATCHED = QoSProfile(depth=100, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+STARTED = 30.0        # s: a node answers within this on a loaded 2-core machine
+
+
+def node_env():
+    return dict(os.environ, PYTHONPATH=str(REPO), ROS_DOMAIN_ID=str(DOMAIN),
+                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', PYTHONUNBUFFERED='1')
+
+
+def body_params(**extra):
+    values = dict(BODY, **extra)
+    return [arg for name, value in values.items() for arg in ('-p', f'{name}:={value}')]
+
+
+def start_roller(*params):
+    return subprocess.Popen(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
+         'config/oloid.yaml', *params], cwd=REPO, env=node_env(), stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True)
+
+
+def stop(process, sig=signal.SIGINT, timeout=20.0):
+    """Send ``sig`` (None: wait for the end), then the exit code and stderr; killed by PID if
+    it does not end."""
+    try:
+        if process.poll() is None and sig is not None:
+            process.send_signal(sig)
+        _, err = process.communicate(timeout=timeout)
+        return process.returncode, err
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+
+
+@pytest.fixture
+def client():
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=DOMAIN)
+    node = rclpy.create_node('frames_test_client', context=ctx)
+    executor = SingleThreadedExecutor(context=ctx)
+    executor.add_node(node)
+    try:
+        yield node, executor
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown(context=ctx)
+
+
+def spin_until(executor, predicate, timeout=STARTED):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        executor.spin_once(timeout_sec=0.02)
+        if predicate():
+            return True
+    return False
+
+
+def stamp_ns(header):
+    return header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
+
+
+def rotation(q):
+    """Rotation matrix of a unit quaternion (x, y, z, w)."""
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def xyz(v):
+    return np.array([v.x, v.y, v.z])
+
+
+def xyzw(q):
+    return np.array([q.x, q.y, q.z, q.w])
+
+
+def assert_tf_is_pose(tf, pose, parent='world', child='twodisk_body'):
+    """One /tf message holds the pose's transform, bit for bit."""
+    (t,) = tf.transforms
+    assert (t.header.frame_id, t.child_frame_id) == (parent, child)
+    assert stamp_ns(t.header) == stamp_ns(pose.header)
+    tr, p = t.transform, pose.pose
+    assert [tr.translation.x, tr.translation.y, tr.translation.z] == [
+        p.position.x, p.position.y, p.position.z]
+    assert list(xyzw(tr.rotation)) == list(xyzw(p.orientation))
+
+
+def static_frames(message):
+    """{child: (parent, translation, rotation matrix disk → body)} of a /tf_static message."""
+    return {t.child_frame_id: (t.header.frame_id, xyz(t.transform.translation),
+                               rotation(xyzw(t.transform.rotation)))
+            for t in message.transforms}
+
+
+def assert_contacts_on_rims(tfs, contacts_a, contacts_b, states, static,
+                            body_frame='twodisk_body'):
+    """Each contact, carried world → body (/tf) → disk (/tf_static), is on its disk's rim, at
+    the polar angle (from x towards y) that rolling_state gives: theta on disk a, psi on b."""
+    a, b = BODY['a'], BODY['b']
+    checked = 0
+    for stamp, tf in tfs.items():
+        if not all(stamp in topic for topic in (contacts_a, contacts_b, states)):
+            continue
+        (t,) = tf.transforms
+        g, r = xyz(t.transform.translation), rotation(xyzw(t.transform.rotation))
+        angles = states[stamp].position[:2]
+        for contact, suffix, angle in ((contacts_a[stamp], '_disk_a', angles[0]),
+                                       (contacts_b[stamp], '_disk_b', angles[1])):
+            parent, centre, axes = static[body_frame + suffix]
+            assert parent == body_frame
+            local = axes.T @ (r.T @ (xyz(contact.point) - g) - centre)
+            # 1e-12 m: the closed forms' positions are exact to ~1e-16 of the size (0.1 m)
+            assert abs(local[2]) < 1e-12, (suffix, local)
+            assert abs((local[0] / a) ** 2 + (local[1] / b) ** 2 - 1) < 1e-12, (suffix, local)
+            # the contact angle is the polar angle from x towards y (1e-9 rad: θ, ψ come
+            # from the phase by complex steps, the points from the closed forms)
+            polar = np.arctan2(local[1], local[0])
+            assert abs(np.angle(np.exp(1j * (polar - angle)))) < 1e-9, (suffix, polar, angle)
+        checked += 1
+    assert checked >= 10
+    return checked
+
+
+# -- /tf at rate, /tf_static and robot_description to late joiners ---------------------------
+
+def test_tf_matches_pose_and_latched_topics_reach_late_joiners(client):
+    node, executor = client
+    got = {'pose': [], '/tf': [], 'contact_a': [], 'contact_b': [], 'rolling_state': []}
+    for topic, kind in (('pose', PoseStamped), ('/tf', TFMessage), ('contact_a', PointStamped),
+                        ('contact_b', PointStamped), ('rolling_state', JointState)):
+        node.create_subscription(kind, topic, got[topic].append, 1000)
+    process = start_roller('-p', f'rate:={RATE}', *body_params())
+    try:
+        assert spin_until(executor, lambda: len(got['/tf']) >= 40), 'no /tf'
+        # late joiners: the node published both before these subscriptions existed
+        statics, descriptions = [], []
+        node.create_subscription(TFMessage, '/tf_static', statics.append, LATCHED)
+        node.create_subscription(String, 'robot_description', descriptions.append, LATCHED)
+        assert spin_until(executor, lambda: statics and descriptions), 'no latched message'
+        assert spin_until(executor, lambda: len(got['/tf']) >= 60)
+    finally:
+        code, err = stop(process)
+    assert code == 0 and 'Traceback' not in err, err
+    poses = {stamp_ns(m.header): m for m in got['pose']}
+    tfs = {stamp_ns(m.transforms[0].header): m for m in got['/tf']}
+    # /tf at rate: consecutive stamps one period apart (reliable, keep last 100)
+    assert np.all(np.diff(sorted(tfs)) == PERIOD_NS)
+    common = sorted(set(poses) & set(tfs))
+    assert len(common) >= 40
+    for stamp in common:
+        assert_tf_is_pose(tfs[stamp], poses[stamp])
+    # /tf_static: one message, both disks, once (nothing changed)
+    assert len(statics) == 1
+    static = static_frames(statics[0])
+    assert set(static) == {'twodisk_body_disk_a', 'twodisk_body_disk_b'}
+    assert_contacts_on_rims(tfs, {stamp_ns(m.header): m for m in got['contact_a']},
+                            {stamp_ns(m.header): m for m in got['contact_b']},
+                            {stamp_ns(m.header): m for m in got['rolling_state']}, static)
+    # robot_description: a URDF whose links are the body and its two disks
+    (description,) = descriptions
+    assert_urdf(description.data, 'twodisk_body')
+
+
+def assert_urdf(text, body_frame):
+    robot = ElementTree.fromstring(text)
+    assert robot.tag == 'robot'
+    links = {link.get('name') for link in robot.findall('link')}
+    assert {body_frame, body_frame + '_disk_a', body_frame + '_disk_b'} <= links
+    joints = {j.find('child').get('link'): j.find('parent').get('link')
+              for j in robot.findall('joint')}
+    assert joints[body_frame + '_disk_a'] == joints[body_frame + '_disk_b'] == body_frame
+    return robot
+
+
+# -- changes at run time ---------------------------------------------------------------------
+
+def call(executor, client, parameter):
+    request = SetParameters.Request(parameters=[parameter.to_parameter_msg()])
+    future = client.call_async(request)
+    assert spin_until(executor, future.done), 'service call timed out'
+    (result,) = future.result().results
+    return result
+
+
+def test_changes_resend_what_they_alter_and_nothing_else(client):
+    node, executor = client
+    poses, tfs, statics, descriptions = [], [], [], []
+    node.create_subscription(PoseStamped, 'pose', poses.append, 1000)
+    node.create_subscription(TFMessage, '/tf', tfs.append, 1000)
+    node.create_subscription(TFMessage, '/tf_static', statics.append, LATCHED)
+    node.create_subscription(String, 'robot_description', descriptions.append, LATCHED)
+    process = start_roller('-p', f'rate:={RATE}', *body_params())
+    try:
+        assert spin_until(executor, lambda: statics and descriptions and len(poses) >= 5)
+        setter = node.create_client(SetParameters, '/roller/set_parameters')
+        assert setter.wait_for_service(timeout_sec=STARTED)
+
+        # friction alters neither: after 10 more samples, nothing was re-sent
+        assert call(executor, setter, Parameter('friction', value=0.8)).successful
+        count = len(poses)
+        assert spin_until(executor, lambda: len(poses) >= count + 10)
+        assert (len(statics), len(descriptions)) == (1, 1)
+
+        # delta moves the disk centres (±delta e2) and changes the URDF
+        assert call(executor, setter, Parameter('delta', value=0.06)).successful
+        assert spin_until(executor, lambda: len(statics) == 2 and len(descriptions) == 2)
+        static = static_frames(statics[-1])
+        np.testing.assert_array_equal(static['twodisk_body_disk_a'][1], [0.0, -0.06, 0.0])
+        np.testing.assert_array_equal(static['twodisk_body_disk_b'][1], [0.0, 0.06, 0.0])
+        assert descriptions[-1].data != descriptions[0].data
+
+        # body_frame renames the child on /tf, the static parents and the URDF's links
+        assert call(executor, setter, Parameter('body_frame', value='oloid')).successful
+        assert spin_until(executor, lambda: len(statics) == 3 and len(descriptions) == 3)
+        assert set(static_frames(statics[-1])) == {'oloid_disk_a', 'oloid_disk_b'}
+        assert_urdf(descriptions[-1].data, 'oloid')
+        tfs.clear()
+        assert spin_until(executor, lambda: len(tfs) >= 5)
+        assert all(m.transforms[0].child_frame_id == 'oloid' for m in tfs[1:])
+
+        # refused at run time, one line each: a bad body_frame, following /clock
+        for parameter, words in ((Parameter('body_frame', value='world'), 'frame_id'),
+                                 (Parameter('body_frame', value='a b'), 'spaces'),
+                                 (Parameter('use_sim_time', value=True), 'use_sim_time')):
+            result = call(executor, setter, parameter)
+            assert not result.successful and words in result.reason, result.reason
+            assert '\n' not in result.reason
+        count = len(poses)
+        assert spin_until(executor, lambda: len(poses) >= count + 10)   # still running
+        assert len(statics) == 3
+    finally:
+        code, err = stop(process)
+    assert code == 0 and 'Traceback' not in err, err
+
+
+# -- bad input -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('arguments, words', [
+    (["body_frame:=''"], 'body_frame must be a non-empty frame name'),
+    (["body_frame:='two words'"], 'without spaces'),
+    (['body_frame:=/twodisk_body'], 'leading "/"'),
+    (['body_frame:=world'], 'body_frame must differ from frame_id'),
+    (['frame_id:=map', 'body_frame:=map'], "include frame_id 'map'"),
+    (['frame_id:=body_disk_b', 'body_frame:=body'], "include frame_id 'body_disk_b'"),
+    (['body_frame:=12'], 'body_frame is a string'),
+    (['use_sim_time:=true'], 'use_sim_time must be false for roller'),
+], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time'])
+def test_bad_body_frame_or_sim_time_exits_2_with_one_line(arguments, words):
+    params = [arg for argument in arguments for arg in ('-p', argument)]
+    code, err = stop(start_roller('-p', 'realtime:=false', '-p', 'duration:=0.1', *params),
+                     sig=None, timeout=STARTED)
+    lines = err.strip().splitlines()
+    assert code == 2, err
+    assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err
+
+
+# -- the recording -----------------------------------------------------------------------------
+
+def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
+    """As rosbag2 records them: /tf per sample, /tf_static and robot_description once,
+    transient local in their offered QoS; read by rosbags and by mcap-ros2-support."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+    from twodisk_ros.io import read_recording
+    target = tmp_path / 'frames.mcap'
+    process = start_roller('-p', 'realtime:=false', '-p', 'duration:=2.0', '-p', 'rate:=100.0',
+                           '-p', 'frame_id:=odom', '-p', 'body_frame:=oloid',
+                           '-p', f'record:={target}', *body_params())
+    code, err = stop(process, sig=None, timeout=60.0)
+    assert code == 0 and 'Traceback' not in err, err
+    store = get_typestore(Stores.ROS2_JAZZY)
+    got = {}
+    with AnyReader([target], default_typestore=store) as reader:
+        qos = {c.topic: c.ext.offered_qos_profiles for c in reader.connections}
+        for connection, log_time, data in reader.messages():
+            message = reader.deserialize(data, connection.msgtype)
+            got.setdefault(connection.topic, []).append((log_time, message))
+    assert len(got['/pose']) == len(got['/tf']) == 201
+    for (log_pose, pose), (log_tf, tf) in zip(got['/pose'], got['/tf']):
+        assert log_pose == log_tf
+        assert_tf_is_pose(tf, pose, parent='odom', child='oloid')
+    for topic in ('/tf_static', '/robot_description'):
+        (profile,) = qos[topic]
+        assert profile.durability.name == 'TRANSIENT_LOCAL' and profile.depth == 1, topic
+        assert len(got[topic]) == 1, topic
+        assert got[topic][0][0] == got['/pose'][0][0]      # sent with the first sample
+    assert qos['/tf'][0].durability.name == 'VOLATILE' and qos['/tf'][0].depth == 100
+    (_, static), = got['/tf_static']
+    assert {t.child_frame_id: t.header.frame_id for t in static.transforms} == {
+        'oloid_disk_a': 'oloid', 'oloid_disk_b': 'oloid'}
+    (_, description), = got['/robot_description']
+    assert_urdf(description.data, 'oloid')
+    # mcap-ros2-support, and the parameters in the metadata
+    recording = read_recording(target, decode=lambda topic: topic in (
+        '/tf', '/tf_static', '/robot_description'))
+    assert not recording.undecodable
+    tfs = [m.msg for m in recording.messages if m.topic == '/tf']
+    assert [t.transforms[0].transform.translation.x for t in tfs] == [
+        pose.pose.position.x for _, pose in got['/pose']]
+    assert recording.metadata['twodisk_ros']['body_frame'] == 'oloid'
+    assert '/clock' not in qos                               # published, not recorded
