@@ -20,9 +20,10 @@ USAGE = f"""\
 usage: {PROG} [-h] [--version] [--ros-args [-p NAME:=VALUE ...] [--params-file FILE ...] ...]
 
 The twodisk_ros node: a rigid body of two elliptic disks (the oloid among them) rolling on a
-plane. It simulates the motion and publishes the pose, the contact points, paths, markers and
-/diagnostics at `rate`, optionally recording every message to an MCAP file (`record`). It runs
-until `duration` of simulated time (0: until SIGINT or SIGTERM).
+plane. It simulates the motion and publishes the pose, the body frame on /tf, the contact
+points, paths, markers, /diagnostics and /clock at `rate`, the disk frames on /tf_static and
+the URDF on robot_description, optionally recording every message to an MCAP file (`record`).
+It runs until `duration` of simulated time (0: until SIGINT or SIGTERM).
 
 Parameters are ROS 2 parameters and go after --ros-args:
   -p NAME:=VALUE        one parameter; doubles need a decimal point (rate:=50.0)
