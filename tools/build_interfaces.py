@@ -239,7 +239,7 @@ def remove_installed(prefix, files, owned):
     for relative in files:
         try:
             (prefix / relative).unlink()
-        except FileNotFoundError:
+        except (FileNotFoundError, NotADirectoryError):
             pass
 
 
@@ -261,6 +261,10 @@ def install(staged, prefix, stamp, digest):
     """Copy the staged tree into ``prefix``; on any failure remove every tf2_msgs file."""
     files, owned = staged_files(staged)
     old_files, old_dirs = previous_install(prefix, stamp, owned)
+    # directories this install creates (the prefix too, if new): removed again on failure
+    created = sorted({d for f in files for d in [prefix, *(prefix / f).parents]
+                      if d.is_relative_to(prefix) and not d.exists()},
+                     key=lambda d: len(d.parts), reverse=True)
     stamp.unlink(missing_ok=True)
     try:
         remove_installed(prefix, old_files, old_dirs)
@@ -278,12 +282,23 @@ def install(staged, prefix, stamp, digest):
     except BaseException:
         remove_installed(prefix, files + [f.with_name(f'.{f.name}.partial') for f in files],
                          owned)
+        for directory in created:
+            try:
+                directory.rmdir()
+            except OSError:
+                pass
         stamp.unlink(missing_ok=True)
         raise
 
 
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        """Bad arguments: one line, exit status 2."""
+        self.exit(2, f'{self.prog}: error: {message} (see --help)\n')
+
+
 def parse_arguments(argv):
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         description='Build tf2_msgs/msg/TFMessage from interfaces/tf2_msgs with the rosidl '
                     'tool chain of the venv and install it into a prefix (make venv runs '
                     'this). Needs gcc/g++ and the Python headers.')
