@@ -6,7 +6,9 @@ QoS that tf2_ros's broadcasters offer: /tf keep last 100, reliable, volatile; /t
 last 1, reliable, transient local (rosbag2 stores each publisher's offered QoS, and its player
 republishes /tf_static transient local from that). References, none of them this package:
 rosbags' Jazzy type store (the type hash, the CDR, the QoS parsed back from the bag metadata),
-mcap-ros2-support's decoder, rclpy's deserializer; every number comes back bit for bit.
+mcap-ros2-support's decoder, rclpy's deserializer, and Foxglove's own readers (@mcap/core,
+@foxglove/rosmsg2-serialization in Node.js, installed by ``make foxglove-readers`` from
+tests/foxglove/package-lock.json); every number comes back bit for bit.
 """
 
 import os
@@ -14,7 +16,11 @@ import os
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 os.environ.setdefault('ROS_DOMAIN_ID', '40')
 
+import json  # noqa: E402
+from pathlib import Path  # noqa: E402
+import shutil  # noqa: E402
 import struct  # noqa: E402
+import subprocess  # noqa: E402
 import textwrap  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -48,6 +54,7 @@ TF_STATIC_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                            reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
 N = 50
+FOXGLOVE = Path(__file__).resolve().parent / 'foxglove'
 
 
 def samples():
@@ -203,3 +210,51 @@ def test_tf_equals_pose_sample_for_sample(bag):
         assert transform_values(tfs[stamp]) == (
             pose.header.stamp.sec * 10**9 + pose.header.stamp.nanosec, pose.header.frame_id,
             'twodisk_body', bits([p.x, p.y, p.z]), bits([q.x, q.y, q.z, q.w]))
+
+
+def _from_node(value):
+    """Undo decode.mjs's JSON encoding: "f:<float64 bits>" and "i:<bigint>" back to numbers."""
+    if isinstance(value, dict):
+        return {k: _from_node(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_from_node(v) for v in value]
+    if isinstance(value, str) and value[:2] == 'f:':
+        return struct.unpack('<d', bytes.fromhex(value[2:]))[0]
+    if isinstance(value, str) and value[:2] == 'i:':
+        return int(value[2:])
+    return value
+
+
+def foxglove_decode(path, *topics):
+    """Every message of the topics as Foxglove's readers decode it (tests/foxglove/decode.mjs)."""
+    installed = (FOXGLOVE / 'node_modules' / '@foxglove' / 'rosmsg2-serialization').is_dir()
+    if shutil.which('node') is None or not installed:
+        if os.environ.get('CI', '').lower() in ('1', 'true', 'yes'):
+            pytest.fail('Foxglove readers missing: make foxglove-readers')
+        pytest.skip('Foxglove readers not installed (make foxglove-readers)')
+    result = subprocess.run(['node', str(FOXGLOVE / 'decode.mjs'), str(path), *topics],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return [_from_node(json.loads(line)) for line in result.stdout.splitlines()]
+
+
+def _foxglove_transform(t):
+    tr, rot = t['transform']['translation'], t['transform']['rotation']
+    stamp = t['header']['stamp']
+    return (int(stamp['sec']) * 10**9 + int(stamp['nanosec']), t['header']['frame_id'],
+            t['child_frame_id'], bits([tr['x'], tr['y'], tr['z']]),
+            bits([rot['x'], rot['y'], rot['z'], rot['w']]))
+
+
+def test_foxglove_readers_decode_tf_bit_for_bit(bag):
+    _, path, static = bag
+    decoded = foxglove_decode(path, '/tf', '/tf_static')
+    assert {m['schema'] for m in decoded} == {TF}
+    assert not any(m['trailing'] for m in decoded)      # each message ends at its last field
+    tf = [m for m in decoded if m['topic'] == '/tf']
+    assert [m['logTime'] for m in tf] == [e[0] for e in expected_tf()]
+    assert [[_foxglove_transform(t) for t in m['message']['transforms']] for m in tf] \
+        == [[e] for e in expected_tf()]
+    (tf_static,) = [m for m in decoded if m['topic'] == '/tf_static']
+    assert [_foxglove_transform(t) for t in tf_static['message']['transforms']] \
+        == [transform_values(t) for t in static.transforms]
