@@ -10,7 +10,7 @@ export MPLBACKEND := Agg
 # where make demo writes (a test runs it into a temporary directory)
 OUT ?= out
 
-.PHONY: venv test demo figures bench clean
+.PHONY: venv foxglove-readers test demo figures bench clean
 
 venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
@@ -38,9 +38,18 @@ $(VENV)/.tf2_msgs: $(VENV)/.installed tools/build_interfaces.py $(TF2_MSGS)
 	@$(PY) tools/build_interfaces.py --prefix $(VENV) --stamp $@ \
 	    --log $(VENV)/tf2_msgs-build.log
 
+## Foxglove's own readers (Node.js: @mcap/core, @foxglove/rosmsg2-serialization), for the tests
+## that decode recordings as the Foxglove app does; versions pinned in the lock file.
+foxglove-readers: tests/foxglove/node_modules/.installed
+
+tests/foxglove/node_modules/.installed: tests/foxglove/package.json tests/foxglove/package-lock.json
+	@command -v npm >/dev/null || { echo "npm not found: install Node.js 18 or later (apt-get install nodejs npm)"; exit 2; }
+	cd tests/foxglove && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error
+	touch $@
+
 ## Run the whole test suite (what CI runs), one pytest worker per core. A test module stays
 ## on one worker: the modules whose nodes subscribe each use a ROS domain of their own.
-test: venv
+test: venv foxglove-readers
 	$(PY) -m pytest -n auto --dist loadfile
 
 ## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
@@ -62,4 +71,4 @@ bench: venv
 	$(PY) benchmarks/run_all.py --overwrite
 
 clean:
-	rm -rf $(VENV) out build install log .pytest_cache .hypothesis twodisk_ros.egg-info
+	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info
