@@ -35,8 +35,8 @@ from twodisk_ros.physics.mass_models import MODELS
 
 from .frames import disk_frames
 
-__all__ = ['Mesh', 'body_mesh', 'laminae_mesh', 'hull_mesh', 'DEFAULT_RESOLUTION',
-           'DEFAULT_THICKNESS']
+__all__ = ['Mesh', 'body_mesh', 'mesh_parts', 'laminae_mesh', 'hull_mesh', 'merge',
+           'DEFAULT_RESOLUTION', 'DEFAULT_THICKNESS']
 
 #: Rim vertices per disk (laminae) and phase steps per cycle (solid hull).
 DEFAULT_RESOLUTION = 256
@@ -105,8 +105,18 @@ def _model_name(mass_model):
     return name
 
 
+def merge(meshes):
+    """One :class:`Mesh` holding all of ``meshes`` (an iterable of Mesh) as its components."""
+    vertices, faces, offset = [], [], 0
+    for mesh in meshes:
+        vertices.append(mesh.vertices)
+        faces.append(mesh.faces + offset)
+        offset += len(mesh.vertices)
+    return Mesh(np.concatenate(vertices), np.concatenate(faces))
+
+
 def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickness=None):
-    """The mesh that shows ``body`` under a mass model.
+    """The mesh that shows ``body`` under a mass model: all of :func:`mesh_parts` in one.
 
     Parameters
     ----------
@@ -124,13 +134,29 @@ def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickne
     -------
     Mesh
     """
+    return merge(mesh_parts(body, mass_model, resolution, thickness).values())
+
+
+def mesh_parts(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickness=None):
+    """The closed parts of :func:`body_mesh` (same arguments), to colour them apart.
+
+    Returns
+    -------
+    dict of str to Mesh
+        ``{'disk_a': plate of disk 1, 'disk_b': plate of disk 2}`` for ``'laminae'`` and
+        ``'custom'``; ``{'hull': the convex hull}`` for ``'solid'``. Body frame (m).
+    """
     if _model_name(mass_model) == 'solid':
-        return hull_mesh(body, resolution)
-    return laminae_mesh(body, resolution, thickness)
+        return {'hull': hull_mesh(body, resolution)}
+    return dict(zip(('disk_a', 'disk_b'), _plates(body, resolution, thickness)))
 
 
 def laminae_mesh(body, resolution=DEFAULT_RESOLUTION, thickness=None):
     """The two disks as closed elliptic prisms (see the module docstring), body frame (m)."""
+    return merge(_plates(body, resolution, thickness))
+
+
+def _plates(body, resolution, thickness):
     n = _resolution(resolution)
     if thickness is None:
         thickness = DEFAULT_THICKNESS * body.size
@@ -158,11 +184,8 @@ def laminae_mesh(body, resolution=DEFAULT_RESOLUTION, thickness=None):
         np.stack([n + k, n + k1, k1], axis=1),                      # side, outward
         np.stack([n + k, k1, k], axis=1),
     ])
-    vertices, all_faces = [], []
-    for index, frame in enumerate(disk_frames(body)):
-        vertices.append(local @ frame.axes.T + frame.translation)
-        all_faces.append(faces + index * len(local))
-    return Mesh(np.concatenate(vertices), np.concatenate(all_faces))
+    return tuple(Mesh(local @ frame.axes.T + frame.translation, faces)
+                 for frame in disk_frames(body))
 
 
 def hull_mesh(body, resolution=DEFAULT_RESOLUTION):
