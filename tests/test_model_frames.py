@@ -70,3 +70,15 @@ def test_bad_frame_names_are_refused_in_one_line(name):
     assert '\n' not in str(error.value) and 'body_frame' in str(error.value)
     with pytest.raises(ValueError):
         disk_frames(TwoDiskBody.oloid(), name)
+
+
+def test_model_package_imports_without_ros_or_matplotlib():
+    import subprocess
+    import sys
+    code = ('import sys, twodisk_ros.model.frames, twodisk_ros.model.mesh, '
+            'twodisk_ros.model.stl, twodisk_ros.model.urdf; '
+            'print(sorted(m for m in ("rclpy", "matplotlib") if m in sys.modules))')
+    result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == '[]'
