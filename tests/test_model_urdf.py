@@ -160,3 +160,12 @@ def test_bad_body_frame_in_one_line(name):
     with pytest.raises(ValueError) as error:
         robot_description(TwoDiskBody.oloid(), _mass('laminae', (1.0, 1.0, 0.5)), name)
     assert '\n' not in str(error.value)
+
+
+def test_a_server_can_name_the_mesh_files_its_own_way(tmp_path):
+    body = TwoDiskBody.oloid(0.1)
+    text = body_description(body, _mass('laminae', (0.1, 0.1, 0.05)), directory=tmp_path,
+                            uri=lambda path: f'package://twodisk_ros/meshes/{path.name}')
+    names = [m.get('filename') for m in ElementTree.fromstring(text).iter('mesh')]
+    assert len(names) == 4 and all(n.startswith('package://twodisk_ros/meshes/') for n in names)
+    assert {n.rsplit('/', 1)[1] for n in names} == {p.name for p in tmp_path.iterdir()}

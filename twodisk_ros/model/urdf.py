@@ -129,13 +129,14 @@ def robot_description(body, mass, body_frame='twodisk_body', mesh_uris=None, *,
 
 
 def body_description(body, mass, body_frame='twodisk_body', *, resolution=DEFAULT_RESOLUTION,
-                     thickness=None, directory=None, robot_name='twodisk'):
+                     thickness=None, directory=None, robot_name='twodisk', uri=mesh_uri):
     """The URDF with meshes: :func:`~twodisk_ros.model.mesh.mesh_parts` for ``mass.model``
     written to the mesh cache (:func:`~twodisk_ros.model.stl.cached_stl`, ``directory``
-    overrides it) and referred to by ``file://`` URIs. Raises
+    overrides it) and referred to by ``uri(path)``, by default the ``file://`` URI (a server
+    that hands the files out itself, e.g. to a browser, passes its own). Raises
     :class:`~twodisk_ros.outputs.OutputError` (one line) if the cache cannot be written.
     """
     check_frame_id(body_frame)
     parts = mesh_parts(body, mass, resolution, thickness)
-    uris = {part: mesh_uri(cached_stl(mesh, directory)) for part, mesh in parts.items()}
+    uris = {part: uri(cached_stl(mesh, directory)) for part, mesh in parts.items()}
     return robot_description(body, mass, body_frame, uris, robot_name=robot_name)
