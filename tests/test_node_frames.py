@@ -32,7 +32,9 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
-pytestmark = pytest.mark.ros
+# yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
+pytestmark = [pytest.mark.ros,
+              pytest.mark.filterwarnings('ignore:.*Scene.dump.*:DeprecationWarning')]
 
 REPO = Path(__file__).resolve().parents[1]
 DOMAIN = 32
@@ -206,17 +208,31 @@ def test_tf_matches_pose_and_latched_topics_reach_late_joiners(client):
                             {stamp_ns(m.header): m for m in got['rolling_state']}, static)
     # robot_description: a URDF whose links are the body and its two disks
     (description,) = descriptions
-    assert_urdf(description.data, 'twodisk_body')
+    assert_urdf(description.data, 'twodisk_body', static)
 
 
-def assert_urdf(text, body_frame):
-    robot = ElementTree.fromstring(text)
-    assert robot.tag == 'robot'
-    links = {link.get('name') for link in robot.findall('link')}
-    assert {body_frame, body_frame + '_disk_a', body_frame + '_disk_b'} <= links
-    joints = {j.find('child').get('link'): j.find('parent').get('link')
-              for j in robot.findall('joint')}
-    assert joints[body_frame + '_disk_a'] == joints[body_frame + '_disk_b'] == body_frame
+def assert_urdf(text, body_frame, static=None, mass=1.0):
+    """The URDF as yourdfpy reads it: the body link with the run's mass and its meshes on
+    disk; the disk links on fixed joints placed as the /tf_static transforms (if given)."""
+    import io
+    from urllib.parse import unquote, urlparse
+    import yourdfpy
+    robot = yourdfpy.URDF.load(io.StringIO(text), build_scene_graph=False,
+                               load_meshes=False).robot
+    links = {link.name: link for link in robot.links}
+    assert set(links) == {body_frame, body_frame + '_disk_a', body_frame + '_disk_b'}
+    assert links[body_frame].inertial.mass == mass
+    meshes = [visual.geometry.mesh.filename for visual in links[body_frame].visuals]
+    assert meshes and all(Path(unquote(urlparse(uri).path)).is_file() for uri in meshes)
+    joints = {j.child: j for j in robot.joints}
+    for suffix in ('_disk_a', '_disk_b'):
+        joint = joints[body_frame + suffix]
+        assert (joint.type, joint.parent) == ('fixed', body_frame)
+        if static is not None:
+            parent, translation, axes = static[body_frame + suffix]
+            np.testing.assert_array_equal(joint.origin[:3, 3], translation)
+            # rpy → matrix in float64: the 0/±1 entries to a few ulp
+            np.testing.assert_allclose(joint.origin[:3, :3], axes, rtol=0, atol=1e-15)
     return robot
 
 
@@ -261,7 +277,7 @@ def test_changes_resend_what_they_alter_and_nothing_else(client):
         assert call(executor, setter, Parameter('body_frame', value='oloid')).successful
         assert spin_until(executor, lambda: len(statics) == 3 and len(descriptions) == 3)
         assert set(static_frames(statics[-1])) == {'oloid_disk_a', 'oloid_disk_b'}
-        assert_urdf(descriptions[-1].data, 'oloid')
+        assert_urdf(descriptions[-1].data, 'oloid', static_frames(statics[-1]))
         tfs.clear()
         assert spin_until(executor, lambda: len(tfs) >= 5)
         assert all(m.transforms[0].child_frame_id == 'oloid' for m in tfs[1:])
@@ -337,7 +353,7 @@ def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
     assert {t.child_frame_id: t.header.frame_id for t in static.transforms} == {
         'oloid_disk_a': 'oloid', 'oloid_disk_b': 'oloid'}
     (_, description), = got['/robot_description']
-    assert_urdf(description.data, 'oloid')
+    assert_urdf(description.data, 'oloid', static_frames(static))
     # mcap-ros2-support, and the parameters in the metadata
     recording = read_recording(target, decode=lambda topic: topic in (
         '/tf', '/tf_static', '/robot_description'))

@@ -10,9 +10,9 @@ bytes at that stamp, before the sample's messages.
   ``body_frame``, children ``{body_frame}_disk_a`` (disk 1, contact A) and
   ``{body_frame}_disk_b`` (disk 2, contact B): each disk's centre and plane
   (:mod:`twodisk_ros.model.frames`). They change with ``delta`` and ``body_frame``.
-- ``robot_description`` (std_msgs/String): the URDF of :mod:`twodisk_ros.model.urdf`. It
-  changes with the shape (a, b, delta), the mass model (mass, mass_model,
-  principal_moments) and ``body_frame``.
+- ``robot_description`` (std_msgs/String): the URDF of :mod:`twodisk_ros.model.urdf` with
+  its meshes (binary STL in the mesh cache, ``file://`` URIs). It changes with the shape
+  (a, b, delta), the mass model (mass, mass_model, principal_moments) and ``body_frame``.
 
 "Alters" is judged on the content itself (the transforms, the URDF text), so a change that
 leaves it equal sends nothing. A renamed ``body_frame`` leaves the old static frames in the
@@ -32,7 +32,7 @@ from tf2_msgs.msg import TFMessage
 
 from ..io import cdr
 from ..model.frames import disk_frames
-from ..model.urdf import robot_description
+from ..model.urdf import body_description
 from . import messages
 
 __all__ = ['DESCRIPTION_TOPIC', 'LATCHED_QOS', 'TF_QOS', 'TF_STATIC_TOPIC', 'TF_TOPIC',
@@ -63,12 +63,15 @@ class Description:
 def describe(settings, body):
     """The :class:`Description` of checked ``settings`` and their ``TwoDiskBody``.
 
-    Raises ValueError or RuntimeError (one line) if the URDF cannot be made.
+    The URDF's meshes are written to the mesh cache if missing
+    (:func:`~twodisk_ros.model.urdf.body_description`); raises ValueError (one line,
+    :class:`~twodisk_ros.outputs.OutputError`) if the cache cannot be written.
     """
     frames = tuple((f.parent_frame_id, f.child_frame_id, tuple(map(float, f.translation)),
                     tuple(map(float, f.quaternion)))
                    for f in disk_frames(body, settings.body_frame))
-    return Description(static=frames, urdf=robot_description(settings, body))
+    urdf = body_description(body, settings.mass_properties(), settings.body_frame)
+    return Description(static=frames, urdf=urdf)
 
 
 def _static_message(static, stamp_ns):

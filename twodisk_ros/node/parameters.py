@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields, make_dataclass, replace
 import math
 import re
 
+from ..model.frames import DISK_SUFFIXES, check_frame_id
 from ..physics.body import TwoDiskBody
 from ..physics.mass_models import MODELS, mass_properties
 from ..physics.motion import METHODS, MODES
@@ -22,8 +23,6 @@ from ..physics.motion import METHODS, MODES
 __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings',
            'markdown_table', 'parse_recorded']
 
-#: The disk frames' names are body_frame + these (as in twodisk_ros.model.frames).
-DISK_SUFFIXES = ('_disk_a', '_disk_b')
 B_OVER_A = (0.01, 100.0)             # allowed b/a
 DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
 
@@ -186,14 +185,14 @@ def _check_together(s):
 def _check_body_frame(body_frame, frame_id):
     """The body's frame names are usable tf2 frame ids below ``frame_id``; else ValueError.
 
-    tf2 refuses an empty frame id and one with a leading ``/``; a space breaks the URDF's
-    names and the tools that take frames on a command line; a name equal to ``frame_id``
-    would make the world frame its own child (a loop in the TF tree).
+    tf2 refuses an empty frame id and one with a leading ``/``; a space breaks the tools that
+    take frames on a command line, a control character the message (CDR strings end at NUL);
+    a name equal to ``frame_id`` would make the world frame its own child (a loop in the TF
+    tree). :func:`twodisk_ros.model.frames.check_frame_id` is the rule the URDF applies.
     """
-    if (not body_frame or re.search(r'\s', body_frame) or not body_frame.isprintable()
-            or body_frame.startswith('/')):
-        raise ValueError('body_frame must be a non-empty frame name without spaces, control '
-                         f'characters or a leading "/", got {body_frame!r}')
+    check_frame_id(body_frame)
+    if not body_frame.isprintable():
+        raise ValueError(f'body_frame must not hold control characters, got {body_frame!r}')
     names = (body_frame,) + tuple(body_frame + suffix for suffix in DISK_SUFFIXES)
     if frame_id in names:
         raise ValueError(f'body_frame must differ from frame_id: the body\'s frames '
