@@ -6,13 +6,21 @@ message sizes, the ``mcap`` writer's own ``add_message`` rate (the floor the nod
 and ``rclpy.serialization.serialize_message`` (the old per-message path) are measured.
 
 Real time: the node runs as a process (as users run it) with recording on, while a
-subscriber in this process takes every topic; at the subscriber, the inter-arrival times of
+subscriber in this process takes every topic (``/tf``, ``/clock`` and the latched
+``/tf_static`` and ``robot_description`` too); at the subscriber, the inter-arrival times of
 ``/pose`` (p50, p99), the achieved rate and the lag of arrival behind the stamp; from the
-node's last ``/diagnostics``, its own achieved rate and the samples it dropped.
+node's last ``/diagnostics``, its own achieved rate and the samples it dropped; from
+``/proc``, the node's CPU time per wall second.
+
+The cost of ``/tf``: the node builds and publishes it only for a subscriber or a recording,
+so the same run with and without a ``/tf`` subscriber (recording off) shows what it adds:
+in real time as the node's CPU share (:func:`realtime_rate` with ``tf`` off and on), and in
+a batch run as wall time per sample (:func:`batch_tf_cost`, in process, runs alternated).
 """
 
 from dataclasses import asdict, dataclass
 import io
+import math
 import os
 import struct
 import subprocess
@@ -76,6 +84,74 @@ def _serialize_rate(count=20000):
     return count / (time.perf_counter() - start)
 
 
+def _listen(node, topics, callbacks=None):
+    """Raw subscriptions of ``node`` to ``topics`` ({name: type}) with the publishers' QoS."""
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from twodisk_ros.node.frames_publisher import LATCHED_QOS, TYPES
+    callbacks = callbacks or {}
+    for topic, kind in topics.items():
+        qos = (QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+               if topic == '/clock' else LATCHED_QOS if topic in TYPES else 1000)
+        node.create_subscription(kind, topic, callbacks.get(topic, lambda data: None), qos,
+                                 raw=True)
+
+
+def every_topic(tf=True):
+    """{topic: type} of everything the node publishes (``/tf`` left out if not ``tf``)."""
+    from rosgraph_msgs.msg import Clock
+    from twodisk_ros.node.frames_publisher import TYPES
+    from twodisk_ros.node.roller import TOPIC_TYPES
+    topics = dict(TOPIC_TYPES, **TYPES)
+    topics['/clock'] = Clock
+    if not tf:
+        del topics['/tf']
+    return topics
+
+
+def batch_tf_cost(rate=1000.0, duration=20.0, repeats=5):
+    """Time per sample (µs) of ``run_batch`` without and with a /tf subscriber.
+
+    In process, no recording, a listener node in the same context subscribed to every other
+    topic (never spun: the node's cost is publishing, not the listener's); best of
+    ``repeats`` alternated runs each, as wall time and as CPU time of this process (all
+    threads, DDS's included: less disturbed by other processes on a shared machine).
+    Returns {'off': µs, 'on': µs, 'cpu_off': µs, 'cpu_on': µs, 'samples': n}.
+    """
+    import rclpy
+    from rclpy.parameter import Parameter
+    from twodisk_ros.node.roller import Roller
+    best = {}
+    for _ in range(repeats):
+        for tf in (False, True):
+            context = rclpy.Context()
+            rclpy.init(context=context, domain_id=int(DOMAIN))
+            try:
+                listener = rclpy.create_node('bench_listener', context=context)
+                topics = every_topic(tf)
+                _listen(listener, topics)
+                node = Roller(context=context, parameter_overrides=[
+                    Parameter('realtime', value=False), Parameter('rate', value=float(rate)),
+                    Parameter('duration', value=float(duration))])
+                deadline = time.monotonic() + 30.0
+                while not all(node.count_subscribers(t) for t in topics if t in (
+                        '/tf', 'pose')) and time.monotonic() < deadline:
+                    time.sleep(0.01)            # discovery in this process
+                start, cpu = time.perf_counter(), time.process_time()
+                node.run_batch()
+                samples = node.samples_published
+                per_sample = (time.perf_counter() - start) / samples * 1e6
+                cpu_per_sample = (time.process_time() - cpu) / samples * 1e6
+                node.destroy_node()
+                listener.destroy_node()
+            finally:
+                rclpy.try_shutdown(context=context)
+            for key, value in (('on' if tf else 'off', per_sample),
+                               ('cpu_on' if tf else 'cpu_off', cpu_per_sample)):
+                best[key] = min(best.get(key, math.inf), value)
+    best['samples'] = samples
+    return best
+
+
 def batch_rate(rate=1000.0, duration=300.0):
     """Record ``duration`` s at ``rate`` Hz in process; the floors in the same run."""
     import rclpy
@@ -118,26 +194,39 @@ class RealtimeRate:
     node_achieved_hz: float   #: from the node's last /diagnostics
     dropped: int              #: samples the node dropped to keep real time
     level: int                #: its diagnostics level (0 OK, 1 WARN, 2 ERROR)
+    node_cpu: float = math.nan   #: the node's CPU seconds per wall second (1 = one core)
+    tf: bool = True           #: /tf subscribed
+    record: bool = True       #: recording on
 
     def as_dict(self):
         return asdict(self)
 
 
-def realtime_rate(rate, seconds=8.0, warmup=3.0):
-    """Run the node at ``rate`` Hz in real time, every topic subscribed and recording on."""
+def _cpu_seconds(pid):
+    """User + system CPU time (s) of a process so far, all its threads (/proc/PID/stat)."""
+    with open(f'/proc/{pid}/stat', encoding='ascii') as stat:
+        fields = stat.read().rsplit(')', 1)[1].split()   # from field 3 (state) on
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True):
+    """Run the node at ``rate`` Hz in real time, every topic subscribed and recording on.
+
+    ``tf=False`` leaves /tf unsubscribed and ``record=False`` the recording off: with both,
+    the node builds no /tf (the "off" side of the cost of /tf).
+    """
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from diagnostic_msgs.msg import DiagnosticArray
     from rclpy.serialization import deserialize_message
-    from twodisk_ros.node.roller import TOPIC_TYPES
     with tempfile.TemporaryDirectory() as folder:
         env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID=DOMAIN,
                    PYTHONPATH=ROOT + os.pathsep + os.environ.get('PYTHONPATH', ''))
+        recording = ['-p', f'record:={os.path.join(folder, "rt.mcap")}'] if record else []
         process = subprocess.Popen(
             [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
              os.path.join(ROOT, 'config', 'oloid.yaml'), '-p', f'rate:={float(rate)}',
-             '-p', f'record:={os.path.join(folder, "rt.mcap")}'],
-            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+             *recording], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         context = rclpy.Context()
         rclpy.init(context=context, domain_id=int(DOMAIN))
         node = rclpy.create_node('bench_listener', context=context)
@@ -147,10 +236,8 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0):
             arrivals.append(time.time())
             sec, nanosec = struct.unpack_from('<iI', data, 4)   # header stamp after CDR header
             stamps.append(sec + 1e-9 * nanosec)
-        for topic, kind in TOPIC_TYPES.items():   # raw: the listener must not be the bottleneck
-            callback = (on_pose if topic == 'pose' else diagnostics.append
-                        if kind is DiagnosticArray else (lambda data: None))
-            node.create_subscription(kind, topic, callback, 1000, raw=True)
+        # raw: the listener must not be the bottleneck
+        _listen(node, every_topic(tf), {'pose': on_pose, '/diagnostics': diagnostics.append})
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         try:
@@ -160,19 +247,23 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0):
                 if time.monotonic() > end + 30:
                     raise RuntimeError('no pose received')
             first = len(arrivals)
+            cpu0, wall0 = _cpu_seconds(process.pid), time.monotonic()
             end = time.monotonic() + seconds
             while time.monotonic() < end:
                 executor.spin_once(timeout_sec=0.001)
+            node_cpu = (_cpu_seconds(process.pid) - cpu0) / (time.monotonic() - wall0)
         finally:
             process.send_signal(2)
             try:
-                process.wait(timeout=20)
+                err = process.communicate(timeout=20)[1].decode(errors='replace')
             finally:
                 if process.poll() is None:
                     process.kill()
             executor.shutdown()
             node.destroy_node()
             rclpy.try_shutdown(context=context)
+    if len(arrivals) - first < 2:
+        raise RuntimeError(f'no pose while measuring; the node said: {err[-2000:]}')
     t = np.array(arrivals[first:])
     s = np.array(stamps[first:])
     gaps = np.diff(t) * 1e3
@@ -186,12 +277,23 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0):
         lag_ms=float(np.mean(t - s) * 1e3),
         node_lag_ms=float(values.get('clock_lag', 'nan')) * 1e3,
         node_achieved_hz=float(values.get('achieved_rate', 'nan')),
-        dropped=int(float(values.get('samples_dropped', '0'))), level=level)
+        dropped=int(float(values.get('samples_dropped', '0'))), level=level,
+        node_cpu=node_cpu, tf=tf, record=record)
 
 
 if __name__ == '__main__':
     import argparse
-    argparse.ArgumentParser(description=__doc__.splitlines()[0] + ' Real time at 100 Hz, 1 kHz '
-                            'and 10 kHz (5 s each).').parse_args()
-    for hz in (100.0, 1000.0, 10000.0):
-        print(realtime_rate(hz, seconds=5.0, warmup=2.0))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] + ' Real time at '
+                                     '100 Hz, 1 kHz and 10 kHz (5 s each), then the cost of '
+                                     '/tf (1 kHz, off and on).')
+    parser.add_argument('--seconds', type=float, default=5.0,
+                        help='wall seconds measured per real-time run (default 5)')
+    parser.add_argument('--only-tf', action='store_true', help='only the cost of /tf')
+    options = parser.parse_args()
+    if not options.only_tf:
+        for hz in (100.0, 1000.0, 10000.0):
+            print(realtime_rate(hz, seconds=options.seconds, warmup=2.0))
+    for tf in (False, True):
+        print(realtime_rate(1000.0, seconds=options.seconds, warmup=2.0, tf=tf, record=False))
+    print('batch, µs per sample without and with /tf:',
+          batch_tf_cost(duration=max(2.0, 4 * options.seconds)))

@@ -3,7 +3,9 @@
 - full poses and positions per second against the independent reference (``targets.py``);
 - batch recording: the node's messages/s against the ``mcap`` writer's and rclpy's floors,
   measured side by side in one run (``node_rates.py``);
-- real time at 100 Hz, 1 kHz and 10 kHz (``node_rates.py``);
+- real time at 100 Hz, 1 kHz and 10 kHz, every topic subscribed and recording on
+  (``node_rates.py``);
+- the cost of ``/tf``: the same runs without and with a ``/tf`` subscriber (``node_rates.py``);
 - contact forces per second, and the cost of the solid mass model;
 - parameter sweeps on Dask (``sweep_rate.py``).
 """
@@ -15,7 +17,7 @@ import time
 
 import numpy as np
 
-from node_rates import batch_rate, realtime_rate
+from node_rates import batch_rate, batch_tf_cost, realtime_rate
 from targets import poses_throughput
 
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
@@ -71,6 +73,14 @@ def measure(builds, quick=False, log=print):
     for r in out['realtime']:
         log(f'   realtime {r.rate_hz:g} Hz: node {r.node_achieved_hz:.0f} Hz, lag '
             f'{r.node_lag_ms:.2f} ms, dropped {r.dropped}')
+    out['tf_cost'] = {
+        'batch': batch_tf_cost(duration=5.0 if quick else 20.0, repeats=2 if quick else 5),
+        'realtime': [realtime_rate(1000.0, seconds=3.0 if quick else 8.0, tf=tf, record=False)
+                     for tf in (False, True)]}
+    t = out['tf_cost']
+    log(f'   /tf cost: batch {t["batch"]["cpu_off"]:.1f} -> {t["batch"]["cpu_on"]:.1f} us CPU '
+        f'per sample; 1 kHz real time node CPU {t["realtime"][0].node_cpu:.2f} -> '
+        f'{t["realtime"][1].node_cpu:.2f}')
     out['forces'] = contact_force_rate(10**5 if quick else 10**6)
     out['solid'] = solid_hull_cost()
     log('   parameter sweeps on Dask (benchmarks/sweep_rate.py)')
@@ -85,6 +95,8 @@ def measure(builds, quick=False, log=print):
 def as_dict(out):
     return {'poses': [asdict(p) for p in out['poses']], 'batch': out['batch'].as_dict(),
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
+            'tf_cost': {'batch': out['tf_cost']['batch'],
+                        'realtime': [r.as_dict() for r in out['tf_cost']['realtime']]},
             'solid': out['solid'], 'sweep': out['sweep']}
 
 
@@ -132,20 +144,43 @@ def report_lines(out):
       f'{TARGET_FLOOR_SHARE:.0%} of the floor).\n')
     w('## Real time\n')
     w('`roller` as a process with `config/oloid.yaml`, recording on, every topic subscribed '
-      'by a listener process (raw subscriptions, so that the listener\'s own decoding is not '
+      'by a listener process (`/tf`, `/clock`, `/tf_static` and `robot_description` '
+      'included; raw subscriptions, so that the listener\'s own decoding is not '
       'measured). Node: its achieved rate, its lag (wall clock minus the time of the last '
-      'sample it published, mean) and the samples it dropped, from its `/diagnostics`. '
+      'sample it published, mean) and the samples it dropped, from its `/diagnostics`; its '
+      'CPU time per wall second (1 = one core, all its threads, from `/proc`). '
       'Listener: inter-arrival times of `/pose` (p50, p99) and the mean arrival time minus '
       'stamp; on this 2-core machine the Python listener shares the cores with the node, so '
       'its numbers include its own backlog.\n')
-    w('| rate (Hz) | node achieved (Hz) | node lag (ms) | dropped | diagnostics | '
+    w('| rate (Hz) | node achieved (Hz) | node lag (ms) | dropped | diagnostics | node CPU | '
       'listener p50 (ms) | listener p99 (ms) | listener lag (ms) |')
-    w('|---|---|---|---|---|---|---|---|')
+    w('|---|---|---|---|---|---|---|---|---|')
     levels = {0: 'OK', 1: 'WARN', 2: 'ERROR', -1: 'none'}
     for r in out['realtime']:
         w(f'| {r.rate_hz:g} | {r.node_achieved_hz:.0f} | {r.node_lag_ms:.2f} | {r.dropped} | '
-          f'{levels.get(r.level, r.level)} | {r.p50_ms:.2f} | {r.p99_ms:.2f} | '
-          f'{r.lag_ms:.1f} |')
+          f'{levels.get(r.level, r.level)} | {r.node_cpu:.2f} | {r.p50_ms:.2f} | '
+          f'{r.p99_ms:.2f} | {r.lag_ms:.1f} |')
+    w('')
+    t = out['tf_cost']
+    b = t['batch']
+    w('## The cost of /tf\n')
+    w('The node builds and publishes `/tf` only for a subscriber or a recording, so the same '
+      'run without and with a `/tf` subscriber (recording off, every other topic subscribed) '
+      'shows what it adds. Batch: `run_batch` in process at 1 kHz for '
+      f'{b["samples"]} samples, best of alternated runs, per sample, as wall time and as the '
+      'process\'s CPU time (less disturbed by the other processes of a shared machine). Real '
+      'time: the node as a process at 1 kHz, its CPU time per wall second.\n')
+    w('| | /tf off | /tf on | added |')
+    w('|---|---|---|---|')
+    w(f'| batch, wall per sample (µs) | {b["off"]:.1f} | {b["on"]:.1f} | '
+      f'{b["on"] - b["off"]:+.1f} |')
+    w(f'| batch, CPU per sample (µs) | {b["cpu_off"]:.1f} | {b["cpu_on"]:.1f} | '
+      f'{b["cpu_on"] - b["cpu_off"]:+.1f} |')
+    off, on = t['realtime']
+    w(f'| real time 1 kHz, node CPU (cores) | {off.node_cpu:.3f} | {on.node_cpu:.3f} | '
+      f'{on.node_cpu - off.node_cpu:+.3f} |')
+    w(f'| real time 1 kHz, node achieved (Hz), dropped | {off.node_achieved_hz:.0f}, '
+      f'{off.dropped} | {on.node_achieved_hz:.0f}, {on.dropped} | |')
     w('')
     f = out['forces']
     w('## Contact forces\n')
