@@ -1,0 +1,453 @@
+"""``twodisk-view``: a Foxglove WebSocket server of the rolling body, without ROS.
+
+Each test starts the command in its own process, with rclpy made unimportable (the whole
+path of the command must run without ROS), on a free port (``--port 0``, the port read from
+its first line), and reads it with the headless client of ``foxglove_client`` (``websockets``
+and ``google.protobuf``, nothing of twodisk_ros or foxglove-sdk). The values received are
+compared with the physics library called independently at the same times, or with the
+recording read by ``mcap_ros2``. The server is killed by its PID in a finally.
+
+The roller node (for the recording) runs with ROS_DOMAIN_ID 46, loopback discovery only.
+"""
+
+import math
+import os
+from pathlib import Path
+import queue
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from foxglove_client import SUBPROTOCOL, collect, refused, stamp_ns
+from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.contact_forces import ContactForceModel
+from twodisk_ros.physics.dynamics import RollingDynamics
+from twodisk_ros.physics.mass_models import mass_properties
+from twodisk_ros.physics.motion import simulate
+from twodisk_ros.plotting import palette
+
+REPO = Path(__file__).resolve().parents[1]
+TESTS = Path(__file__).resolve().parent
+ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='46',
+           PYTHONPATH=str(REPO))
+OLOID = REPO / 'config' / 'oloid.yaml'
+TOPICS = ('/tf', '/body', '/contact_segment', '/contact_forces', '/traces', '/parameters')
+#: Start-up (imports, tables, server) on a loaded 2-core machine: ~2 s measured, bound far above.
+READY_SECONDS = 90.0
+#: A stop (signal → server stopped → exit) takes well under a second; bound far above.
+STOP_SECONDS = 30.0
+#: "Floating precision": the same samples of the same motion, computed twice, agree to
+#: rounding: positions to this share of the body size, quaternions and directions to this.
+ROUNDING = 1e-12
+
+RUNNER = '''
+import sys
+class _Refuse:
+    def find_spec(self, name, path=None, target=None):
+        if name == 'rclpy' or name.startswith('rclpy.'):
+            raise ImportError('rclpy refused by the test')
+sys.meta_path.insert(0, _Refuse())
+sys.path.insert(0, {tests!r})
+import view_standin
+view_standin.install()
+from twodisk_ros.view.cli import main
+status = main(sys.argv[1:])
+imported = [name for name in ('rclpy', 'matplotlib') if name in sys.modules]
+if imported:
+    print('imported', imported, file=sys.stderr)
+    sys.exit(9)
+sys.exit(status)
+'''.format(tests=str(TESTS))
+
+
+class View:
+    """A ``twodisk-view`` process; ``port`` once it serves."""
+
+    def __init__(self, *args):
+        self.process = subprocess.Popen([sys.executable, '-c', RUNNER, *map(str, args)],
+                                        cwd=REPO, env=ENV, stdout=subprocess.PIPE,
+                                        stderr=subprocess.PIPE, text=True,
+                                        stdin=subprocess.DEVNULL)
+        self.lines = queue.Queue()
+        self.stdout = []
+        threading.Thread(target=self._read, daemon=True).start()
+        self.port = None
+
+    def _read(self):
+        for line in self.process.stdout:
+            self.stdout.append(line)
+            self.lines.put(line)
+        self.lines.put(None)
+
+    def wait_serving(self):
+        deadline = time.monotonic() + READY_SECONDS
+        while time.monotonic() < deadline:
+            try:
+                line = self.lines.get(timeout=max(0.0, deadline - time.monotonic()))
+            except queue.Empty:
+                break
+            if line is None:
+                break
+            if 'serving ws://127.0.0.1:' in line:
+                self.port = int(line.split('ws://127.0.0.1:')[1].split()[0])
+                return self.port
+        raise AssertionError(f'not serving: {"".join(self.stdout)}'
+                             f'{self.process.stderr.read() if self.process.poll() else ""}')
+
+    def wait_line(self, text):
+        deadline = time.monotonic() + READY_SECONDS
+        while time.monotonic() < deadline:
+            if any(text in line for line in self.stdout):
+                return
+            time.sleep(0.05)
+        raise AssertionError(f'no line with {text!r}: {"".join(self.stdout)}')
+
+    def stop(self, number=signal.SIGTERM):
+        os.kill(self.process.pid, number)
+        status = self.process.wait(timeout=STOP_SECONDS)
+        return status, self.process.stderr.read()
+
+    def kill(self):
+        if self.process.poll() is None:
+            os.kill(self.process.pid, signal.SIGKILL)
+            self.process.wait(timeout=STOP_SECONDS)
+
+
+def _oloid_parameters():
+    return yaml.safe_load(OLOID.read_text())['/**']['ros__parameters']
+
+
+def _library(p, t):
+    """Poses, contacts and ground forces of the parameters ``p`` at times ``t`` (s): the
+    physics library, called here independently of the command."""
+    body = TwoDiskBody(p['a'], p['b'], p['delta'])
+    mass = mass_properties(p['mass_model'], p['a'], p['b'], p['delta'], p['mass'])
+    dynamics = RollingDynamics(body, mass, p['gravity'])
+    motion = simulate(dynamics, t, mode=p['mode'], theta0=p['theta0'], branch=p['branch'],
+                      omega0=p['omega0'], method=p['method'], tolerance=p['tolerance'])
+    state = dynamics.cycle.state(motion.phase)
+    forces = ContactForceModel(dynamics).dynamic(motion.phase, motion.phase_rate)
+    return body, state, forces, mass.mass * p['gravity']
+
+
+def _rotation(q):
+    x, y, z, w = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def _vector(v):
+    return np.array([v.x, v.y, v.z])
+
+
+def _quaternion(q):
+    return np.array([q.x, q.y, q.z, q.w])
+
+
+def _colour(c):
+    return (c.r, c.g, c.b)
+
+
+def _live_enough(received):
+    return (received.count('/tf') >= 40 and all(received.count(t) for t in TOPICS)
+            and len(received.messages['/traces'][-1][1].entities[0].lines[0].points) >= 2)
+
+
+@pytest.fixture(scope='module')
+def live():
+    """A live oloid (config/oloid.yaml) and what a client received from it."""
+    view = View('--params-file', OLOID, '--port', 0)
+    try:
+        port = view.wait_serving()
+        received = collect(port, TOPICS, _live_enough, request_parameters=True)
+        status, stderr = view.stop(signal.SIGINT)
+        yield received, status, stderr, view
+    finally:
+        view.kill()
+
+
+def test_live_server_info_and_every_channel(live):
+    received, status, stderr, view = live
+    assert status == 0, stderr
+    assert received.server_info['name'] == 'twodisk-view'
+    assert {'time', 'parameters'} <= set(received.server_info['capabilities'])
+    assert set(received.channels) == set(TOPICS)
+    schemas = {t: c['schemaName'] for t, c in received.channels.items()}
+    assert schemas['/tf'] == 'foxglove.FrameTransforms'
+    assert all(schemas[t] == 'foxglove.SceneUpdate' for t in TOPICS[1:5])
+    assert received.channels['/parameters']['encoding'] == 'json'
+    assert all(received.count(t) > 0 for t in TOPICS), {t: received.count(t) for t in TOPICS}
+    assert 'stopped after' in ''.join(view.stdout)
+
+
+def test_live_transforms_equal_the_library_poses(live):
+    """Each world → body transform is the library's pose at the sample's time, the disk
+    frames put the disk rims on the body's outlines, and the stamps are the node's."""
+    received, *_ = live
+    p = _oloid_parameters()
+    run = received.messages['/parameters'][0][1]['run']
+    start, rate = run['start_stamp_ns'], run['rate']
+    assert rate == p['rate'] and run['frame_id'] == p['frame_id']
+    transforms = [m.transforms for _, m in received.messages['/tf']]
+    stamps = np.array([stamp_ns(tf[0].timestamp) for tf in transforms])
+    ticks = np.round((stamps - start) * rate / 1e9).astype(np.int64)
+    assert np.array_equal(stamps, start + np.round(ticks * (1e9 / rate)).astype(np.int64))
+    assert np.all(np.diff(ticks) >= 1)
+    assert [log for log, _ in received.messages['/tf']] == list(stamps)
+    body, state, _, _ = _library(p, ticks / rate)
+    size = body.size
+    for k, tf in enumerate(transforms):
+        world = tf[0]
+        assert (world.parent_frame_id, world.child_frame_id) == ('world', 'twodisk_body')
+        assert np.max(np.abs(_vector(world.translation) - state.position_g[k])) \
+            <= ROUNDING * size
+        assert np.max(np.abs(_rotation(_quaternion(world.rotation)) - state.rotation[k])) \
+            <= ROUNDING
+        assert abs(np.linalg.norm(_quaternion(world.rotation)) - 1) <= ROUNDING
+        disks = {d.child_frame_id: d for d in tf[1:]}
+        assert set(disks) == {'twodisk_body_disk_a', 'twodisk_body_disk_b'}
+        assert all(d.parent_frame_id == 'twodisk_body' for d in tf[1:])
+    # the rims x²/a² + y²/b² = 1, z = 0 of the disk frames lie on the body's disks:
+    # disk 1 in the plane e3 = 0 around (0, −Δ, 0), disk 2 in e1 = 0 around (0, Δ, 0)
+    s = np.linspace(0, 2 * math.pi, 17)
+    rim = np.stack([p['a'] * np.cos(s), p['b'] * np.sin(s), 0 * s], -1)
+    a, b, d = p['a'], p['b'], p['delta']
+    for name, (normal, along_a, centre) in {'twodisk_body_disk_a': (2, 0, -d),
+                                             'twodisk_body_disk_b': (0, 2, d)}.items():
+        frame = disks[name]
+        points = rim @ _rotation(_quaternion(frame.rotation)).T + _vector(frame.translation)
+        assert np.max(np.abs(points[:, normal])) <= ROUNDING * size
+        assert np.max(np.abs(((points[:, 1] - centre) / a) ** 2
+                             + (points[:, along_a] / b) ** 2 - 1)) <= ROUNDING
+    assert received.times and set(received.times) <= set(stamps) | {received.times[0]}
+
+
+def test_live_scene_contacts_forces_and_traces(live):
+    """The contact segment, the force arrows and the traces are the library's contacts and
+    ground forces at their stamps; the colours are the palette's."""
+    received, *_ = live
+    p = _oloid_parameters()
+    run = received.messages['/parameters'][0][1]['run']
+    start, rate = run['start_stamp_ns'], run['rate']
+
+    def tick(entity):
+        return round((stamp_ns(entity.timestamp) - start) * rate / 1e9)
+
+    segments = [m.entities[0] for _, m in received.messages['/contact_segment']]
+    arrows = [m.entities[0] for _, m in received.messages['/contact_forces']]
+    traces = [m.entities for _, m in received.messages['/traces']]
+    ticks = sorted({tick(e) for e in segments + arrows} | {tick(t[0]) for t in traces})
+    body, state, forces, weight = _library(p, np.array(ticks) / rate)
+    at = {k: i for i, k in enumerate(ticks)}
+    size = body.size
+    for segment in segments:
+        i = at[tick(segment)]
+        line = segment.lines[0]
+        ends = np.array([_vector(q) for q in line.points])
+        assert np.max(np.abs(ends - [state.contact_a[i], state.contact_b[i]])) <= ROUNDING * size
+        assert _colour(line.color) == pytest.approx(palette.rgb(palette.AB), abs=1e-7)
+    for entity in arrows:
+        i = at[tick(entity)]
+        assert len(entity.arrows) == 2
+        for arrow, point, force in zip(entity.arrows, (state.contact_a[i], state.contact_b[i]),
+                                       (forces.force_a[i], forces.force_b[i])):
+            start_point = _vector(arrow.pose.position)
+            direction = _rotation(_quaternion(arrow.pose.orientation))[:, 0]
+            length = arrow.shaft_length + arrow.head_length
+            assert np.max(np.abs(start_point - point)) <= ROUNDING * size
+            expected = force * size / weight
+            assert np.max(np.abs(direction * length - expected)) <= ROUNDING * size
+    for entities in traces:
+        i = at[tick(entities[0])]
+        ends = {e.id: _vector(e.lines[0].points[-1]) for e in entities}
+        colours = {e.id: _colour(e.lines[0].color) for e in entities}
+        assert np.max(np.abs(ends['trace_a'] - state.contact_a[i])) <= ROUNDING * size
+        assert np.max(np.abs(ends['trace_b'] - state.contact_b[i])) <= ROUNDING * size
+        assert np.max(np.abs(ends['trace_g'] - state.position_g[i])) <= ROUNDING * size
+        assert colours['trace_a'] == pytest.approx(palette.rgb(palette.A), abs=1e-7)
+        assert colours['trace_b'] == pytest.approx(palette.rgb(palette.B), abs=1e-7)
+
+
+def test_live_body_mesh_and_parameters(live):
+    received, *_ = live
+    p = _oloid_parameters()
+    update = received.messages['/body'][0][1]
+    entities = {e.id: e for e in update.entities}
+    mesh = entities['body']
+    assert mesh.frame_id == 'twodisk_body' and mesh.frame_locked
+    triangles = mesh.triangles[0]
+    vertices = np.array([_vector(q) for q in triangles.points])
+    faces = np.array(triangles.indices).reshape(-1, 3)
+    assert len(faces) > 0 and faces.min() >= 0 and faces.max() < len(vertices)
+    # every vertex is inside the body: within the hull of the disks' extent
+    assert np.max(np.abs(vertices[:, 1])) <= p['delta'] + p['a'] + 1e-9
+    for rim_id, frame, colour in (('rim_a', 'twodisk_body_disk_a', palette.A),
+                                  ('rim_b', 'twodisk_body_disk_b', palette.B)):
+        rim = entities[rim_id]
+        assert rim.frame_id == frame and rim.frame_locked
+        points = np.array([_vector(q) for q in rim.lines[0].points])
+        assert np.max(np.abs((points[:, 0] / p['a']) ** 2 + (points[:, 1] / p['b']) ** 2 - 1)) \
+            <= ROUNDING
+        assert _colour(rim.lines[0].color) == pytest.approx(palette.rgb(colour), abs=1e-7)
+    shown = received.messages['/parameters'][0][1]['parameters']
+    for name, value in p.items():
+        assert shown[name] == value, name
+    assert received.parameters, 'no answer to getParameters'
+    served = {q['name']: q['value'] for q in received.parameters[0]['parameters']}
+    assert served['a'] == p['a'] and served['mass_model'] == p['mass_model']
+
+
+def test_old_subprotocol_is_refused_and_the_sdk_one_accepted():
+    view = View('--params-file', OLOID, '--port', 0)
+    try:
+        port = view.wait_serving()
+        assert refused(port, 'foxglove.websocket.v1') == 400
+        assert refused(port, SUBPROTOCOL) is None
+        assert view.stop()[0] == 0
+    finally:
+        view.kill()
+
+
+def _recording(tmp_path, duration=2.0):
+    out = tmp_path / 'run.mcap'
+    made = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file', str(OLOID),
+         '-p', 'realtime:=false', '-p', f'duration:={duration}', '-p', f'record:={out}'],
+        cwd=REPO, env=ENV, capture_output=True, text=True, timeout=300)
+    assert made.returncode == 0, made.stderr
+    return out
+
+
+def _recorded_poses(path):
+    """{stamp ns: (G, q)} of /pose, read with mcap_ros2 (not the package's reader)."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    poses = {}
+    with open(path, 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for _, channel, _, msg in reader.iter_decoded_messages(topics=['/pose']):
+            stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+            p, q = msg.pose.position, msg.pose.orientation
+            poses[stamp] = (np.array([p.x, p.y, p.z]), np.array([q.x, q.y, q.z, q.w]))
+    return poses
+
+
+def test_replay_transforms_equal_the_recording(tmp_path):
+    """Replayed transforms carry the recorded poses and stamps, bit for bit."""
+    recording = _recording(tmp_path)
+    poses = _recorded_poses(recording)
+    view = View(recording, '--port', 0, '--speed', 0.5)
+    try:
+        port = view.wait_serving()
+        received = collect(port, TOPICS, lambda r: r.count('/tf') >= 50
+                           and r.count('/contact_forces') and r.count('/parameters'))
+        status, stderr = view.stop()
+    finally:
+        view.kill()
+    assert status == 0, stderr
+    assert received.count('/tf') >= 50
+    for log_time, message in received.messages['/tf']:
+        world = message.transforms[0]
+        stamp = stamp_ns(world.timestamp)
+        assert stamp == log_time and stamp in poses
+        position, quaternion = poses[stamp]
+        assert np.array_equal(_vector(world.translation), position)
+        assert np.array_equal(_quaternion(world.rotation), quaternion)
+    run = received.messages['/parameters'][0][1]['run']
+    assert run['start_stamp_ns'] == min(poses) and str(recording) in run['source']
+
+
+def _one_line_refusal(*args):
+    result = subprocess.run([sys.executable, '-c', RUNNER, *map(str, args)], cwd=REPO, env=ENV,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 2, (result.returncode, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('twodisk-view: '), result.stderr
+    assert 'Traceback' not in result.stderr
+    return lines[0]
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path):
+    missing = tmp_path / 'missing.mcap'
+    assert 'missing.mcap' in _one_line_refusal(missing)
+    text = tmp_path / 'text.mcap'
+    text.write_text('not a recording\n')
+    assert 'not an MCAP file' in _one_line_refusal(text)
+    assert 'delta/a' in _one_line_refusal('--delta', 0.2, '--port', 0)
+    bad_file = tmp_path / 'bad.yaml'
+    bad_file.write_text('/**:\n  ros__parameters:\n    a: [1\n')
+    assert 'bad.yaml' in _one_line_refusal('--params-file', bad_file, '--port', 0)
+    assert 'loopback' in _one_line_refusal('--host', '192.0.2.1')
+    assert '--speed' in _one_line_refusal('--speed', 0)
+    assert '--port' in _one_line_refusal('--port', 70000)
+    assert 'rate' in _one_line_refusal('--rate', 5000.0, '--port', 0)
+    assert 'applies to simulated runs' in _one_line_refusal(text, '--a', 0.2)
+
+
+def test_a_port_in_use_is_refused():
+    with socket.socket() as taken:
+        taken.bind(('127.0.0.1', 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert 'in use' in _one_line_refusal('--port', port)
+
+
+@pytest.mark.parametrize('number', [signal.SIGINT, signal.SIGTERM])
+def test_signal_stops_the_server_and_frees_the_port(number):
+    view = View('--params-file', OLOID, '--port', 0)
+    try:
+        port = view.wait_serving()
+        received = collect(port, ['/tf'], lambda r: r.count('/tf') >= 5)
+        assert received.count('/tf') >= 5
+        status, stderr = view.stop(number)
+        assert status == 0, stderr
+        assert 'stopped after' in ''.join(view.stdout)
+        with socket.socket() as again:       # the port is free: nobody listens on it
+            again.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)   # as servers do
+            again.bind(('127.0.0.1', port))
+            again.listen()
+    finally:
+        view.kill()
+
+
+def _wait_for_handlers(pid, timeout=READY_SECONDS):
+    """Wait until the process catches SIGTERM (its handlers are in: /proc/PID/status)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        with open(f'/proc/{pid}/status', encoding='ascii') as status:
+            caught = next(int(line.split()[1], 16) for line in status
+                          if line.startswith('SigCgt:'))
+        if caught & (1 << (signal.SIGTERM - 1)):
+            return
+        time.sleep(0.002)
+    raise AssertionError(f'no SIGTERM handler within {timeout} s')
+
+
+def test_signal_before_serving_exits_0():
+    """A signal during start-up (the costliest body's tables: 2-4 s) ends the command at
+    once, exit 0, without serving."""
+    view = View('--port', 0, '--a', 0.1, '--b', 0.001, '--delta', 0.0001, '--theta0', 0.0)
+    try:
+        _wait_for_handlers(view.process.pid)
+        status, stderr = view.stop(signal.SIGTERM)
+        assert status == 0, stderr
+        assert not any('serving' in line for line in view.stdout)
+    finally:
+        view.kill()
+
+
+def test_help_states_the_protocol_and_the_viewers(tmp_path):
+    result = subprocess.run([sys.executable, '-m', 'twodisk_ros.view', '--help'], cwd=tmp_path,
+                            env=ENV, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0
+    text = ' '.join(result.stdout.split())
+    assert 'foxglove.sdk.v1' in text and 'Lichtblick 1.22.0' in text
+    assert 'foxglove.websocket.v1' in text and list(tmp_path.iterdir()) == []
