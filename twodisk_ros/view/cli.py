@@ -32,11 +32,13 @@ MAX_RATE = 1000.0
 MAX_SPEED, MIN_SPEED = 100.0, 0.01
 #: The body frame when the node's parameters do not name one.
 DEFAULT_BODY_FRAME = 'twodisk_body'
-#: Options of a simulated run: (name, type); the node's parameters of the same names.
-SIMULATION_OPTIONS = (('a', float), ('b', float), ('delta', float), ('theta0', float),
-                      ('branch', int), ('omega0', float), ('mass', float), ('gravity', float),
-                      ('friction', float), ('rate', float), ('duration', float),
-                      ('path_length', int))
+#: Options of a simulated run: (name, type, unit); the node's parameters of these names.
+SIMULATION_OPTIONS = (('a', float, 'm'), ('b', float, 'm'), ('delta', float, 'm'),
+                      ('theta0', float, 'rad'), ('branch', int, '+1 or -1'),
+                      ('omega0', float, 'rad/s'), ('mass', float, 'kg'),
+                      ('gravity', float, 'm/s^2'), ('friction', float, 'mu; .inf: no limit'),
+                      ('rate', float, 'Hz'), ('duration', float, 's; 0: until stopped'),
+                      ('path_length', int, 'samples in each trace'))
 CHOICE_OPTIONS = (('mode', ('dynamic', 'kinematic')),
                   ('mass_model', ('laminae', 'solid', 'custom')),
                   ('method', ('direct', 'table')))
@@ -70,10 +72,10 @@ class _Parser(argparse.ArgumentParser):
 
 def _parser():
     parser = _Parser(prog=PROG, formatter_class=argparse.RawDescriptionHelpFormatter,
-                     description='Serve a rolling run (the library in real time, or an MCAP '
-                     'recording) to Foxglove over its WebSocket protocol: the body, its '
-                     'frames, the contact segment, the traces and the ground forces. No '
-                     'ROS needed.', epilog=EPILOG)
+                     description='Serve a rolling run (the library in real time, or an MCAP\n'
+                     'recording) to Foxglove over its WebSocket protocol: the body, its frames,\n'
+                     'the contact segment, the traces and the ground forces. No ROS needed.',
+                     epilog=EPILOG)
     parser.add_argument('recording', nargs='?', help='an MCAP recording of the roller node '
                         'to replay (omit to simulate with the parameters below)')
     parser.add_argument('--speed', type=float, default=1.0,
@@ -87,12 +89,12 @@ def _parser():
     parser.add_argument('--allow-remote', action='store_true',
                         help='serve on a non-loopback --host: anyone who reaches it can watch')
     group = parser.add_argument_group(
-        'simulated run', "the node's parameters (README, Parameters); a --params-file of the "
-        "node first, then these options; rate defaults to 100 Hz (at most "
-        f"{MAX_RATE:g} here), duration 0 = until stopped")
+        'simulated run', "the roller node's parameters (README, Parameters): a --params-file\n"
+        f"first, then these options; rate 100 Hz unless given (at most {MAX_RATE:g} here)")
     group.add_argument('--params-file', help='a parameter file of the roller node (YAML)')
-    for name, kind in SIMULATION_OPTIONS:
-        group.add_argument('--' + name.replace('_', '-'), dest=name, type=kind)
+    for name, kind, unit in SIMULATION_OPTIONS:
+        group.add_argument('--' + name.replace('_', '-'), dest=name, type=kind,
+                           metavar=name.upper(), help=unit)
     for name, choices in CHOICE_OPTIONS:
         group.add_argument('--' + name.replace('_', '-'), dest=name, choices=choices)
     return parser
@@ -116,7 +118,7 @@ def _check_args(args):
         raise _Refusal(f'--port must be 0 (any free port) to 65535, got {args.port}')
     if not (math.isfinite(args.speed) and MIN_SPEED <= args.speed <= MAX_SPEED):
         raise _Refusal(f'--speed must be in [{MIN_SPEED:g}, {MAX_SPEED:g}], got {args.speed!r}')
-    given = [name for name, _ in SIMULATION_OPTIONS + CHOICE_OPTIONS
+    given = [name for name, *_ in SIMULATION_OPTIONS + CHOICE_OPTIONS
              if getattr(args, name) is not None]
     if args.params_file is not None:
         given.insert(0, 'params_file')
@@ -128,7 +130,7 @@ def _check_args(args):
 def _settings(args):
     """The node's settings of a simulated run (the view is always paced by the clock)."""
     from ..plotting.runs import RunError, settings_from
-    values = {name: getattr(args, name) for name, _ in SIMULATION_OPTIONS + CHOICE_OPTIONS}
+    values = {name: getattr(args, name) for name, *_ in SIMULATION_OPTIONS + CHOICE_OPTIONS}
     settings = settings_from(args.params_file, realtime=True, **values)
     if settings.rate > MAX_RATE:
         raise RunError(f'rate must be <= {MAX_RATE:g} Hz for the view (every sample is a '
