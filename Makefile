@@ -10,9 +10,9 @@ export MPLBACKEND := Agg
 # where make demo writes (a test runs it into a temporary directory)
 OUT ?= out
 
-.PHONY: venv test demo figures bench clean
+.PHONY: venv foxglove-readers test demo figures bench clean
 
-venv: $(VENV)/.installed
+venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
 # The pinned requirements, then twodisk_ros itself (editable: the venv runs this checkout's
 # code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep` and
@@ -28,9 +28,28 @@ $(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
 	install -m 644 config/* $(VENV)/share/twodisk_ros/config/
 	touch $@
 
+# tf2_msgs/msg/TFMessage (for /tf) is not a wheel: tools/build_interfaces.py generates and
+# compiles it from interfaces/tf2_msgs with the rosidl tool chain pinned in requirements.txt
+# and installs it into .venv, once (needs gcc/g++ and the Python headers). On failure it says
+# in one line what is missing, installs nothing and names its log, .venv/tf2_msgs-build.log.
+TF2_MSGS := $(wildcard interfaces/tf2_msgs/*.xml interfaces/tf2_msgs/*.txt \
+                       interfaces/tf2_msgs/msg/*.msg)
+$(VENV)/.tf2_msgs: $(VENV)/.installed tools/build_interfaces.py $(TF2_MSGS)
+	@$(PY) tools/build_interfaces.py --prefix $(VENV) --stamp $@ \
+	    --log $(VENV)/tf2_msgs-build.log
+
+## Foxglove's own readers (Node.js: @mcap/core, @foxglove/rosmsg2-serialization), for the tests
+## that decode recordings as the Foxglove app does; versions pinned in the lock file.
+foxglove-readers: tests/foxglove/node_modules/.installed
+
+tests/foxglove/node_modules/.installed: tests/foxglove/package.json tests/foxglove/package-lock.json
+	@command -v npm >/dev/null || { echo "npm not found: install Node.js 18 or later (apt-get install nodejs npm)"; exit 2; }
+	cd tests/foxglove && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error
+	touch $@
+
 ## Run the whole test suite (what CI runs), one pytest worker per core. A test module stays
 ## on one worker: the modules whose nodes subscribe each use a ROS domain of their own.
-test: venv
+test: venv foxglove-readers
 	$(PY) -m pytest -n auto --dist loadfile
 
 ## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
@@ -52,4 +71,4 @@ bench: venv
 	$(PY) benchmarks/run_all.py --overwrite
 
 clean:
-	rm -rf $(VENV) out build install log .pytest_cache .hypothesis twodisk_ros.egg-info
+	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info

@@ -6,6 +6,7 @@
 - :mod:`~twodisk_ros.inspect.checks`: the checks and their tolerances;
 - :mod:`~twodisk_ros.inspect.forces`, :mod:`~twodisk_ros.inspect.force_checks`: contact forces
   from the poses (Newton–Euler) against the recorded wrenches, and the model's validity;
+- :mod:`~twodisk_ros.inspect.tf_check`: the body frame on /tf against the poses, bit for bit;
 - :mod:`~twodisk_ros.inspect.inspection`: :func:`inspect_recording`;
 - :mod:`~twodisk_ros.inspect.report`, :mod:`~twodisk_ros.inspect.cli`: output, command line.
 """

@@ -12,6 +12,8 @@ from which no channel, message or metadata can be read is not a recording
 (:class:`RecordingError`).  How much of the *run* was recovered (samples against ``duration``
 × ``rate``) is ``summary['run']`` (:mod:`twodisk_ros.inspect.completeness`); with it the
 checks give the verdict PASS, FAIL or INCOMPLETE (:mod:`twodisk_ros.inspect.results`).
+The body frame on ``/tf`` is checked against the poses by :mod:`twodisk_ros.inspect.tf_check`
+(not applicable to recordings without /tf).
 """
 
 import numpy as np
@@ -25,6 +27,7 @@ from .model import build_model
 from .results import Check, Inspection, json_ready
 from .series import (METADATA_NAME, TOPIC_TYPES, WRENCHES, extract_series, join_samples,
                      select_topics, topic_role)
+from .tf_check import is_tf_topic, tf_check
 
 __all__ = ['inspect_recording']
 
@@ -119,7 +122,8 @@ def inspect_recording(path):
     RecordingError
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
     """
-    recording = read_recording(path, decode=lambda topic: topic_role(topic) in _DECODED)
+    recording = read_recording(
+        path, decode=lambda topic: topic_role(topic) in _DECODED or is_tf_topic(topic))
     if recording.empty:
         raise RecordingError(f'cannot read recording {recording.path}: '
                              f'{_nothing_recovered(recording)}')
@@ -145,7 +149,10 @@ def inspect_recording(path):
     more, forces, force_series = _force_checks(series, samples, motion, model, parameters,
                                                recording.truncated)
     checks.extend(more)
+    more, tf_summary = tf_check(recording, series, parameters, stamp0)
+    checks.extend(more)
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
+    summary['tf'] = tf_summary
     summary['diagnostics'] = _diagnostics_summary(series)
     summary['contact_forces'] = forces
     diagnostics = series.get('diagnostics')

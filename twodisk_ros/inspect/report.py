@@ -131,6 +131,18 @@ def _force_lines(info):
             f'  {_extremes(info)}']
 
 
+def _tf_lines(info):
+    """The ``tf:`` line (nothing for a report without that summary)."""
+    if not info:
+        return []
+    if not info.get('recorded'):
+        return ['tf: not recorded, check not applicable (a recording made before /tf)']
+    if 'transforms' not in info:
+        return [f'tf: recorded on {info["topic"]} (not evaluated, see the checks)']
+    return [f'tf: {info["transforms"]} transforms {info["parent"]} → {info["child"]} on '
+            f'{info["topic"]}, {info["pose_stamps"]} pose stamps']
+
+
 def format_report(inspection):
     """The human-readable report of an :class:`Inspection` (several lines, no final newline)."""
     s = inspection.summary
@@ -191,6 +203,7 @@ def format_report(inspection):
     lines.append(f'samples: {s["samples"]} stamps shared by pose, contacts and rolling_state'
                  + (f' ({s["mode"]} mode)' if s['mode'] else ''))
     lines.extend(_force_lines(s.get('contact_forces')))
+    lines.extend(_tf_lines(s.get('tf')))
     lines.append('checks:')
     for check in inspection.checks:
         lines.append(f'  {check.status}  {check.name:<14} {_value(check.value, check.unit)} '

@@ -2,9 +2,9 @@
 
 The node's markers (disk outlines and fills, the contact line, force arrows) are plain
 geometry: a few hundred points each. Building them as rclpy objects costs a Python object
-per point; here each marker is laid out with :class:`~twodisk_ros.io.cdr.Layout` (zero
+per point; here each marker is laid out with :class:`~twodisk_ros.io.cdr_layout.Layout` (zero
 padding, exact length) and its points are written as one float64 block. The result is
-checked byte for byte against :func:`twodisk_ros.io.cdr.serialize` of the same markers in
+checked byte for byte against :func:`twodisk_ros.io.cdr_generic.serialize` of the same markers in
 the tests. Only numpy and the standard library are imported.
 """
 
@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from .cdr import ENCAPSULATION, Layout, stamp_columns
+from .cdr_layout import ENCAPSULATION, Layout, stamp_columns
 
 __all__ = ['MarkerSpec', 'encode_markers']
 

@@ -1,0 +1,118 @@
+"""Fixed CDR layouts: a template row of constant bytes and numeric columns, filled from numpy.
+
+Encoding (XCDR1 / plain CDR, little endian): the encapsulation header ``00 01 00 00``, then the
+payload, in which every primitive is aligned to its own size (``float64`` to 8, ``int32`` and
+``uint32`` to 4) relative to the start of the payload.  A string is a ``uint32`` length counting
+the terminating NUL, the UTF-8 bytes, and the NUL; a sequence is a ``uint32`` count then its
+elements.  A :class:`Layout` holds the constant bytes of a message whose strings and sequence
+lengths are fixed (header, string lengths, zero padding) and where each numeric field sits;
+:meth:`Layout.fill` writes a whole batch of messages as the rows of an ``(n, L)`` ``uint8``
+array through ``float64``/``int32`` views.  Only numpy and the standard library are imported.
+"""
+
+import struct
+
+import numpy as np
+
+__all__ = ['ENCAPSULATION', 'Layout', 'float_columns', 'split_rows', 'stamp_columns']
+
+#: CDR_LE encapsulation header (representation id 0x0001, options 0).
+ENCAPSULATION = b'\x00\x01\x00\x00'
+
+_NS = 1_000_000_000
+_SEC_MIN, _SEC_MAX = -2**31, 2**31 - 1
+
+
+class Layout:
+    """Byte layout of one message (or a part of one) with fixed lengths.
+
+    ``start`` is the payload offset (bytes after the encapsulation header) of the first byte;
+    alignment is relative to the payload start, so only ``start % 8`` matters.
+    """
+
+    def __init__(self, start=0, prefix=b''):
+        self.start = start
+        self.raw = bytearray(prefix)
+        self.fields = {}          # name -> (byte offset in raw, numpy dtype, element count)
+        self.offset = start - len(prefix)
+
+    def _align(self, size):
+        self.raw += bytes(-(self.offset + len(self.raw)) % size)
+
+    def u32(self, value):
+        self._align(4)
+        self.raw += struct.pack('<I', value)
+
+    def string(self, text):
+        data = text.encode('utf-8')
+        if b'\x00' in data:
+            raise ValueError(f'a CDR string cannot contain NUL: {text!r}')
+        self.u32(len(data) + 1)
+        self.raw += data + b'\x00'
+
+    def field(self, name, dtype, count=1):
+        dtype = np.dtype(dtype)
+        if count:
+            self._align(dtype.itemsize)
+        self.fields[name] = (len(self.raw), dtype, count)
+        self.raw += bytes(dtype.itemsize * count)
+
+    def header(self, frame_id, name='stamp'):
+        """std_msgs/Header: builtin_interfaces/Time (int32 sec, uint32 nanosec), frame_id."""
+        self.field(name, '<i4', 2)
+        self.string(frame_id)
+
+    def float64_sequence(self, name, count):
+        self.u32(count)
+        self.field(name, '<f8', count)
+
+    def pose(self, position='position', orientation='orientation'):
+        """geometry_msgs/Pose: Point (x, y, z), Quaternion (x, y, z, w), all float64."""
+        self.field(position, '<f8', 3)
+        self.field(orientation, '<f8', 4)
+
+    def fill(self, n, **columns):
+        """``(n, len(raw))`` uint8 array: the template in every row, the named columns set.
+
+        Each column is broadcast to ``(n, count)`` of the field's dtype.
+        """
+        rows = np.empty((n, len(self.raw)), np.uint8)
+        rows[...] = np.frombuffer(bytes(self.raw), np.uint8)
+        for name, values in columns.items():
+            offset, dtype, count = self.fields[name]
+            if count:
+                view = rows[:, offset:offset + dtype.itemsize * count].view(dtype)
+                view[...] = values          # broadcast to (n, count) by the assignment
+        return rows
+
+
+def split_rows(rows):
+    """One ``bytes`` per row of a 2-D ``uint8`` array (the messages of a batch)."""
+    rows = np.ascontiguousarray(rows)
+    size = rows.shape[1]
+    data = rows.tobytes()
+    return [data[i:i + size] for i in range(0, len(data), size)]
+
+
+def stamp_columns(stamps_ns, n=None):
+    """``(n, 2)`` int64 columns (sec, nanosec) from integer nanoseconds, range-checked."""
+    ns = np.asarray(stamps_ns)
+    if ns.dtype.kind not in 'iu' and ns.size:
+        raise TypeError(f'stamps must be integer nanoseconds, got dtype {ns.dtype}')
+    ns = ns.astype(np.int64).reshape(-1)
+    if n is not None and ns.size != n:
+        if ns.size != 1:
+            raise ValueError(f'{ns.size} stamps for {n} messages')
+        ns = np.repeat(ns, n)
+    sec, nanosec = np.divmod(ns, _NS)
+    if sec.size and (sec.min() < _SEC_MIN or sec.max() > _SEC_MAX):
+        raise ValueError('stamp out of the int32 seconds range of builtin_interfaces/Time')
+    return np.stack([sec, nanosec], axis=1)
+
+
+def float_columns(values, width, name):
+    """``values`` as a float64 ``(n, width)`` array, or ValueError naming ``name``."""
+    array = np.asarray(values, dtype=np.float64)
+    if array.ndim != 2 or array.shape[1] != width:
+        raise ValueError(f'{name} must have shape (n, {width}), got {array.shape}')
+    return array
