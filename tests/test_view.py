@@ -26,6 +26,7 @@ import pytest
 import yaml
 
 from foxglove_client import SUBPROTOCOL, collect, refused, stamp_ns
+from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.contact_forces import ContactForceModel
 from twodisk_ros.physics.dynamics import RollingDynamics
@@ -34,7 +35,6 @@ from twodisk_ros.physics.motion import simulate
 from twodisk_ros.plotting import palette
 
 REPO = Path(__file__).resolve().parents[1]
-TESTS = Path(__file__).resolve().parent
 ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='46',
            PYTHONPATH=str(REPO))
 OLOID = REPO / 'config' / 'oloid.yaml'
@@ -54,9 +54,6 @@ class _Refuse:
         if name == 'rclpy' or name.startswith('rclpy.'):
             raise ImportError('rclpy refused by the test')
 sys.meta_path.insert(0, _Refuse())
-sys.path.insert(0, {tests!r})
-import view_standin
-view_standin.install()
 from twodisk_ros.view.cli import main
 status = main(sys.argv[1:])
 imported = [name for name in ('rclpy', 'matplotlib') if name in sys.modules]
@@ -64,7 +61,7 @@ if imported:
     print('imported', imported, file=sys.stderr)
     sys.exit(9)
 sys.exit(status)
-'''.format(tests=str(TESTS))
+'''
 
 
 class View:
@@ -276,19 +273,19 @@ def test_live_scene_contacts_forces_and_traces(live):
         assert colours['trace_b'] == pytest.approx(palette.rgb(palette.B), abs=1e-7)
 
 
-def test_live_body_mesh_and_parameters(live):
-    received, *_ = live
-    p = _oloid_parameters()
-    update = received.messages['/body'][0][1]
+def _check_body(update, p, parts):
+    """The /body update: the mesh's parts as mesh_parts gives them, coloured as the URDF's,
+    in the body frame; the rims on x²/a² + y²/b² = 1 in the disk frames, blue and orange."""
     entities = {e.id: e for e in update.entities}
     mesh = entities['body']
     assert mesh.frame_id == 'twodisk_body' and mesh.frame_locked
-    triangles = mesh.triangles[0]
-    vertices = np.array([_vector(q) for q in triangles.points])
-    faces = np.array(triangles.indices).reshape(-1, 3)
-    assert len(faces) > 0 and faces.min() >= 0 and faces.max() < len(vertices)
-    # every vertex is inside the body: within the hull of the disks' extent
-    assert np.max(np.abs(vertices[:, 1])) <= p['delta'] + p['a'] + 1e-9
+    assert len(mesh.triangles) == len(parts)
+    colours = {'disk_a': palette.A, 'disk_b': palette.B, 'hull': palette.HULL}
+    for triangles, (name, part) in zip(mesh.triangles, parts.items()):
+        vertices = np.array([_vector(q) for q in triangles.points])
+        assert np.array_equal(vertices, part.vertices), name
+        assert np.array_equal(np.array(triangles.indices).reshape(-1, 3), part.faces), name
+        assert _colour(triangles.color) == pytest.approx(palette.rgb(colours[name]), abs=1e-7)
     for rim_id, frame, colour in (('rim_a', 'twodisk_body_disk_a', palette.A),
                                   ('rim_b', 'twodisk_body_disk_b', palette.B)):
         rim = entities[rim_id]
@@ -297,12 +294,34 @@ def test_live_body_mesh_and_parameters(live):
         assert np.max(np.abs((points[:, 0] / p['a']) ** 2 + (points[:, 1] / p['b']) ** 2 - 1)) \
             <= ROUNDING
         assert _colour(rim.lines[0].color) == pytest.approx(palette.rgb(colour), abs=1e-7)
+
+
+def test_live_body_mesh_and_parameters(live):
+    received, *_ = live
+    p = _oloid_parameters()
+    parts = mesh_parts(TwoDiskBody(p['a'], p['b'], p['delta']), p['mass_model'])
+    assert set(parts) == {'disk_a', 'disk_b'}
+    _check_body(received.messages['/body'][0][1], p, parts)
     shown = received.messages['/parameters'][0][1]['parameters']
     for name, value in p.items():
         assert shown[name] == value, name
     assert received.parameters, 'no answer to getParameters'
     served = {q['name']: q['value'] for q in received.parameters[0]['parameters']}
     assert served['a'] == p['a'] and served['mass_model'] == p['mass_model']
+
+
+def test_solid_body_is_the_grey_hull():
+    p = dict(_oloid_parameters(), mass_model='solid')
+    view = View('--params-file', OLOID, '--mass-model', 'solid', '--port', 0)
+    try:
+        port = view.wait_serving()
+        received = collect(port, ['/body'], lambda r: r.count('/body'))
+        assert view.stop()[0] == 0
+    finally:
+        view.kill()
+    parts = mesh_parts(TwoDiskBody(p['a'], p['b'], p['delta']), 'solid')
+    assert set(parts) == {'hull'}
+    _check_body(received.messages['/body'][0][1], p, parts)
 
 
 def test_old_subprotocol_is_refused_and_the_sdk_one_accepted():

@@ -166,7 +166,7 @@ def _refuse(error):
 
 def _serve(args, signals):
     from ..model.frames import disk_frames
-    from ..model.mesh import body_mesh
+    from ..model.mesh import mesh_parts
     from .player import Player
     from .server import SUBPROTOCOL, ViewServer, parameter_values
     from .sources import LiveSource, ReplaySource
@@ -177,7 +177,7 @@ def _serve(args, signals):
     settings = source.settings
     body_frame = getattr(settings, 'body_frame', DEFAULT_BODY_FRAME)
     disks = disk_frames(source.body, body_frame)
-    mesh = body_mesh(source.body, settings.mass_model)
+    parts = mesh_parts(source.body, settings.mass_model)
     parameters = parameter_values(settings)
     signals.serving = True          # from here on a signal only sets the flag
     server = ViewServer(args.host, args.port, parameters)
@@ -189,7 +189,7 @@ def _serve(args, signals):
                     'speed': args.speed, 'start_stamp_ns': source.start_ns,
                     'rate': settings.rate, 'forces': source.has_forces,
                     'subprotocol': SUBPROTOCOL}
-        player = Player(source, server, (settings.frame_id, body_frame), mesh, disks,
+        player = Player(source, server, (settings.frame_id, body_frame), parts, disks,
                         run_info, parameters, signals.stop)
         host = f'[{args.host}]' if ':' in args.host else args.host
         print(f'{PROG}: serving ws://{host}:{server.port} (subprotocol {SUBPROTOCOL}): '

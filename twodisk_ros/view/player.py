@@ -35,20 +35,20 @@ class Player:
     server : ViewServer
     frames : (str, str)
         The world frame ``frame_id`` and the body frame.
-    mesh : object with ``vertices`` and ``faces``
-        The body's mesh in the body frame (m).
+    parts : dict of str to Mesh
+        The body's mesh in parts (:func:`twodisk_ros.model.mesh.mesh_parts`), body frame (m).
     disks : pair of DiskFrame
         The disk frames relative to the body frame.
-    run_info : dict
-        What ``/parameters`` shows under ``run`` (with ``parameters`` under ``parameters``).
+    run_info, parameters : dict
+        What ``/parameters`` shows under ``run`` and under ``parameters``.
     stop : threading.Event
         Set to stop (by the signal handlers).
     """
 
-    def __init__(self, source, server, frames, mesh, disks, run_info, parameters, stop):
+    def __init__(self, source, server, frames, parts, disks, run_info, parameters, stop):
         self.source, self.server, self.stop = source, server, stop
         self.frame_id, self.body_frame = frames
-        self.mesh, self.disks = mesh, disks
+        self.parts, self.disks = parts, disks
         self.document = {'parameters': parameters, 'run': run_info}
         self.size = source.body.size
         self.traces = scene.Traces(source.settings.path_length)
@@ -62,7 +62,7 @@ class Player:
         stamp = self.last_stamp if self.last_stamp is not None else self.source.start_ns
         if '/body' in topics:
             self.server.log_scene('/body', scene.body_update(
-                stamp, self.body_frame, self.source.body, self.mesh, self.disks), stamp)
+                stamp, self.body_frame, self.source.body, self.parts, self.disks), stamp)
         if '/parameters' in topics:
             self.server.log_parameters(self.document, stamp)
 

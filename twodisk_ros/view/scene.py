@@ -20,7 +20,7 @@ from foxglove.messages import (ArrowPrimitive, Color, FrameTransform, FrameTrans
 
 from ..plotting import palette
 
-__all__ = ['Traces', 'body_update', 'color', 'contact_update', 'force_arrows', 'force_update',
+__all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows', 'force_update',
            'frame_transforms', 'timestamp', 'trace_update']
 
 #: Line width of the contact segment, the rims and the traces, as a share of the body size.
@@ -87,7 +87,19 @@ def _rim(a, b, points=RIM_POINTS):
     return [Point3(x=float(a * math.cos(v)), y=float(b * math.sin(v)), z=0.0) for v in s]
 
 
-def body_update(stamp_ns, body_frame, body, mesh, disks):
+#: Colours of the mesh's parts (:func:`twodisk_ros.model.mesh.mesh_parts`), as in the URDF.
+PART_COLOURS = {'disk_a': palette.A, 'disk_b': palette.B, 'hull': palette.HULL}
+
+
+def _surface(mesh, colour):
+    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1)
+    return TriangleListPrimitive(
+        pose=Pose(position=Vector3(), orientation=Quaternion(w=1.0)),
+        points=[_point(v) for v in np.asarray(mesh.vertices, dtype=float)],
+        color=color(colour, MESH_ALPHA), indices=[int(k) for k in faces])
+
+
+def body_update(stamp_ns, body_frame, body, parts, disks):
     """The body: its mesh in the body frame and the two rims in the disk frames.
 
     Each entity is ``frame_locked``, so it follows its frame as the transforms arrive and
@@ -97,20 +109,18 @@ def body_update(stamp_ns, body_frame, body, mesh, disks):
     ----------
     body : TwoDiskBody
         For the semi-axes a, b (m) of the rims.
-    mesh : object with ``vertices`` (n, 3) in m, body frame, and ``faces`` (m, 3) int
-        The body's surface (:func:`twodisk_ros.model.mesh.body_mesh`).
+    parts : dict of str to Mesh
+        The body's closed parts (``vertices`` (n, 3) in m, body frame; ``faces`` (m, 3)
+        int), as :func:`twodisk_ros.model.mesh.mesh_parts` gives them: the plates
+        ``disk_a`` (blue) and ``disk_b`` (orange), or the ``hull`` (grey).
     disks : pair of DiskFrame
         Disk 1 (A, blue) and disk 2 (B, orange).
     """
     stamp = timestamp(stamp_ns)
-    vertices = np.asarray(mesh.vertices, dtype=float)
-    faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1)
-    surface = TriangleListPrimitive(
-        pose=Pose(position=Vector3(), orientation=Quaternion(w=1.0)),
-        points=[_point(v) for v in vertices], color=color(palette.HULL, MESH_ALPHA),
-        indices=[int(k) for k in faces])
+    surfaces = [_surface(mesh, PART_COLOURS.get(name, palette.HULL))
+                for name, mesh in parts.items()]
     entities = [SceneEntity(timestamp=stamp, frame_id=body_frame, id='body', frame_locked=True,
-                            triangles=[surface])]
+                            triangles=surfaces)]
     width = LINE_WIDTH * body.size
     for disk, colour in zip(disks, (palette.A, palette.B)):
         rim = LinePrimitive(type=LinePrimitiveLineType.LineLoop,
