@@ -20,8 +20,8 @@ from foxglove.messages import (ArrowPrimitive, Color, FrameTransform, FrameTrans
 
 from ..plotting import palette
 
-__all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows', 'force_update',
-           'frame_transforms', 'timestamp', 'trace_update']
+__all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows',
+           'force_update', 'frame_transforms', 'timestamp', 'trace_update']
 
 #: Line width of the contact segment, the rims and the traces, as a share of the body size.
 LINE_WIDTH = 0.01
