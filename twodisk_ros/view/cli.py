@@ -20,7 +20,6 @@ import os
 import signal
 import sys
 import threading
-import time
 
 __all__ = ['DEFAULT_PORT', 'EPILOG', 'MAX_RATE', 'MAX_SPEED', 'main']
 
@@ -173,7 +172,7 @@ def _serve(args, signals):
     if args.recording is not None:
         source = ReplaySource(args.recording, speed=args.speed)
     else:
-        source = LiveSource(_settings(args), start_ns=time.time_ns(), speed=args.speed)
+        source = LiveSource(_settings(args), speed=args.speed)
     settings = source.settings
     body_frame = getattr(settings, 'body_frame', DEFAULT_BODY_FRAME)
     disks = disk_frames(source.body, body_frame)
@@ -186,7 +185,7 @@ def _serve(args, signals):
             return 0
         run_info = {'source': source.description, 'frame_id': settings.frame_id,
                     'body_frame': body_frame, 'disk_frames': [d.child_frame_id for d in disks],
-                    'speed': args.speed, 'start_stamp_ns': source.start_ns,
+                    'speed': args.speed, 'start_stamp_ns': None,
                     'rate': settings.rate, 'forces': source.has_forces,
                     'subprotocol': SUBPROTOCOL}
         player = Player(source, server, (settings.frame_id, body_frame), parts, disks,

@@ -101,9 +101,13 @@ class Player:
             stamp, self.frame_id, self.traces, self.size), stamp)
 
     def play(self):
-        """Show every sample when due; return True if the source ran out, False if stopped."""
-        self._static({'/body', '/parameters'})
+        """Show every sample when due; return True if the source ran out, False if stopped.
+
+        The static content goes to each client when it subscribes (:meth:`serve_subscriptions`).
+        """
+        self.source.start(time.time_ns())
         start = time.monotonic()
+        self.document['run']['start_stamp_ns'] = self.source.start_ns
         for block in self.source.blocks():
             traced = 0
             for i in range(len(block)):

@@ -56,20 +56,20 @@ class LiveSource:
     ----------
     settings : RollerSettings
         Checked settings (geometry, mass model, motion, ``rate``, ``duration``).
-    start_ns : int
-        The stamp of sample 0 (ns; the wall clock when the show starts).
     speed : float
         Simulated seconds per wall-clock second (> 0).
     """
 
     description = 'the library (simulated as it goes)'
 
-    def __init__(self, settings, *, start_ns, speed=1.0):
+    def __init__(self, settings, *, speed=1.0):
         self.settings = settings
         self.simulation = Simulation(settings)
         self.body = self.simulation.body
         self.weight = self.simulation.weight
-        self.start_ns, self.speed = int(start_ns), float(speed)
+        self.speed = float(speed)
+        #: the stamp of sample 0 (ns): the wall clock when the show starts (:meth:`start`)
+        self.start_ns = None
         rate, duration = settings.rate, settings.duration
         #: ticks 0 … last (None: until stopped), as the node publishes them
         self.last_tick = int(math.floor(duration * rate + 1e-9)) if duration > 0 else None
@@ -77,6 +77,10 @@ class LiveSource:
     @property
     def has_forces(self):
         return True
+
+    def start(self, now_ns):
+        """The show starts: sample 0 is stamped ``now_ns`` (the wall clock, ns)."""
+        self.start_ns = int(now_ns)
 
     def times(self, ticks):
         """Simulated times (s) of the ticks k: k / rate, as the node computes them."""
@@ -136,6 +140,9 @@ class ReplaySource:
     @property
     def start_ns(self):
         return int(self.run.stamp_ns[0])
+
+    def start(self, now_ns):
+        """The show starts (the recorded stamps are kept)."""
 
     def blocks(self, size=64):
         """The recording's samples in blocks of ``size``, due at (stamp − first) / speed."""
