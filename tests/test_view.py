@@ -487,3 +487,20 @@ def test_help_states_the_protocol_and_the_viewers(tmp_path):
     text = ' '.join(result.stdout.split())
     assert 'foxglove.sdk.v1' in text and 'Lichtblick 1.22.0' in text
     assert 'foxglove.websocket.v1' in text and list(tmp_path.iterdir()) == []
+
+
+def test_static_content_reaches_a_client_between_sparse_samples():
+    """With 20 s between samples, a client that subscribes just after a sample gets the body
+    and the parameters at once, not at the next sample (it waits 10 s at most)."""
+    view = View('--params-file', OLOID, '--rate', 0.05, '--port', 0)
+    try:
+        port = view.wait_serving()
+        first = collect(port, ['/tf'], lambda r: r.count('/tf'))   # a sample was just shown
+        assert first.count('/tf') == 1
+        received = collect(port, ['/body', '/parameters'],
+                           lambda r: r.count('/body') and r.count('/parameters'), timeout=10.0)
+        assert view.stop()[0] == 0
+    finally:
+        view.kill()
+    assert received.count('/body') and received.count('/parameters')
+    assert received.messages['/parameters'][0][1]['run']['rate'] == 0.05

@@ -21,7 +21,7 @@ SCENE_RATE = 60.0
 TRACE_RATE = 10.0
 #: Samples due longer ago than this (s) are skipped rather than shown late.
 MAX_LAG = 0.5
-#: While idle (after the run), how often new subscriptions are served (s).
+#: How often new subscriptions are served while waiting for a sample or idle (s).
 IDLE_POLL = 0.05
 
 
@@ -100,6 +100,16 @@ class Player:
         self.server.log_scene('/traces', scene.trace_update(
             stamp, self.frame_id, self.traces, self.size), stamp)
 
+    def _wait(self, due):
+        """Serve new subscriptions until the monotonic time ``due``; False if stopped."""
+        while True:
+            self.serve_subscriptions()
+            left = due - time.monotonic()
+            if left <= 0:
+                return not self.stop.is_set()
+            if self.stop.wait(min(left, IDLE_POLL)):
+                return False
+
     def play(self):
         """Show every sample when due; return True if the source ran out, False if stopped.
 
@@ -111,12 +121,7 @@ class Player:
         for block in self.source.blocks():
             traced = 0
             for i in range(len(block)):
-                self.serve_subscriptions()
-                due = start + float(block.due[i])
-                now = time.monotonic()
-                if now < due and self.stop.wait(due - now):
-                    return False
-                if self.stop.is_set():
+                if not self._wait(start + float(block.due[i])):
                     return False
                 clock = time.monotonic() - start
                 if clock - float(block.due[i]) > MAX_LAG and i + 1 < len(block):
