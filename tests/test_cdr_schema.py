@@ -157,3 +157,32 @@ def test_layouts_are_cached():
     b = cdr_schema.message_layout('sensor_msgs/msg/JointState', {'name': ('a', 'b')},
                                   {'position': 2})
     assert a is b
+
+
+def test_long_sequences_repeat_one_element_layout():
+    """1000 points, colours and uv coordinates: the repeated elements are addressable one by
+    one and as one column, and give rclpy's bytes."""
+    from geometry_msgs.msg import Point
+    from std_msgs.msg import ColorRGBA
+    from visualization_msgs.msg import Marker, UVCoordinate
+    rng = np.random.default_rng(3)
+    xyz = rng.normal(size=(1000, 3))
+    rgba = rng.random((1000, 4)).astype(np.float32)
+    marker = Marker(ns='n', id=7, points=[Point(x=a, y=b, z=c) for a, b, c in xyz.tolist()],
+                    colors=[ColorRGBA(r=float(r), g=float(g), b=float(b), a=float(a))
+                            for r, g, b, a in rgba],
+                    uv_coordinates=[UVCoordinate(u=float(u), v=float(v)) for u, v in rgba[:, :2]])
+    msg = MarkerArray(markers=[marker])
+    expected = check(msg)
+    assert built(msg) == expected           # element by element, names like points[637].y
+    layout = cdr_schema.message_layout(
+        'visualization_msgs/msg/MarkerArray', {'markers[0].ns': 'n'},
+        {'markers': 1, 'markers[0].points': 1000, 'markers[0].colors': 1000,
+         'markers[0].uv_coordinates': 1000})
+    whole = layout.fill(1, **{'markers[0].id': 7, 'markers[0].points': xyz.ravel(),
+                              'markers[0].colors': rgba.ravel(),
+                              'markers[0].uv_coordinates': rgba[:, :2].ravel()})
+    assert whole.tobytes() == expected
+    assert layout.block('markers[0].points')[2] == 3000
+    with pytest.raises(KeyError):
+        layout.block('markers[0].points[1000].x')

@@ -182,8 +182,25 @@ class _Walk:
             for k in range(count):
                 self.string(field, constant[k] if constant is not None else '')
         else:
-            for k in range(count):
-                self.message(field.type, f'{path}[{k}].')
+            self.messages(field.type, path, count)
+
+    def messages(self, type_name, path, count):
+        """A sequence or array of messages. From the third element on, if the second one's
+        size is a multiple of 8 (so every later element starts at the same offset modulo 8)
+        and no constant or count names an element, the elements repeat the second one's
+        bytes: a Marker's thousand points cost one walk of geometry_msgs/Point, not 1000."""
+        specific = any(key.startswith(path + '[') for key in (*self.constants, *self.counts))
+        layout = self.layout
+        for k in range(min(count, 2)):
+            begin = len(layout.raw)
+            self.message(type_name, f'{path}[{k}].')
+        if count <= 2:
+            return
+        if specific or (len(layout.raw) - begin) % 8:
+            for k in range(2, count):
+                self.message(type_name, f'{path}[{k}].')
+        else:
+            layout.repeat(begin, count - 2, path)
 
 
 def _frozen(table):
