@@ -12,7 +12,7 @@ OUT ?= out
 
 .PHONY: venv foxglove-readers test demo figures bench clean
 
-venv: $(VENV)/.installed
+venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
 # The pinned requirements, then twodisk_ros itself (editable: the venv runs this checkout's
 # code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep` and
@@ -27,6 +27,16 @@ $(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
 	install -m 644 package.xml $(VENV)/share/twodisk_ros/
 	install -m 644 config/* $(VENV)/share/twodisk_ros/config/
 	touch $@
+
+# tf2_msgs/msg/TFMessage (for /tf) is not a wheel: tools/build_interfaces.py generates and
+# compiles it from interfaces/tf2_msgs with the rosidl tool chain pinned in requirements.txt
+# and installs it into .venv, once (needs gcc/g++ and the Python headers). On failure it says
+# in one line what is missing, installs nothing and names its log, .venv/tf2_msgs-build.log.
+TF2_MSGS := $(wildcard interfaces/tf2_msgs/*.xml interfaces/tf2_msgs/*.txt \
+                       interfaces/tf2_msgs/msg/*.msg)
+$(VENV)/.tf2_msgs: $(VENV)/.installed tools/build_interfaces.py $(TF2_MSGS)
+	@$(PY) tools/build_interfaces.py --prefix $(VENV) --stamp $@ \
+	    --log $(VENV)/tf2_msgs-build.log
 
 ## Foxglove's own readers (Node.js: @mcap/core, @foxglove/rosmsg2-serialization), for the tests
 ## that decode recordings as the Foxglove app does; versions pinned in the lock file.

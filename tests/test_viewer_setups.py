@@ -33,6 +33,10 @@ def _published():
     # wrench_a / wrench_b (geometry_msgs/WrenchStamped) are being added to the node
     for topic in ('/wrench_a', '/wrench_b'):
         published.setdefault(topic, 'geometry_msgs/WrenchStamped')
+    # the robot description and /tf (issue 22) are being added to the node
+    published.setdefault('/robot_description', 'std_msgs/String')
+    published.setdefault('/tf', 'tf2_msgs/TFMessage')
+    published.setdefault('/tf_static', 'tf2_msgs/TFMessage')
     return published
 
 
@@ -106,3 +110,23 @@ def test_foxglove_layout():
 def test_setups_are_installed():
     setup = (REPO / 'setup.py').read_text(encoding='utf-8')
     assert "glob('config/*.rviz')" in setup and "glob('config/*.json')" in setup
+
+
+def test_setups_show_the_robot_model_and_the_tf_tree():
+    # RViz: a RobotModel reading the latched (transient-local) robot_description, and TF
+    config = yaml.safe_load(RVIZ.read_text(encoding='utf-8'))
+    displays = {d['Class']: d for d in _displays(config['Visualization Manager']['Displays'])}
+    model = displays['rviz_default_plugins/RobotModel']
+    assert model['Enabled'] and model['Description Source'] == 'Topic'
+    topic = model['Description Topic']
+    assert topic['Value'] == '/robot_description'
+    assert _published()[topic['Value']] == 'std_msgs/String'
+    assert topic['Durability Policy'] == 'Transient Local'
+    assert topic['Reliability Policy'] == 'Reliable'
+    assert displays['rviz_default_plugins/TF']['Enabled']
+    # Foxglove: the 3D panel shows the URDF of /robot_description (its Urdfs layer reads
+    # that topic; hidden unless the topic's settings say visible)
+    layout = json.loads(FOXGLOVE.read_text(encoding='utf-8'))
+    panel = layout['configById']['3D!twodisk']
+    assert panel['topics']['/robot_description']['visible'] is True
+    assert panel['topics']['/robot_description']['displayMode'] in ('auto', 'visual')

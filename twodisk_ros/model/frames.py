@@ -1,0 +1,113 @@
+"""The frames of the two disks, fixed in the body: where /tf_static and the URDF put them.
+
+Parent frame: the body frame ``G e1 e2 e3`` of docs/physics.md, published as ``body_frame``
+(default ``twodisk_body``): origin at G, the same orientation as the node's ``pose``
+(v_world = R v_body). Lengths in metres, quaternions (x, y, z, w), scalar last as in ROS,
+rotating disk frame → body frame (the body-frame components of a disk-frame vector v are
+R v), so a ``geometry_msgs/Transform`` with parent ``body_frame`` and child the disk frame
+carries ``translation`` and ``quaternion`` as they are.
+
+Each disk frame has its origin at the disk's centre, z normal to the disk's plane, and its
+x axis along the semi-axis ``a`` pointing away from G, towards the disk's far tip (where
+θ = 0, resp. ψ = 0); y completes the right-handed frame. The rim is then
+x²/a² + y²/b² = 1, z = 0, on both disks, and the contact angle of the disk is the polar
+angle from x towards y, so the contact point is ρ (cos ∠, sin ∠, 0) with ρ = ab/D(∠):
+
+``{body_frame}_disk_a`` — disk 1, which carries the contact point A (angle θ):
+    centre C1 = −Δ e2; x = −e2, y = +e1, z = +e3 (a turn by −90° about e3).
+``{body_frame}_disk_b`` — disk 2, which carries the contact point B (angle ψ):
+    centre C2 = +Δ e2; x = +e2, y = −e3, z = −e1.
+
+The two frames are exact (quaternion components 0, ±1/2, ±√½); only the translations depend
+on the body (±Δ e2).
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+__all__ = ['DiskFrame', 'disk_frames', 'check_frame_id', 'DISK_SUFFIXES']
+
+#: The suffixes of the disk frames' names, after the body frame's: disk 1 (A), disk 2 (B).
+DISK_SUFFIXES = ('_disk_a', '_disk_b')
+
+_HALF_SQRT2 = math.sqrt(0.5)
+# Columns: the disk frame's x, y, z axes in the body frame (exact integers).
+_AXES = (np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+         np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]))
+# The same rotations as unit quaternions (x, y, z, w), w > 0.
+_QUATERNIONS = ((0.0, 0.0, -_HALF_SQRT2, _HALF_SQRT2), (-0.5, -0.5, 0.5, 0.5))
+# Sign of the centre along e2: C1 = −Δ e2, C2 = +Δ e2.
+_CENTRE_SIGNS = (-1.0, 1.0)
+
+
+def check_frame_id(name, what='body_frame'):
+    """Return ``name`` if it is a usable tf2 frame id, else raise a one-line ValueError.
+
+    Allowed: a non-empty string without whitespace and without a leading ``/`` (tf2 refuses
+    frame ids that start with a slash).
+    """
+    if not isinstance(name, str) or not name or any(c.isspace() for c in name) \
+            or name.startswith('/'):
+        raise ValueError(f'{what} must be a non-empty frame name without spaces or a leading '
+                         f'"/", got {name!r}')
+    return name
+
+
+@dataclass(frozen=True, eq=False)
+class DiskFrame:
+    """One disk's frame relative to the body frame (a static transform).
+
+    Attributes
+    ----------
+    child_frame_id : str
+        ``f'{body_frame}_disk_a'`` (disk 1, contact A) or ``f'{body_frame}_disk_b'``
+        (disk 2, contact B).
+    translation : numpy.ndarray, shape (3,)
+        The disk's centre in the body frame (m): (0, ∓Δ, 0).
+    quaternion : numpy.ndarray, shape (4,)
+        (x, y, z, w), unit, w > 0: rotates disk-frame components into body-frame ones.
+    parent_frame_id : str
+        The body frame's name.
+    axes : numpy.ndarray, shape (3, 3)
+        The same rotation as a matrix, disk frame → body frame: its columns are the disk's
+        x, y, z axes in the body frame (exact entries 0, ±1).
+    """
+
+    child_frame_id: str
+    translation: np.ndarray
+    quaternion: np.ndarray
+    parent_frame_id: str
+    axes: np.ndarray
+
+    def to_disk(self, points):
+        """Body-frame points (m, shape (..., 3)) expressed in this disk's frame (m)."""
+        return (np.asarray(points, dtype=float) - self.translation) @ self.axes
+
+
+def disk_frames(body, body_frame='twodisk_body'):
+    """The two disk frames of ``body`` (a TwoDiskBody), relative to ``body_frame``.
+
+    Parameters
+    ----------
+    body : twodisk_ros.physics.body.TwoDiskBody
+        Uses ``body.delta`` (m).
+    body_frame : str
+        The parent frame's name (see :func:`check_frame_id`).
+
+    Returns
+    -------
+    tuple of DiskFrame
+        (disk 1 / contact A, disk 2 / contact B); see the module docstring for the axes.
+    """
+    check_frame_id(body_frame)
+    frames = []
+    for suffix, sign, quaternion, axes in zip(DISK_SUFFIXES, _CENTRE_SIGNS, _QUATERNIONS, _AXES):
+        arrays = [np.array([0.0, sign * float(body.delta), 0.0]), np.array(quaternion),
+                  axes.copy()]
+        for array in arrays:
+            array.setflags(write=False)
+        frames.append(DiskFrame(body_frame + suffix, arrays[0], arrays[1], body_frame,
+                                arrays[2]))
+    return tuple(frames)
