@@ -228,3 +228,14 @@ def test_foxglove_readers_decode_tf_bit_for_bit(bag):
     (tf_static,) = [m for m in decoded if m['topic'] == '/tf_static']
     assert [_foxglove_transform(t) for t in tf_static['message']['transforms']] \
         == [transform_values(t) for t in static.transforms]
+
+
+@pytest.mark.parametrize('type_name', [
+    TF, 'rosgraph_msgs/msg/Clock', 'std_msgs/msg/String', 'geometry_msgs/msg/PoseStamped',
+    'geometry_msgs/msg/PointStamped', 'geometry_msgs/msg/WrenchStamped',
+    'sensor_msgs/msg/JointState', 'nav_msgs/msg/Path', 'visualization_msgs/msg/MarkerArray',
+    'diagnostic_msgs/msg/DiagnosticArray'])
+def test_type_hashes_are_jazzys(type_name):
+    """The hash each channel carries (``topic_type_hash``) is the one rosbags' Jazzy store
+    computes from its own definitions: RViz, tf2 and ``ros2 bag`` accept the recording."""
+    assert msgdefs.type_hash(type_name) == STORE.hash_rihs01(type_name)
