@@ -11,7 +11,9 @@ and the message ends after its last field (``serialize_message`` of a JointState
 All messages of a batch share one frame id, hence one length and one layout
 (:class:`~twodisk_ros.io.cdr_layout.Layout`): a template row holds the constant bytes (header,
 string lengths, zero padding), and the numeric columns of an ``(n, L)`` ``uint8`` array are
-filled through ``float64``/``int32`` views.
+filled through ``float64``/``int32`` views.  The layouts are derived from the installed
+``.msg`` definitions (:func:`~twodisk_ros.io.cdr_schema.message_layout`, cached), not written
+by hand: each encoder only names its batch constants (frame ids, joint names) and columns.
 
 ``serialize`` (:mod:`~twodisk_ros.io.cdr_generic`) encodes any other rclpy message object
 (MarkerArray, DiagnosticArray, ...) one field at a time, with the same guarantees.
@@ -20,8 +22,9 @@ Stamps are integer nanoseconds (``int64``), converted exactly as
 ``Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)``: floor division, so the
 nanoseconds are always in ``[0, 1e9)``; ``sec`` must fit ``int32``.
 
-Only numpy and the standard library are imported, so this module works without ROS (``serialize``
-duck-types the message object and its ``rosidl_parser`` field types by class name).
+Only numpy and the standard library are imported, so this module works without rclpy: it reads
+the ``.msg`` files from the share directories (``serialize`` duck-types the message object and
+its ``rosidl_parser`` field types by class name).
 """
 
 import numpy as np
