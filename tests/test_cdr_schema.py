@@ -186,3 +186,32 @@ def test_long_sequences_repeat_one_element_layout():
     assert layout.block('markers[0].points')[2] == 3000
     with pytest.raises(KeyError):
         layout.block('markers[0].points[1000].x')
+
+
+def test_declared_defaults_of_every_kind(tmp_path, monkeypatch):
+    """A definition with constants, comments and defaults of each kind, laid out by hand."""
+    import struct
+    folder = tmp_path / 'share' / 'twodisk_test_msgs' / 'msg'
+    folder.mkdir(parents=True)
+    (folder / 'Defaults.msg').write_text(
+        '# a comment line\n'
+        'int32 CONSTANT=5\n'
+        'string NAME="x # y"\n'
+        'float64[] seq [1.5, -2.0]   # a sequence default\n'
+        'int16[3] fixed [1, 2, -3]\n'
+        'bool flag true\n'
+        'string text "hello"\n'
+        'uint8 last\n')
+    monkeypatch.setenv('AMENT_PREFIX_PATH', str(tmp_path))
+    expected = (b'\x00\x01\x00\x00' + struct.pack('<I', 2) + bytes(4)
+                + struct.pack('<2d3h?', 1.5, -2.0, 1, 2, -3, True) + bytes(1)
+                + struct.pack('<I', 6) + b'hello\x00' + b'\x00')
+    layout = cdr_schema.message_layout('twodisk_test_msgs/msg/Defaults')
+    assert layout.fill(1).tobytes() == expected
+    assert [f.name for f in cdr_schema.message_fields('twodisk_test_msgs/msg/Defaults')] == [
+        'seq', 'fixed', 'flag', 'text', 'last']
+    three = cdr_schema.message_layout('twodisk_test_msgs/msg/Defaults', {'text': ''},
+                                      {'seq': 3})
+    data = three.fill(1, seq=[1.0, 2.0, 3.0], last=7).tobytes()
+    assert data[4:8] == struct.pack('<I', 3) and data[12:36] == struct.pack('<3d', 1, 2, 3)
+    assert data.endswith(struct.pack('<I', 1) + b'\x00' + b'\x07')

@@ -163,11 +163,15 @@ class _Walk:
 
     def array(self, field, path):
         constant = self._get(self.constants, path, None)
+        default = _default(field) if field.type in PRIMITIVES else None
         if field.array >= 0:
             count = field.array
         else:
-            count = self._get(self.counts, path, None if constant is None else len(constant))
+            known = constant if constant is not None else default
+            count = self._get(self.counts, path, None if known is None else len(known))
             count = 0 if count is None else int(count)
+            if default is not None and len(default) != count:
+                default = None          # a count given for a sequence with a default: zeros
             if field.bound is not None and count > field.bound:
                 raise ValueError(f'{path}: {count} elements exceed the bound {field.bound}')
             self.layout.u32(count)
@@ -177,7 +181,7 @@ class _Walk:
             if constant is not None:
                 self.layout.constant(PRIMITIVES[field.type], constant)
             else:
-                self.layout.field(path, PRIMITIVES[field.type], count, _default(field))
+                self.layout.field(path, PRIMITIVES[field.type], count, default)
         elif field.type in _STRINGS:
             for k in range(count):
                 self.string(field, constant[k] if constant is not None else '')
