@@ -15,8 +15,8 @@ OUT ?= out
 venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
 # The pinned requirements, then twodisk_ros itself (editable: the venv runs this checkout's
-# code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep` and
-# `twodisk-figures` are in .venv/bin and work from any directory; the parameter files go to
+# code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep`, `twodisk-view`
+# and `twodisk-figures` are in .venv/bin and work from any directory; the parameter files go to
 # .venv/share/twodisk_ros/config, where a colcon install puts them.
 $(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
 	$(PYTHON) -m venv $(VENV)

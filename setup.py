@@ -28,6 +28,7 @@ setup(
             'twodisk-figures = twodisk_ros.plotting.figures:main',
             'twodisk-animate = twodisk_ros.plotting.animate_cli:main',
             'twodisk-sweep = twodisk_ros.sweep.cli:main',
+            'twodisk-view = twodisk_ros.view.cli:main',
         ],
     },
 )

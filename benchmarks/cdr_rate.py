@@ -1,11 +1,11 @@
 """Messages per second of CDR encoding, and of MCAP's add_message with these message sizes.
 
-For each of the node's fixed-layout types (PoseStamped, PointStamped, JointState, and a Path of
-``path_length`` poses), compares:
+For each of the node's fixed-layout types (PoseStamped, PointStamped, WrenchStamped, JointState,
+TFMessage of one transform, Clock, and a Path of ``path_length`` poses), compares:
 
 * ``vectorised``: :mod:`twodisk_ros.io.cdr`, a whole batch from numpy arrays to ``list[bytes]``;
 * ``serialize``: ``rclpy.serialization.serialize_message`` of message objects built beforehand;
-* ``build+serialize``: building each object with :mod:`twodisk_ros.messages` then serializing
+* ``build+serialize``: building each object with :mod:`twodisk_ros.node.messages` then serializing
   it, what the node did until now;
 * ``add_message``: ``mcap.writer.Writer.add_message`` alone, the encoded messages of that type
   into an in-memory stream written as the project writes (chunks of 256 KiB, zstd).
@@ -37,7 +37,9 @@ from twodisk_ros.io import cdr  # noqa: E402
 FRAME = 'world'
 NAMES = ['theta', 'psi', 'phase']
 TYPES = {'pose': 'geometry_msgs/msg/PoseStamped', 'point': 'geometry_msgs/msg/PointStamped',
-         'joint_state': 'sensor_msgs/msg/JointState', 'path': 'nav_msgs/msg/Path'}
+         'wrench': 'geometry_msgs/msg/WrenchStamped', 'joint_state': 'sensor_msgs/msg/JointState',
+         'tf': 'tf2_msgs/msg/TFMessage', 'clock': 'rosgraph_msgs/msg/Clock',
+         'path': 'nav_msgs/msg/Path'}
 
 
 def _best(function, repeat):
@@ -66,6 +68,11 @@ def _encoders(s, path_length):
     return {
         'pose': (lambda: cdr.encode_pose_stamped(s['stamps'], FRAME, s['xyz'], s['q']), n),
         'point': (lambda: cdr.encode_point_stamped(s['stamps'], FRAME, s['xyz']), n),
+        'wrench': (lambda: cdr.encode_wrench_stamped(s['stamps'], FRAME, s['xyz'],
+                                                     s['joints']), n),
+        'tf': (lambda: cdr.encode_tf_message(s['stamps'], FRAME, 'twodisk_body', s['xyz'],
+                                             s['q']), n),
+        'clock': (lambda: cdr.encode_clock(s['stamps']), n),
         'joint_state': (lambda: cdr.encode_joint_state(s['stamps'], NAMES, s['joints'],
                                                        s['rates']), n),
         'path': (lambda: [cdr.encode_path(s['stamps'][-1], FRAME, s['xyz'][:m],
@@ -75,8 +82,22 @@ def _encoders(s, path_length):
 
 def _builders(s, path_length):
     """type -> function building the message objects of the batch (rclpy imported here)."""
-    from twodisk_ros import messages
+    from geometry_msgs.msg import (Quaternion, Transform, TransformStamped, Vector3, Wrench,
+                                   WrenchStamped)
+    from rosgraph_msgs.msg import Clock
+    from tf2_msgs.msg import TFMessage
+    from twodisk_ros.node import messages
     n = len(s['stamps'])
+
+    def vector(xyz):
+        return Vector3(x=float(xyz[0]), y=float(xyz[1]), z=float(xyz[2]))
+
+    def tf(i):
+        q = s['q'][i]
+        return TFMessage(transforms=[TransformStamped(
+            header=messages.header(FRAME, int(s['stamps'][i])), child_frame_id='twodisk_body',
+            transform=Transform(translation=vector(s['xyz'][i]), rotation=Quaternion(
+                x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3]))))])
     m = min(path_length, n)
 
     def path():
@@ -88,6 +109,12 @@ def _builders(s, path_length):
                          for i in range(n)],
         'point': lambda: [messages.point_stamped(FRAME, int(s['stamps'][i]), s['xyz'][i])
                           for i in range(n)],
+        'wrench': lambda: [WrenchStamped(header=messages.header(FRAME, int(s['stamps'][i])),
+                                         wrench=Wrench(force=vector(s['xyz'][i]),
+                                                       torque=vector(s['joints'][i])))
+                           for i in range(n)],
+        'tf': lambda: [tf(i) for i in range(n)],
+        'clock': lambda: [Clock(clock=messages.stamp(int(s['stamps'][i]))) for i in range(n)],
         'joint_state': lambda: [messages.rolling_state(int(s['stamps'][i]), s['joints'][i],
                                                        s['rates'][i]) for i in range(n)],
         'path': path,

@@ -7,7 +7,8 @@
   (``node_rates.py``);
 - the cost of ``/tf``: the same runs without and with a ``/tf`` subscriber (``node_rates.py``);
 - contact forces per second, and the cost of the solid mass model;
-- parameter sweeps on Dask (``sweep_rate.py``).
+- parameter sweeps on Dask (``sweep_rate.py``);
+- the live view without ROS, ``twodisk-view``, at 100 Hz and 1 kHz (``view_rate.py``).
 """
 
 import contextlib
@@ -19,6 +20,7 @@ import numpy as np
 
 from node_rates import batch_rate, batch_tf_cost, realtime_rate
 from targets import poses_throughput
+import view_rate
 
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
 from twodisk_ros.physics.contact_forces import ContactForceModel
@@ -89,6 +91,10 @@ def measure(builds, quick=False, log=print):
     with contextlib.redirect_stdout(text):
         sweep_rate.main()
     out['sweep'] = text.getvalue()
+    out['view'] = [view_rate.view_rate(hz, 3.0 if quick else 10.0) for hz in (100.0, 1000.0)]
+    for r in out['view']:
+        log(f'   twodisk-view {r.rate_hz:g} Hz: {r.per_second:.0f} transforms/s, lag p50 '
+            f'{r.lag_p50_ms:.2f} ms, server CPU {r.server_cpu:.0%}, skipped {r.skipped}')
     return out
 
 
@@ -97,7 +103,8 @@ def as_dict(out):
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
             'tf_cost': {'batch': out['tf_cost']['batch'],
                         'realtime': [r.as_dict() for r in out['tf_cost']['realtime']]},
-            'solid': out['solid'], 'sweep': out['sweep']}
+            'solid': out['solid'], 'sweep': out['sweep'],
+            'view': [r.as_dict() for r in out['view']]}
 
 
 def _status(ok):
@@ -195,4 +202,5 @@ def report_lines(out):
       'split by quantity, bodies per second with 1 and 2 workers, the 100 × 100 map and the '
       'projection to 1000 × 1000 with the model it uses):\n')
     w('```\n' + out['sweep'].strip() + '\n```\n')
+    lines.extend(view_rate.report_lines(out['view']))
     return lines

@@ -58,7 +58,9 @@ def with_tf(old, path, *, params=PARAMS, edit=None, drop=(), parent='world',
     """
     raw = read_recording(old, decode=lambda topic: False)
     poses = [m.msg for m in read_recording(old).messages if m.topic.endswith('/pose')]
-    with McapRecorder(path, metadata=params) as rec:
+    # 64 KiB chunks as write_run: a cut keeps whole chunks (rclpy leaves padding bytes
+    # uninitialised, so compressed sizes, and where a cut falls, vary from run to run)
+    with McapRecorder(path, metadata=params, chunk_size=64 * 1024) as rec:
         for name, info in raw.topics.items():
             rec.add_topic(name, _class(info.type_name))
         rec.add_topic('/tf', TFMessage, QoSProfile(depth=100))

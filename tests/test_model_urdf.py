@@ -9,6 +9,7 @@ here, scipy's quaternion → matrix, the cached STL bytes and the rims' equation
 import hashlib
 import math
 from pathlib import Path
+import shutil
 import subprocess
 import sys
 from urllib.parse import unquote, urlparse
@@ -28,7 +29,11 @@ from twodisk_ros.plotting import palette
 
 # yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
 pytestmark = pytest.mark.filterwarnings('ignore:.*Scene.dump.*:DeprecationWarning')
-CHECK_URDF = Path(sys.executable).parent / 'check_urdf'
+# urdfdom's check_urdf: the venv's (the cmeel-urdfdom wheel's wrapper), else one on PATH
+# (liburdfdom-tools in a ROS workspace)
+CHECK_URDF = next((p for p in (Path(sys.executable).parent / 'check_urdf',
+                               shutil.which('check_urdf')) if p and Path(p).is_file()),
+                  'check_urdf')
 BODIES = [(1.0, 1.0, 0.5), (2.0, 1.0, 1.0), (0.08, 0.2, 0.03), (1.0, 0.05, 0.02)]
 MODELS = ['laminae', 'solid', 'custom']
 

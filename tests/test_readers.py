@@ -6,10 +6,14 @@
   the recorded bytes: exact lengths and zero padding, no process memory in the file;
 - mcap-ros2-support decodes every message with the schemas stored in the file;
 - the two agree with each other and with rclpy's ``deserialize_message`` of the same bytes
-  (the bytes that went out over DDS), field by field.
+  (the bytes that went out over DDS), field by field;
+- Foxglove's own readers (``@mcap/core``, ``@foxglove/rosmsg2-serialization``, in Node.js:
+  tests/foxglove) decode every message, with no bytes left after its last field, field for
+  field as mcap-ros2-support does.
 """
 
 import math
+import struct
 import os
 from pathlib import Path
 import shutil
@@ -106,3 +110,47 @@ def test_every_message_through_rosbags_mcap_ros2_and_rclpy(bag):
         rosbags_msg = store.deserialize_cdr(bytes(data), type_name)
         _same(rclpy_msg, rosbags_msg, f'{topic}@{stamp} rclpy/rosbags')
         _same(rosbags_msg, mcap_msg, f'{topic}@{stamp} rosbags/mcap-ros2')
+
+
+def _same_as_foxglove(py, js, where):
+    """A message decoded by mcap-ros2-support against Foxglove's decoding of the same bytes
+    (JSON from tests/foxglove/decode.mjs: numbers as float64 bits, 64-bit integers as int)."""
+    if isinstance(js, dict):
+        for key, value in js.items():
+            _same_as_foxglove(getattr(py, key), value, f'{where}.{key}')
+    elif isinstance(js, list):
+        items = list(py)
+        assert len(items) == len(js), where
+        for k, (a, b) in enumerate(zip(items, js)):
+            _same_as_foxglove(a, b, f'{where}[{k}]')
+    elif isinstance(js, bool):
+        assert bool(py) is js, (where, py, js)
+    elif isinstance(js, float):
+        if isinstance(py, (bytes, bytearray)):
+            (py,) = py
+        if isinstance(py, float):
+            assert (math.isnan(py) and math.isnan(js)) or \
+                struct.pack('<d', py) == struct.pack('<d', js), (where, py, js)
+        else:
+            assert float(py) == js, (where, py, js)
+    else:
+        assert py == js, (where, py, js)
+
+
+def test_every_message_through_foxglove_readers(bag):
+    """Foxglove's @mcap/core and @foxglove/rosmsg2-serialization read every message of the
+    node's recording, with nothing left after its last field, field for field as
+    mcap-ros2-support decodes it."""
+    from foxglove_helpers import foxglove_decode
+    _, path = bag
+    ours = read_recording(path)
+    decoded = foxglove_decode(path)
+    assert len(decoded) == len(ours.messages) > 1800
+    assert not [m['topic'] for m in decoded if m['trailing']]
+    by_key = {}
+    for m in decoded:
+        by_key.setdefault((m['topic'], m['logTime']), []).append(m)
+    for message in ours.messages:
+        js = by_key[(message.topic, message.log_time_ns)].pop(0)
+        assert js['schema'] == message.type_name
+        _same_as_foxglove(message.msg, js['message'], f'{message.topic}@{message.log_time_ns}')

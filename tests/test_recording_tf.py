@@ -16,11 +16,7 @@ import os
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 os.environ.setdefault('ROS_DOMAIN_ID', '40')
 
-import json  # noqa: E402
-from pathlib import Path  # noqa: E402
-import shutil  # noqa: E402
 import struct  # noqa: E402
-import subprocess  # noqa: E402
 import textwrap  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -39,6 +35,7 @@ from rclpy.serialization import deserialize_message  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
+from foxglove_helpers import foxglove_decode  # noqa: E402
 from twodisk_ros.io import McapRecorder, cdr, msgdefs, read_recording  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 
@@ -54,7 +51,6 @@ TF_STATIC_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                            reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
 N = 50
-FOXGLOVE = Path(__file__).resolve().parent / 'foxglove'
 
 
 def samples():
@@ -212,32 +208,6 @@ def test_tf_equals_pose_sample_for_sample(bag):
             'twodisk_body', bits([p.x, p.y, p.z]), bits([q.x, q.y, q.z, q.w]))
 
 
-def _from_node(value):
-    """Undo decode.mjs's JSON encoding: "f:<float64 bits>" and "i:<bigint>" back to numbers."""
-    if isinstance(value, dict):
-        return {k: _from_node(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_from_node(v) for v in value]
-    if isinstance(value, str) and value[:2] == 'f:':
-        return struct.unpack('<d', bytes.fromhex(value[2:]))[0]
-    if isinstance(value, str) and value[:2] == 'i:':
-        return int(value[2:])
-    return value
-
-
-def foxglove_decode(path, *topics):
-    """Every message of the topics as Foxglove's readers decode it (tests/foxglove/decode.mjs)."""
-    installed = (FOXGLOVE / 'node_modules' / '@foxglove' / 'rosmsg2-serialization').is_dir()
-    if shutil.which('node') is None or not installed:
-        if os.environ.get('CI', '').lower() in ('1', 'true', 'yes'):
-            pytest.fail('Foxglove readers missing: make foxglove-readers')
-        pytest.skip('Foxglove readers not installed (make foxglove-readers)')
-    result = subprocess.run(['node', str(FOXGLOVE / 'decode.mjs'), str(path), *topics],
-                            capture_output=True, text=True, timeout=120)
-    assert result.returncode == 0, result.stderr[-2000:]
-    return [_from_node(json.loads(line)) for line in result.stdout.splitlines()]
-
-
 def _foxglove_transform(t):
     tr, rot = t['transform']['translation'], t['transform']['rotation']
     stamp = t['header']['stamp']
@@ -258,3 +228,14 @@ def test_foxglove_readers_decode_tf_bit_for_bit(bag):
     (tf_static,) = [m for m in decoded if m['topic'] == '/tf_static']
     assert [_foxglove_transform(t) for t in tf_static['message']['transforms']] \
         == [transform_values(t) for t in static.transforms]
+
+
+@pytest.mark.parametrize('type_name', [
+    TF, 'rosgraph_msgs/msg/Clock', 'std_msgs/msg/String', 'geometry_msgs/msg/PoseStamped',
+    'geometry_msgs/msg/PointStamped', 'geometry_msgs/msg/WrenchStamped',
+    'sensor_msgs/msg/JointState', 'nav_msgs/msg/Path', 'visualization_msgs/msg/MarkerArray',
+    'diagnostic_msgs/msg/DiagnosticArray'])
+def test_type_hashes_are_jazzys(type_name):
+    """The hash each channel carries (``topic_type_hash``) is the one rosbags' Jazzy store
+    computes from its own definitions: RViz, tf2 and ``ros2 bag`` accept the recording."""
+    assert msgdefs.type_hash(type_name) == STORE.hash_rihs01(type_name)

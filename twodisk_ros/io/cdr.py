@@ -11,7 +11,9 @@ and the message ends after its last field (``serialize_message`` of a JointState
 All messages of a batch share one frame id, hence one length and one layout
 (:class:`~twodisk_ros.io.cdr_layout.Layout`): a template row holds the constant bytes (header,
 string lengths, zero padding), and the numeric columns of an ``(n, L)`` ``uint8`` array are
-filled through ``float64``/``int32`` views.
+filled through ``float64``/``int32`` views.  The layouts are derived from the installed
+``.msg`` definitions (:func:`~twodisk_ros.io.cdr_schema.message_layout`, cached), not written
+by hand: each encoder only names its batch constants (frame ids, joint names) and columns.
 
 ``serialize`` (:mod:`~twodisk_ros.io.cdr_generic`) encodes any other rclpy message object
 (MarkerArray, DiagnosticArray, ...) one field at a time, with the same guarantees.
@@ -20,14 +22,16 @@ Stamps are integer nanoseconds (``int64``), converted exactly as
 ``Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)``: floor division, so the
 nanoseconds are always in ``[0, 1e9)``; ``sec`` must fit ``int32``.
 
-Only numpy and the standard library are imported, so this module works without ROS (``serialize``
-duck-types the message object and its ``rosidl_parser`` field types by class name).
+Only numpy and the standard library are imported, so this module works without rclpy: it reads
+the ``.msg`` files from the share directories (``serialize`` duck-types the message object and
+its ``rosidl_parser`` field types by class name).
 """
 
 import numpy as np
 
 from .cdr_generic import serialize
 from .cdr_layout import ENCAPSULATION, Layout, float_columns, split_rows, stamp_columns
+from .cdr_schema import message_layout
 
 __all__ = [
     'ENCAPSULATION',
@@ -45,10 +49,12 @@ __all__ = [
 ]
 
 
-def _header_only(frame_id):
-    layout = Layout(prefix=ENCAPSULATION)
-    layout.header(frame_id)
-    return layout
+POSE_STAMPED = 'geometry_msgs/msg/PoseStamped'
+POINT_STAMPED = 'geometry_msgs/msg/PointStamped'
+WRENCH_STAMPED = 'geometry_msgs/msg/WrenchStamped'
+JOINT_STATE = 'sensor_msgs/msg/JointState'
+TF_MESSAGE = 'tf2_msgs/msg/TFMessage'
+CLOCK = 'rosgraph_msgs/msg/Clock'
 
 
 def encode_pose_stamped(stamps_ns, frame_id, positions, quaternions):
@@ -73,10 +79,10 @@ def encode_pose_stamped(stamps_ns, frame_id, positions, quaternions):
     positions = float_columns(positions, 3, 'positions')
     quaternions = float_columns(quaternions, 4, 'quaternions')
     n = len(positions)
-    layout = _header_only(frame_id)
-    layout.pose()
-    return split_rows(layout.fill(n, stamp=stamp_columns(stamps_ns, n), position=positions,
-                                  orientation=quaternions))
+    layout = message_layout(POSE_STAMPED, {'header.frame_id': frame_id})
+    return split_rows(layout.fill(n, **{'header.stamp': stamp_columns(stamps_ns, n),
+                                        'pose.position': positions,
+                                        'pose.orientation': quaternions}))
 
 
 def encode_tf_message(stamps_ns, parent_frame, child_frame, positions, quaternions):
@@ -108,13 +114,13 @@ def encode_tf_message(stamps_ns, parent_frame, child_frame, positions, quaternio
     positions = float_columns(positions, 3, 'positions')
     quaternions = float_columns(quaternions, 4, 'quaternions')
     n = len(positions)
-    layout = Layout(prefix=ENCAPSULATION)
-    layout.u32(1)                                   # transforms: one TransformStamped
-    layout.header(parent_frame)
-    layout.string(child_frame)
-    layout.pose('translation', 'rotation')          # Transform: Vector3, Quaternion
-    return split_rows(layout.fill(n, stamp=stamp_columns(stamps_ns, n), translation=positions,
-                                  rotation=quaternions))
+    layout = message_layout(TF_MESSAGE, {'transforms[0].header.frame_id': parent_frame,
+                                         'transforms[0].child_frame_id': child_frame},
+                            {'transforms': 1})
+    return split_rows(layout.fill(n, **{
+        'transforms[0].header.stamp': stamp_columns(stamps_ns, n),
+        'transforms[0].transform.translation': positions,
+        'transforms[0].transform.rotation': quaternions}))
 
 
 def encode_clock(stamps_ns):
@@ -131,9 +137,7 @@ def encode_clock(stamps_ns):
         One CDR message (12 bytes: encapsulation, ``int32 sec``, ``uint32 nanosec``) per stamp.
     """
     stamps = stamp_columns(stamps_ns)
-    layout = Layout(prefix=ENCAPSULATION)
-    layout.field('clock', '<i4', 2)
-    return split_rows(layout.fill(len(stamps), clock=stamps))
+    return split_rows(message_layout(CLOCK).fill(len(stamps), clock=stamps))
 
 
 def encode_point_stamped(stamps_ns, frame_id, points):
@@ -154,10 +158,10 @@ def encode_point_stamped(stamps_ns, frame_id, points):
         One CDR message per sample.
     """
     points = float_columns(points, 3, 'points')
-    layout = _header_only(frame_id)
-    layout.field('point', '<f8', 3)
-    return split_rows(layout.fill(len(points), stamp=stamp_columns(stamps_ns, len(points)),
-                                  point=points))
+    n = len(points)
+    layout = message_layout(POINT_STAMPED, {'header.frame_id': frame_id})
+    return split_rows(layout.fill(n, **{'header.stamp': stamp_columns(stamps_ns, n),
+                                        'point': points}))
 
 
 def encode_wrench_stamped(stamps_ns, frame_id, forces, torques=None):
@@ -182,11 +186,9 @@ def encode_wrench_stamped(stamps_ns, frame_id, forces, torques=None):
     forces = float_columns(forces, 3, 'forces')
     n = len(forces)
     torques = np.zeros((n, 3)) if torques is None else float_columns(torques, 3, 'torques')
-    layout = _header_only(frame_id)
-    layout.field('force', '<f8', 3)
-    layout.field('torque', '<f8', 3)
-    return split_rows(layout.fill(n, stamp=stamp_columns(stamps_ns, n), force=forces,
-                                  torque=torques))
+    layout = message_layout(WRENCH_STAMPED, {'header.frame_id': frame_id})
+    return split_rows(layout.fill(n, **{'header.stamp': stamp_columns(stamps_ns, n),
+                                        'wrench.force': forces, 'wrench.torque': torques}))
 
 
 def encode_joint_state(stamps_ns, names, positions, velocities=None, frame_id=''):
@@ -210,23 +212,18 @@ def encode_joint_state(stamps_ns, names, positions, velocities=None, frame_id=''
     list of bytes
         One CDR message per sample, ending right after the (empty) ``effort`` count.
     """
-    names = list(names)
-    positions = float_columns(positions, len(names), 'positions')
+    names = tuple(names)
+    k = len(names)
+    positions = float_columns(positions, k, 'positions')
     n = len(positions)
-    columns = {'stamp': stamp_columns(stamps_ns, n), 'position': positions}
-    layout = _header_only(frame_id)
-    layout.u32(len(names))
-    for name in names:
-        layout.string(name)
-    layout.float64_sequence('position', len(names))
-    if velocities is None:
-        layout.u32(0)
-    else:
-        columns['velocity'] = float_columns(velocities, len(names), 'velocities')
+    columns = {'header.stamp': stamp_columns(stamps_ns, n), 'position': positions}
+    if velocities is not None:
+        columns['velocity'] = float_columns(velocities, k, 'velocities')
         if len(columns['velocity']) != n:
             raise ValueError('positions and velocities must have the same number of rows')
-        layout.float64_sequence('velocity', len(names))
-    layout.u32(0)   # effort: empty, and nothing after it (no alignment for an empty sequence)
+    # effort: empty, and nothing after its count (no alignment for an empty sequence)
+    layout = message_layout(JOINT_STATE, {'header.frame_id': frame_id, 'name': names},
+                            {'position': k, 'velocity': 0 if velocities is None else k})
     return split_rows(layout.fill(n, **columns))
 
 
@@ -260,20 +257,23 @@ def encode_path(stamp_ns, frame_id, positions, quaternions=None, stamps_ns=None)
         quaternions = float_columns(quaternions.reshape(-1, 4), 4, 'quaternions')
     quaternions = np.broadcast_to(quaternions, (m, 4))
     stamps = stamp_columns(stamp_ns if stamps_ns is None else stamps_ns, m)
-    layout = _header_only(frame_id)
-    layout.u32(m)
-    parts = [layout.fill(1, stamp=stamp_columns(stamp_ns, 1))]
+    head = Layout(prefix=ENCAPSULATION)            # the Path's header and the poses' count
+    head.field('stamp', '<i4', 2)
+    head.string(frame_id)
+    head.u32(m)
+    parts = [head.fill(1, stamp=stamp_columns(stamp_ns, 1))]
     # Alignment is relative to the payload start: the first pose starts at a multiple of 4, and
     # every pose ends with a float64, so all later poses start at a multiple of 8 and share one
     # layout; the first one may have 4 bytes more padding.
-    start = len(layout.raw) - len(ENCAPSULATION)
+    start = len(head.raw) - len(ENCAPSULATION)
     for rows in (slice(0, 1), slice(1, m)):
         if rows.start >= m:
             break
-        pose = Layout(start)
-        pose.header(frame_id)
-        pose.pose()
-        parts.append(pose.fill(len(positions[rows]), stamp=stamps[rows],
-                               position=positions[rows], orientation=quaternions[rows]))
+        pose = message_layout(POSE_STAMPED, {'header.frame_id': frame_id}, start=start)
+        parts.append(pose.fill(len(positions[rows]), **{
+            'header.stamp': stamps[rows], 'pose.position': positions[rows],
+            'pose.orientation': quaternions[rows]}))
         start += len(pose.raw)
     return b''.join(part.tobytes() for part in parts)
+
+

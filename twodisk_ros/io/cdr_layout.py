@@ -10,6 +10,7 @@ lengths are fixed (header, string lengths, zero padding) and where each numeric 
 array through ``float64``/``int32`` views.  Only numpy and the standard library are imported.
 """
 
+import bisect
 import struct
 
 import numpy as np
@@ -35,9 +36,20 @@ class Layout:
         self.raw = bytearray(prefix)
         self.fields = {}          # name -> (byte offset in raw, numpy dtype, element count)
         self.offset = start - len(prefix)
+        self._blocks = {}         # name -> (offset, dtype, count) of a group of fields
+        self._template = None
+        self._names = None
+        self._runs = {}           # path -> (element size, elements) of repeated elements
 
     def _align(self, size):
         self.raw += bytes(-(self.offset + len(self.raw)) % size)
+
+    def constant(self, dtype, values):
+        """Append constant primitive values (aligned to their size, as CDR aligns them)."""
+        data = np.asarray(values, dtype=np.dtype(dtype)).reshape(-1)
+        if data.size:
+            self._align(data.itemsize)
+        self.raw += data.tobytes()
 
     def u32(self, value):
         self._align(4)
@@ -50,36 +62,93 @@ class Layout:
         self.u32(len(data) + 1)
         self.raw += data + b'\x00'
 
-    def field(self, name, dtype, count=1):
+    def field(self, name, dtype, count=1, initial=None):
+        """A numeric column of ``count`` elements (aligned unless empty); zeros or ``initial``."""
         dtype = np.dtype(dtype)
         if count:
             self._align(dtype.itemsize)
+        if name in self.fields:
+            raise ValueError(f'field {name!r} defined twice')
         self.fields[name] = (len(self.raw), dtype, count)
-        self.raw += bytes(dtype.itemsize * count)
+        self.raw += (bytes(dtype.itemsize * count) if initial is None else
+                     np.broadcast_to(np.asarray(initial, dtype), (count,)).tobytes())
 
-    def header(self, frame_id, name='stamp'):
-        """std_msgs/Header: builtin_interfaces/Time (int32 sec, uint32 nanosec), frame_id."""
-        self.field(name, '<i4', 2)
-        self.string(frame_id)
+    def repeat(self, begin, count, path):
+        """Append ``count`` copies of the bytes from ``begin`` to the end.
 
-    def float64_sequence(self, name, count):
-        self.u32(count)
-        self.field(name, '<f8', count)
+        They are elements 2 … count + 1 of the sequence ``path``, whose element 1 starts at
+        ``begin`` and ends at the end (the caller checks that all have one layout: the same
+        start modulo 8, no element-specific constants).  Their fields get no names of their
+        own: :meth:`block` finds ``path[k].…`` from element 1's, and ``path`` as a whole.
+        """
+        size = len(self.raw) - begin
+        self._runs[path] = (size, count + 2)
+        self.raw += bytes(self.raw[begin:]) * count
 
-    def pose(self, position='position', orientation='orientation'):
-        """geometry_msgs/Pose: Point (x, y, z), Quaternion (x, y, z, w), all float64."""
-        self.field(position, '<f8', 3)
-        self.field(orientation, '<f8', 4)
+    def _element(self, name):
+        """The block of a field of a repeated element (``path[k]…``, k ≥ 2), or None."""
+        for path, (size, total) in self._runs.items():
+            if not name.startswith(path + '['):
+                continue
+            close = name.index(']', len(path))
+            k = int(name[len(path) + 1:close])
+            if k < 2:
+                return None
+            if k >= total:
+                raise KeyError(f'no field {name!r} in this layout ({total} elements)')
+            offset, dtype, count = self.block(f'{path}[1]{name[close + 1:]}')
+            return offset + (k - 1) * size, dtype, count
+        return None
+
+    def block(self, name):
+        """``(offset, dtype, count)`` of a field, or of the fields named ``name.*``/``name[*``.
+
+        A group (e.g. ``'pose'``: position x, y, z, orientation x, y, z, w) is one column if
+        its fields follow each other without padding and have one size and kind (integers of
+        one size count as one kind: a value written through the first field's dtype has the
+        same bytes in the others, e.g. Time's int32 sec and uint32 nanosec < 2**31).
+        """
+        found = self.fields.get(name) or self._blocks.get(name) or self._element(name)
+        if found is not None:
+            return found
+        if self._names is None or len(self._names) != len(self.fields):
+            self._names = sorted(self.fields)      # the names under a prefix: one range
+        members = []
+        for prefix in (name + '.', name + '['):
+            first = bisect.bisect_left(self._names, prefix)
+            last = bisect.bisect_left(self._names, prefix[:-1] + chr(ord(prefix[-1]) + 1))
+            members += [self.fields[key] for key in self._names[first:last]]
+        members = sorted((spec for spec in members if spec[2]), key=lambda f: f[0])
+        if not members:
+            raise KeyError(f'no field {name!r} in this layout')
+        offset, dtype, _ = members[0]
+        kind = 'iu' if dtype.kind in 'iu' else dtype.kind
+        end = offset
+        for start, other, count in members:
+            if start != end or other.itemsize != dtype.itemsize or other.kind not in kind:
+                raise ValueError(f'the fields of {name!r} are not one contiguous column of '
+                                 f'{dtype}')
+            end = start + other.itemsize * count
+        if name in self._runs:                    # the whole sequence: all elements packed?
+            size, total = self._runs[name]
+            if end - offset != 2 * size:
+                raise ValueError(f'the elements of {name!r} are not one contiguous column')
+            end += (total - 2) * size
+        self._blocks[name] = (offset, dtype, (end - offset) // dtype.itemsize)
+        return self._blocks[name]
 
     def fill(self, n, **columns):
         """``(n, len(raw))`` uint8 array: the template in every row, the named columns set.
 
-        Each column is broadcast to ``(n, count)`` of the field's dtype.
+        A column is a field or a group of fields (:meth:`block`), broadcast to
+        ``(n, count)`` of its dtype.
         """
+        if self._template is None or len(self._template) != len(self.raw):
+            self._template = np.frombuffer(bytes(self.raw), np.uint8)
         rows = np.empty((n, len(self.raw)), np.uint8)
-        rows[...] = np.frombuffer(bytes(self.raw), np.uint8)
+        rows[...] = self._template
         for name, values in columns.items():
-            offset, dtype, count = self.fields[name]
+            offset, dtype, count = self.block(name)
             if count:
                 view = rows[:, offset:offset + dtype.itemsize * count].view(dtype)
                 view[...] = values          # broadcast to (n, count) by the assignment

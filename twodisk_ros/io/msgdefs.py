@@ -17,6 +17,7 @@ from pathlib import Path
 
 __all__ = [
     'DefinitionNotFoundError',
+    'definition_text',
     'find_share_file',
     'full_text',
     'ros_type_name',
@@ -121,6 +122,17 @@ def _load(type_name, cache):
         text = path.read_bytes()
         cache[type_name] = (text, _dependencies(text, package))
     return cache[type_name]
+
+
+def definition_text(type_name):
+    """Return the ``.msg`` file of one type as is (``bytes``), without its dependencies.
+
+    Raises
+    ------
+    DefinitionNotFoundError
+        If the file is in none of the share directories searched (:func:`find_share_file`).
+    """
+    return _load(type_name, {})[0]
 
 
 def full_text(type_name):

@@ -22,7 +22,10 @@ their right-hand normals point out.
 Vertices are on the exact outlines: on the rims, to rounding of the closed forms (≤ 2e-14 of
 the size); for the plates, their projections on the disk's plane. A polygon inscribed in a
 smooth curve with steps h misses O(h²) of its area, so volume and inertia converge at second
-order in 1/resolution (tests/test_model_mesh.py measures it).
+order in 1/resolution n (measured exponents 1.98–2.00, tests/test_model_mesh.py): the hull's
+volume and inertia within 55/n² of the ``solid`` model (the Oloid's volume 22/n²: 3.4e-4 at
+the default n = 256), the plates' inertia within 6.6/n² of the ``laminae`` model plus the
+plates' own thickness term (M h²/24 about e1 and e3, M h²/12 about e2).
 """
 
 from dataclasses import dataclass

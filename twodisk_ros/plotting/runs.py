@@ -36,6 +36,9 @@ class Run:
     """A sampled motion of one body (world frame, SI units), times increasing.
 
     ``force_a``/``force_b`` are the ground forces on the body at A and B (N), or None.
+    ``quaternion`` holds the orientations as sampled or recorded (x, y, z, w, body → world),
+    ``stamp_ns`` the recorded header stamps (ns; None for a library run), ``settings`` the
+    node's settings the run was made with (for a recording: the last recorded).
     """
 
     body: TwoDiskBody
@@ -48,6 +51,9 @@ class Run:
     force_b: np.ndarray | None = None
     weight: float = 1.0        #: M g (N), the scale of the force arrows
     label: str = ''            #: one line describing the body and the motion
+    quaternion: np.ndarray | None = None   #: (n, 4) x, y, z, w
+    stamp_ns: np.ndarray | None = None     #: (n,) int64 ns
+    settings: object = None                #: RollerSettings
 
     def __len__(self):
         return len(self.t)
@@ -58,7 +64,8 @@ class Run:
         pick = (lambda x: None if x is None else x[keep])
         return Run(self.body, self.t[keep], self.position_g[keep], self.contact_a[keep],
                    self.contact_b[keep], self.rotation[keep], pick(self.force_a),
-                   pick(self.force_b), self.weight, self.label)
+                   pick(self.force_b), self.weight, self.label, pick(self.quaternion),
+                   pick(self.stamp_ns), self.settings)
 
     def outlines(self, index, points=72):
         """World points of both disk rims at sample ``index``: two arrays (points + 1, 3)."""
@@ -148,7 +155,7 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
     poses = dynamics.cycle.poses(motion.phase)
     run = Run(body, t, poses.position_g, poses.contact_a, poses.contact_b,
               rotation_matrices(poses.quaternion), weight=dynamics.mass.mass * s.gravity,
-              label=_describe(s))
+              label=_describe(s), quaternion=poses.quaternion, settings=s)
     if forces:
         computed = ContactForceModel(dynamics).along(motion)
         run.force_a, run.force_b = computed.force_a, computed.force_b
@@ -212,7 +219,8 @@ def recorded_run(path):
               np.array([by_role['contact_a'][k] for k in stamps]),
               np.array([by_role['contact_b'][k] for k in stamps]),
               rotation_matrices(quaternion), weight=settings.mass * settings.gravity,
-              label=_describe(settings))
+              label=_describe(settings), quaternion=quaternion, stamp_ns=stamps_ns,
+              settings=settings)
     if by_role['wrench_a'] and by_role['wrench_b']:
         run.force_a = _resample(by_role['wrench_a'], stamps_ns)
         run.force_b = _resample(by_role['wrench_b'], stamps_ns)
