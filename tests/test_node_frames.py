@@ -363,3 +363,30 @@ def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
         pose.pose.position.x for _, pose in got['/pose']]
     assert recording.metadata['twodisk_ros']['body_frame'] == 'oloid'
     assert '/clock' not in qos                               # published, not recorded
+
+
+def test_an_unwritable_mesh_cache_leaves_a_urdf_without_meshes(tmp_path):
+    """The motion does not need the meshes: a warning, and the URDF keeps links and joints."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+    blocker = tmp_path / 'a_file'
+    blocker.write_text('not a directory')
+    target = tmp_path / 'no_meshes.mcap'
+    process = subprocess.Popen(
+        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
+         '-p', 'duration:=0.1', '-p', f'record:={target}'], cwd=REPO,
+        env=dict(node_env(), XDG_CACHE_HOME=str(blocker / 'cache')), stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE, text=True)
+    code, err = stop(process, sig=None, timeout=60.0)
+    assert code == 0, err
+    warnings = [line for line in err.splitlines() if '[WARN]' in line]
+    assert len(warnings) == 1 and 'robot_description without meshes' in warnings[0], err
+    assert 'XDG_CACHE_HOME' in warnings[0]
+    with AnyReader([target], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
+        (connection,) = [c for c in reader.connections if c.topic == '/robot_description']
+        ((_, _, data),) = list(reader.messages(connections=[connection]))
+        text = reader.deserialize(data, connection.msgtype).data
+    robot = ElementTree.fromstring(text)
+    assert robot.find('.//mesh') is None
+    assert {link.get('name') for link in robot.findall('link')} == {
+        'twodisk_body', 'twodisk_body_disk_a', 'twodisk_body_disk_b'}

@@ -32,7 +32,8 @@ from tf2_msgs.msg import TFMessage
 
 from ..io import cdr
 from ..model.frames import disk_frames
-from ..model.urdf import body_description
+from ..model.urdf import body_description, robot_description
+from ..outputs import OutputError
 from . import messages
 
 __all__ = ['DESCRIPTION_TOPIC', 'LATCHED_QOS', 'TF_QOS', 'TF_STATIC_TOPIC', 'TF_TOPIC',
@@ -53,25 +54,32 @@ class Description:
     """What the latched topics hold for some settings (compared to decide what to resend).
 
     ``static``: per disk frame (parent, child, translation (m), quaternion x, y, z, w) as
-    tuples of floats; ``urdf``: the URDF text.
+    tuples of floats; ``urdf``: the URDF text; ``problem``: why it has no meshes (one line),
+    or None.
     """
 
     static: tuple
     urdf: str
+    problem: str | None = None
 
 
 def describe(settings, body):
     """The :class:`Description` of checked ``settings`` and their ``TwoDiskBody``.
 
     The URDF's meshes are written to the mesh cache if missing
-    (:func:`~twodisk_ros.model.urdf.body_description`); raises ValueError (one line,
-    :class:`~twodisk_ros.outputs.OutputError`) if the cache cannot be written.
+    (:func:`~twodisk_ros.model.urdf.body_description`). If the cache cannot be written
+    (a read-only home), the URDF has no meshes (links, joints and inertia only: viewers show
+    the frames) and ``problem`` says why, for the node's log: the motion does not need them.
     """
     frames = tuple((f.parent_frame_id, f.child_frame_id, tuple(map(float, f.translation)),
                     tuple(map(float, f.quaternion)))
                    for f in disk_frames(body, settings.body_frame))
-    urdf = body_description(body, settings.mass_properties(), settings.body_frame)
-    return Description(static=frames, urdf=urdf)
+    mass = settings.mass_properties()
+    try:
+        return Description(frames, body_description(body, mass, settings.body_frame))
+    except OutputError as error:
+        return Description(frames, robot_description(body, mass, settings.body_frame),
+                           f'robot_description without meshes: {error}')
 
 
 def _static_message(static, stamp_ns):
@@ -99,17 +107,15 @@ class LatchedTopics:
         self.publishers = {topic: node.create_publisher(kind, topic, LATCHED_QOS)
                            for topic, kind in TYPES.items()}
         self._sent = {}             # topic -> the content last sent
+        self.due = True             #: a topic's content differs from what it last sent
         self.take(description)
 
     def take(self, description):
         """Send ``description`` at the next :meth:`send` (only what differs from the last)."""
         self._next = {TF_STATIC_TOPIC: description.static,
                       DESCRIPTION_TOPIC: description.urdf}
-
-    @property
-    def due(self):
-        """True if a topic's content differs from what it last sent."""
-        return any(self._sent.get(topic) != content for topic, content in self._next.items())
+        self.due = any(self._sent.get(topic) != content
+                       for topic, content in self._next.items())
 
     def send(self, stamp_ns, record=None):
         """Publish what changed, stamped ``stamp_ns``; ``record(topic_name, data, stamp_ns)``.
@@ -130,4 +136,5 @@ class LatchedTopics:
                 record(publisher.topic_name, data, stamp_ns)
             self._sent[topic] = content
             sent.append(topic)
+        self.due = False
         return sent

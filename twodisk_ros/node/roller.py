@@ -96,7 +96,10 @@ class Roller(Node):
                       for topic, kind in TOPIC_TYPES.items()}
         self._pubs[sim_clock.CLOCK_TOPIC] = self.create_publisher(
             Clock, sim_clock.CLOCK_TOPIC, sim_clock.CLOCK_QOS)     # published, not recorded
-        self._latched = LatchedTopics(self, describe(self.settings, self.simulation.body))
+        description = describe(self.settings, self.simulation.body)
+        if description.problem:
+            self.get_logger().warn(description.problem)
+        self._latched = LatchedTopics(self, description)
         try:
             if self.settings.record:
                 self._open_recorder()
@@ -181,6 +184,8 @@ class Roller(Node):
     def _apply_pending(self):
         (candidate, simulation, description), self._pending = self._pending, None
         self.settings = candidate
+        if description.problem:
+            self.get_logger().warn(description.problem, throttle_duration_sec=60.0)
         self._latched.take(description)
         self._history.length = candidate.path_length
         if simulation is not None:
