@@ -176,7 +176,9 @@ def report_lines(out):
       'shows what it adds. Batch: `run_batch` in process at 1 kHz for '
       f'{b["samples"]} samples, best of alternated runs, per sample, as wall time and as the '
       'process\'s CPU time (less disturbed by the other processes of a shared machine). Real '
-      'time: the node as a process at 1 kHz, its CPU time per wall second.\n')
+      'time: the node as a process at 1 kHz, its CPU time per wall second; this includes '
+      'DDS\'s work for a listener that falls behind (reliable topics are resent), so on a '
+      'loaded machine it varies by more than /tf adds, and the batch rows are the measure.\n')
     w('| | /tf off | /tf on | added |')
     w('|---|---|---|---|')
     w(f'| batch, wall per sample (µs) | {b["off"]:.1f} | {b["on"]:.1f} | '

@@ -308,8 +308,10 @@ def test_changes_resend_what_they_alter_and_nothing_else(client):
     (['frame_id:=body_disk_b', 'body_frame:=body'], "include frame_id 'body_disk_b'"),
     (['body_frame:=12'], 'body_frame is a string'),
     (['use_sim_time:=true'], 'use_sim_time must be false for roller'),
-], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time'])
-def test_bad_body_frame_or_sim_time_exits_2_with_one_line(arguments, words):
+    (['frame_id:=/world'], 'frame_id must be a non-empty frame name'),
+], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time',
+        'frame_id-slash'])
+def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words):
     params = [arg for argument in arguments for arg in ('-p', argument)]
     code, err = stop(start_roller('-p', 'realtime:=false', '-p', 'duration:=0.1', *params),
                      sig=None, timeout=STARTED)

@@ -102,7 +102,7 @@ PARAMETERS = (
               'invariant (energy, or |omega| in kinematic mode) above it is a WARN',
               1e-13, 1e-3, physics=True),
     Parameter('frame_id', str, 'world', '', 'frame of poses, points, paths and markers, '
-              'parent of body_frame on /tf (non-empty, no spaces)'),
+              'parent of body_frame on /tf (non-empty, no spaces, no leading /)'),
     Parameter('body_frame', str, 'twodisk_body', '', 'the body frame at G on /tf (child of '
               'frame_id, the orientation of pose); the disk frames on /tf_static are '
               'body_frame_disk_a, body_frame_disk_b (non-empty, no spaces, no leading /, '
@@ -171,8 +171,7 @@ def _check_together(s):
     if 0 < s.gravity < 1e-6:
         raise ValueError(f'gravity must be 0 (no gravity) or in [1e-6, 1000] m/s^2, got '
                          f'{s.gravity!r}')
-    if not s.frame_id or re.search(r'\s', s.frame_id):
-        raise ValueError(f'frame_id must be non-empty without spaces, got {s.frame_id!r}')
+    check_frame_id(s.frame_id, 'frame_id')   # the parent on /tf: tf2 refuses a leading /
     _check_body_frame(s.body_frame, s.frame_id)
     if s.mass_model == 'custom':
         moments = s.principal_moments
