@@ -11,9 +11,17 @@
 - :mod:`~twodisk_ros.inspect.report`, :mod:`~twodisk_ros.inspect.cli`: output, command line.
 """
 
-from .differences import finite_differences
-from .inspection import inspect_recording
-from .report import format_report
-from .results import Check, Inspection
+import importlib
 
 __all__ = ['Check', 'Inspection', 'finite_differences', 'format_report', 'inspect_recording']
+
+#: public name → the module that defines it, imported on first use (PEP 562), so that
+#: ``twodisk-inspect --help`` does not pay for numpy, scipy and the physics.
+_HOMES = {'finite_differences': 'differences', 'inspect_recording': 'inspection',
+          'format_report': 'report', 'Check': 'results', 'Inspection': 'results'}
+
+
+def __getattr__(name):
+    if name in _HOMES:
+        return getattr(importlib.import_module(f'.{_HOMES[name]}', __name__), name)
+    raise AttributeError(f'module {__name__!r} has no attribute {name!r}')

@@ -15,14 +15,14 @@ import os
 import sys
 import warnings
 
-import numpy as np
-
-from ..io import RecordingError
-from ..io.errors import one_line
+from ..io.errors import RecordingError, one_line
 from ..outputs import OutputError, check_output, replacing
-from .inspection import inspect_recording
-from .report import PROG, format_report
-from .results import EXIT_UNUSABLE
+
+# Light imports only up to here: ``--help`` and bad arguments answer without numpy, the
+# reader or the physics, which ``main`` imports once the arguments are parsed.
+PROG = 'twodisk-inspect'
+#: exit status of an unreadable file or a refused output (inspect.results.EXIT_STATUS)
+EXIT_UNUSABLE = 2
 
 __all__ = ['main']
 
@@ -79,6 +79,7 @@ def main(argv=None):
     int
     """
     args = _parser().parse_args(argv)
+    import numpy as np
     # Values of a damaged file may overflow; the checks report non-finite results, so
     # numpy's floating-point warnings would only add lines to stderr.
     with warnings.catch_warnings(), np.errstate(all='ignore'):
@@ -121,6 +122,8 @@ def _run(args):
     if refusal:
         print(f'{PROG}: {one_line(refusal)}', file=sys.stderr)
         return EXIT_UNUSABLE
+    from .inspection import inspect_recording
+    from .report import format_report
     try:
         inspection = inspect_recording(args.file)
     except RecordingError as error:

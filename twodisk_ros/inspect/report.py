@@ -2,12 +2,12 @@
 
 import textwrap
 
+from .cli import PROG
 from .results import FAIL, INCOMPLETE
 from .series import METADATA_NAME
 
 __all__ = ['PROG', 'format_report', 'run_phrase']
 
-PROG = 'twodisk-inspect'
 _DAMAGE_SHOWN = 10
 
 

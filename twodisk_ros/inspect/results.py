@@ -26,8 +26,9 @@ __all__ = ['Check', 'EXIT_STATUS', 'EXIT_UNUSABLE', 'FAIL', 'INCOMPLETE', 'Inspe
 PASS, FAIL, INCOMPLETE = 'PASS', 'FAIL', 'INCOMPLETE'
 #: Exit status of ``twodisk-inspect`` for each verdict.
 EXIT_STATUS = {PASS: 0, FAIL: 1, INCOMPLETE: 4}
-#: Exit status for a file that cannot be read, bad arguments or an output refused.
-EXIT_UNUSABLE = 2
+#: Exit status for a file that cannot be read, bad arguments or an output refused (defined
+#: with the command line, which answers bad arguments before importing this module).
+from .cli import EXIT_UNUSABLE  # noqa: E402
 
 
 @dataclass
