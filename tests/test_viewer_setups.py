@@ -25,18 +25,12 @@ RVIZ_TYPES = {
 
 
 def _published():
-    """{topic as resolved in the root namespace: 'pkg/Type'} of the node."""
+    """{topic as resolved in the root namespace: 'pkg/Type'} of the node (sampled and latched)."""
+    from twodisk_ros.node.frames_publisher import TYPES as LATCHED_TYPES
     from twodisk_ros.node.roller import TOPIC_TYPES
     published = {}
-    for topic, kind in TOPIC_TYPES.items():
+    for topic, kind in {**TOPIC_TYPES, **LATCHED_TYPES}.items():
         published['/' + topic.lstrip('/')] = f'{kind.__module__.split(".")[0]}/{kind.__name__}'
-    # wrench_a / wrench_b (geometry_msgs/WrenchStamped) are being added to the node
-    for topic in ('/wrench_a', '/wrench_b'):
-        published.setdefault(topic, 'geometry_msgs/WrenchStamped')
-    # the robot description and /tf (issue 22) are being added to the node
-    published.setdefault('/robot_description', 'std_msgs/String')
-    published.setdefault('/tf', 'tf2_msgs/TFMessage')
-    published.setdefault('/tf_static', 'tf2_msgs/TFMessage')
     return published
 
 
