@@ -1,8 +1,9 @@
 """The progress of a sweep as a tqdm bar, and its summary line.
 
 The bar counts bodies (resumed ones included from the start, so the rate and the time left
-are this run's), on the given stream only when that stream is a terminal: in a log file or a
-pipe a redrawn bar is noise, so there the sweep is silent until its summary.
+are this run's; counts in k and M from 100 000 bodies on), on the given stream only when that
+stream is a terminal: in a log file or a pipe a redrawn bar is noise, so there the sweep is
+silent until its summary.
 """
 
 from tqdm import tqdm
@@ -23,7 +24,7 @@ class SweepProgress:
 
     def __init__(self, stream, total, done=0):
         tty = stream is not None and bool(getattr(stream, 'isatty', lambda: False)())
-        self.bar = tqdm(total=total, initial=done, unit='body', unit_scale=True,
+        self.bar = tqdm(total=total, initial=done, unit='body', unit_scale=total >= 100_000,
                         desc='twodisk-sweep', file=stream, disable=not tty, smoothing=0.05,
                         dynamic_ncols=True, leave=True)
 
