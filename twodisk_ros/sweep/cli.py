@@ -31,9 +31,9 @@ import sys
 import tempfile
 
 from ..outputs import OutputError, check_output, check_output_dir
-from .request import (DEFAULT_CHUNK_SIZE, FORMATS, MAX_BODIES, SweepError, check_size,
-                      check_some_valid, default_chunk_size, grid_range, linspace_grid,
-                      output_format, store_plan)
+from .request import (DEFAULT_CHUNK_SIZE, DEFAULT_STORE_CHUNK_SIZE, FORMATS, MAX_BODIES,
+                      SweepError, check_size, check_some_valid, default_chunk_size, grid_range,
+                      linspace_grid, output_format, store_plan)
 
 __all__ = ['main', 'PROG', 'MAX_WORKERS_PER_CORE']
 
@@ -83,8 +83,8 @@ def _parser():
     parser.add_argument('--workers', metavar='N',
                         help='worker processes of the local cluster (default: every core)')
     parser.add_argument('--chunk-size', default=None, metavar='K',
-                        help=f'the most bodies per task (default {DEFAULT_CHUNK_SIZE}, ~1 s of '
-                             f'work; fewer on small grids)')
+                        help=f'the most bodies per task (default {DEFAULT_CHUNK_SIZE} for .nc, '
+                             f'{DEFAULT_STORE_CHUNK_SIZE} for .zarr; fewer on small grids)')
     parser.add_argument('--plot', metavar='DIR',
                         help='write one PNG map per variable to DIR/NAME.png (DIR is created '
                              'if its parent exists)')
@@ -154,12 +154,12 @@ def _checked(args):
     if not 0 <= speed <= MAX_REFERENCE_SPEED:
         raise _Usage(f'--reference-speed must be finite, 0 <= W <= {MAX_REFERENCE_SPEED:g}, '
                      f'got {args.reference_speed!r}')
-    chunk = (default_chunk_size(b[2] * d[2]) if args.chunk_size is None
+    fmt = output_format(args.out)
+    chunk = (default_chunk_size(b[2] * d[2], fmt) if args.chunk_size is None
              else _integer('--chunk-size', args.chunk_size))
     if chunk > MAX_BODIES:
         raise _Usage(f'--chunk-size must be an integer from 1 to {MAX_BODIES} (the most '
                      f'bodies of a sweep), got {args.chunk_size!r}')
-    fmt = output_format(args.out)
     if os.path.isdir(args.out) and fmt != 'zarr':    # said first: the suffix is not the problem
         raise OutputError(f'{args.out} is a directory: --out must name a .nc file or a .zarr '
                           f'store')

@@ -76,22 +76,27 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
 
 
 def template_dataset(b_over_a, delta_over_a, block, attrs):
-    """The sweep's Dataset with lazy (Dask) variables chunked in ``block`` = (rows, columns):
-    what ``to_zarr(compute=False)`` lays out as an empty store. Floats NaN, ``failure`` ''
-    (variable-length UTF-8 strings), ``computed`` 0 (int8; 1 once a block is complete)."""
+    """The sweep's Dataset with lazy (Dask) variables, and the encoding that chunks them in
+    ``block`` = (rows, columns): what ``to_zarr(compute=False, encoding=...)`` lays out as an
+    empty store. Floats NaN, ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
+    (int8; 1 once a block is complete). Returns (Dataset, encoding).
+
+    Each variable is one Dask chunk (a graph of one task per variable, however many blocks:
+    nothing of it is computed); the store's chunks come from the encoding."""
     import dask.array as da
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
     shape, chunks = (b.size, d.size), tuple(int(x) for x in block)
     attrs_of = _variable_attrs()
-    data = {name: (DIMS, da.full(shape, np.nan, chunks=chunks), attrs_of[name])
+    data = {name: (DIMS, da.full(shape, np.nan, chunks=-1), attrs_of[name])
             for name in VARIABLES}
-    data['failure'] = (DIMS, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=chunks),
+    data['failure'] = (DIMS, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=-1),
                        attrs_of['failure'])
-    data[COMPUTED] = (DIMS, da.zeros(shape, dtype=np.int8, chunks=chunks), {
+    data[COMPUTED] = (DIMS, da.zeros(shape, dtype=np.int8, chunks=-1), {
         'units': '1', 'description': '1 where the point was computed and written (its chunk '
                                      'complete), 0 where not yet (an interrupted sweep)'})
-    return xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+    dataset = xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+    return dataset, {name: {'chunks': chunks} for name in dataset.data_vars}
 
 
 def write_netcdf(dataset, path):

@@ -30,13 +30,18 @@ from ..limits import LimitError, check_memory, describe_bytes
 
 __all__ = ['SweepError', 'linspace_grid', 'grid_range', 'estimate', 'check_size',
            'check_some_valid', 'default_chunk_size', 'output_format', 'store_info',
-           'StoreInfo', 'FORMATS', 'DEFAULT_CHUNK_SIZE', 'MIN_CHUNKS', 'MAX_BODIES',
+           'StoreInfo', 'FORMATS', 'DEFAULT_CHUNK_SIZE', 'DEFAULT_STORE_CHUNK_SIZE',
+           'MIN_CHUNKS', 'MAX_BODIES',
            'BYTES_PER_BODY', 'BYTES_PER_BODY_ZARR', 'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE',
            'CORE_SECONDS_PER_BODY', 'STORE_MANIFEST', 'STORE_STATE']
 
-#: Bodies per task: ~1 s of work on one core (benchmarks/sweep_rate.py), so the scheduler's
-#: few ms per task stay below 1 % (docs/sweeps.md "Scaling").
+#: Bodies per task of a NetCDF sweep (the default of the library too): ~1 s of work on one
+#: core (benchmarks/sweep_rate.py), so the scheduler's ~1 ms per task stays below 1 %.
 DEFAULT_CHUNK_SIZE = 16
+#: Bodies per task of a Zarr sweep: one chunk of every variable, 17 files of a few kB; far
+#: fewer files, tasks and client reads (~0.3 ms per chunk) than 16-body chunks on the large
+#: maps Zarr is for (docs/sweeps.md "Scaling"; benchmarks/sweep_scaling.py).
+DEFAULT_STORE_CHUNK_SIZE = 1024
 #: Without --chunk-size a grid is cut into at least this many tasks (smaller chunks on small
 #: grids), so that a small map still spreads over the cores.
 MIN_CHUNKS = 16
@@ -103,11 +108,12 @@ def linspace_grid(name, start, stop, n):
     return np.linspace(start, stop, n)
 
 
-def default_chunk_size(bodies):
-    """Bodies per task when --chunk-size is not given: :data:`DEFAULT_CHUNK_SIZE`, smaller on
-    a grid of fewer than ``MIN_CHUNKS × DEFAULT_CHUNK_SIZE`` bodies (at least
-    :data:`MIN_CHUNKS` tasks). Depends on the grid only, so the same command resumes."""
-    return max(1, min(DEFAULT_CHUNK_SIZE, math.ceil(bodies / MIN_CHUNKS)))
+def default_chunk_size(bodies, fmt='netcdf'):
+    """Bodies per task when --chunk-size is not given: :data:`DEFAULT_CHUNK_SIZE` (NetCDF) or
+    :data:`DEFAULT_STORE_CHUNK_SIZE` (Zarr), smaller on a small grid so that it has at least
+    :data:`MIN_CHUNKS` tasks. Depends on the grid only, so the same command resumes."""
+    base = DEFAULT_STORE_CHUNK_SIZE if fmt == 'zarr' else DEFAULT_CHUNK_SIZE
+    return max(1, min(base, math.ceil(bodies / MIN_CHUNKS)))
 
 
 def estimate(n_b, n_delta, chunk_size, fmt='netcdf'):

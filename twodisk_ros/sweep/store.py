@@ -57,12 +57,13 @@ def create_store(path, spec):
     staging = Path(tempfile.mkdtemp(prefix=f'.{path.name}.', suffix='.partial',
                                     dir=path.parent))
     try:
-        template = template_dataset(spec.b_over_a, spec.delta_over_a, spec.block, spec.attrs())
+        template, encoding = template_dataset(spec.b_over_a, spec.delta_over_a, spec.block,
+                                              spec.attrs())
         template.attrs.update({STORE_MANIFEST: json.dumps(spec.manifest()),
                                STORE_STATE: 'incomplete'})
         with _quiet_zarr():
             template.to_zarr(staging / 'store', mode='w-', compute=False, zarr_format=3,
-                             consolidated=True)
+                             consolidated=True, encoding=encoding)
         os.rename(staging / 'store', path)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
@@ -74,17 +75,23 @@ def remove_store(path):
     shutil.rmtree(path)
 
 
+def _block_minima(values, spec):
+    """The smallest value of each block (flat, in the order of ``spec.blocks()``)."""
+    rows, cols = spec.block
+    starts = (np.arange(0, values.shape[0], rows), np.arange(0, values.shape[1], cols))
+    return np.minimum.reduceat(np.minimum.reduceat(values, starts[0], axis=0), starts[1],
+                               axis=1).ravel()
+
+
 def complete_blocks(path, spec):
     """Indices (into ``spec.blocks()``) of the blocks whose ``computed`` flags are all 1."""
     import zarr
     flags = zarr.open_array(Path(path) / COMPUTED, mode='r')
-    blocks = spec.blocks()
     try:
-        values = flags[...]
-        return {k for k, block in enumerate(blocks) if np.all(values[block] == 1)}
+        return set(np.flatnonzero(_block_minima(flags[...], spec) == 1).tolist())
     except Exception:  # noqa: BLE001 (a damaged chunk object: look at the blocks one by one)
         found = set()
-        for k, block in enumerate(blocks):
+        for k, block in enumerate(spec.blocks()):
             try:
                 if np.all(flags[block] == 1):
                     found.add(k)
