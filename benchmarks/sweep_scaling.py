@@ -27,6 +27,7 @@ import contextlib
 import math
 import os
 from pathlib import Path
+import pickle
 import shutil
 import signal
 import socket
@@ -56,14 +57,16 @@ ENV.pop('DASK_SCHEDULER_ADDRESS', None)
 
 
 def per_body_cost(shape=(6, 8)):
-    """(wall s, CPU s) per body, serially in this process, on a sample of the map."""
+    """(wall s, CPU s, result bytes) per body, serially in this process, on a sample of the
+    map; result bytes: what a task of a NetCDF sweep sends to the client (pickled)."""
     b = np.linspace(*B_RANGE, shape[0])
     d = np.linspace(*D_RANGE, shape[1])
     bb, dd = (x.ravel() for x in np.meshgrid(b, d, indexing='ij'))
     chunk_quantities(bb[:2], dd[:2])            # imports and first-call caches apart
     start, cpu = time.perf_counter(), time.process_time()
-    chunk_quantities(bb, dd)
-    return (time.perf_counter() - start) / bb.size, (time.process_time() - cpu) / bb.size
+    result = chunk_quantities(bb, dd)
+    wall, cpu = time.perf_counter() - start, time.process_time() - cpu
+    return wall / bb.size, cpu / bb.size, len(pickle.dumps(result)) / bb.size
 
 
 def _free_port():
@@ -179,6 +182,8 @@ def scaling_run(workers, spec, folder):
         out['scheduler_rss'] = _peak_rss(scheduler.pid)
         out['worker_rss'] = max(_peak_rss(p.pid) for p in procs)
     tasks = run.computed
+    out['result_bytes'] = len(pickle.dumps({'bodies': 1, 'masked': 0, 'seconds': 1.0,
+                                            'cpu_seconds': 1.0, 'write_seconds': 1.0}))
     files = sum(1 for p in store.rglob('*') if p.is_file() and '/c/' in p.as_posix())
     out.update(wall=run.seconds, tasks=tasks, bodies=run.bodies, rate=run.bodies / run.seconds,
                compute=float(np.sum(run.chunk_seconds)),
@@ -237,13 +242,14 @@ def extrapolate(m, workers, chunk):
 
 def measure(quick=False, log=print):
     """Every measurement of this module (a dict; ``report_lines`` formats it)."""
-    wall, cpu = per_body_cost((4, 4) if quick else (6, 8))
+    wall, cpu, result_bytes = per_body_cost((4, 4) if quick else (6, 8))
     chunk = max(1, math.ceil(TASK_SECONDS / wall))
     rows = 8 if quick else ROWS
     log(f'   sweep scaling: {1e3 * wall:.1f} ms per body serially, tasks of {chunk} bodies')
     spec = SweepSpec(np.linspace(*B_RANGE, rows), np.linspace(*D_RANGE, chunk),
                      chunk_size=chunk)
     m = {'per_body': wall, 'per_body_cpu': cpu, 'chunk': chunk, 'rows': rows,
+         'netcdf_result_bytes_per_body': result_bytes,
          'cores': os.cpu_count(), 'load_before': os.getloadavg()[0], 'runs': []}
     with tempfile.TemporaryDirectory(prefix='sweep-scaling-') as folder:
         for workers in WORKERS:
@@ -254,8 +260,11 @@ def measure(quick=False, log=print):
     m['load_after'] = os.getloadavg()[0]
     one = m['runs'][0]
     two = next(r for r in m['runs'] if r['workers'] == 2)
-    # inside a worker: computing and writing, per body (the least contended run)
-    m['per_body_worker'] = min((r['compute'] + r['write']) / r['bodies'] for r in m['runs'])
+    # inside a worker: CPU time computing plus the wall time writing, per body (the least
+    # contended run): what a dedicated core spends (the wall time computing is inflated by
+    # other jobs on this shared machine)
+    m['per_body_worker'] = min((r['compute_cpu'] + r['write']) / r['bodies']
+                               for r in m['runs'])
     # the scheduler: CPU per task (empty tasks), and per second besides the tasks (its
     # periodic callbacks, heartbeats; from the sweeps: about the same for 1, 2 and 4 workers)
     m['scheduler_per_task'] = two['empty_scheduler']
@@ -297,14 +306,15 @@ def report_lines(m):
       f'oversubscribe them** (two processes per core), so their rate cannot pass the '
       f'2-worker one. Load average {m["load_before"]:.2f} before, {m["load_after"]:.2f} '
       'after (a shared machine).\n')
-    w('| workers | wall (s) | bodies/s | × 1 worker | scheduler CPU per task, all in (ms) | client '
-      'CPU per task (ms) | compute per chunk (s) | write per chunk (ms, median) | bytes per '
-      'chunk | peak memory: worker / scheduler |')
+    w('| workers | wall (s) | bodies/s | × 1 worker | scheduler CPU per task, all in (ms) | '
+      'client CPU per task (ms) | compute per chunk: wall, CPU (s) | write per chunk (ms, '
+      'median) | bytes per chunk | peak memory: worker / scheduler |')
     w('|---|---|---|---|---|---|---|---|---|---|')
     for r in m['runs']:
         w(f'| {r["workers"]} | {r["wall"]:.1f} | {r["rate"]:.1f} | '
           f'{r["rate"] / one["rate"]:.2f} | {1e3 * r["scheduler_cpu"] / r["tasks"]:.1f} | '
-          f'{1e3 * r["client_cpu_per_task"]:.1f} | {r["compute"] / r["tasks"]:.2f} | '
+          f'{1e3 * r["client_cpu_per_task"]:.1f} | {r["compute"] / r["tasks"]:.2f}, '
+          f'{r["compute_cpu"] / r["tasks"]:.2f} | '
           f'{1e3 * r["write_median"]:.0f} | {r["bytes"] / r["tasks"] / 1e3:.0f} kB in '
           f'{r["files_per_chunk"]:.0f} files | {_mib(r["worker_rss"])} / '
           f'{_mib(r["scheduler_rss"])} |')
@@ -313,18 +323,20 @@ def report_lines(m):
       f'**{1e3 * m["scheduler_per_task"]:.2f} ms of scheduler CPU per task**; besides the '
       f'tasks it spends {1e3 * m["scheduler_upkeep"]:.0f} ms of CPU per second (periodic '
       f'callbacks, heartbeats; from the sweeps, about the same for 1, 2 and 4 workers). '
-      f'Inside a worker a body costs {1e3 * m["per_body_worker"]:.1f} ms computing and '
-      f'writing (the least contended run). The client receives ~0.2 kB per task (counts and times; '
-      f'the workers write the data) and spends **{1e3 * m["client_per_task"]:.1f} ms of CPU '
-      f'per task**; its one-off costs on a {MAP[0]} × {MAP[1]} store (lay-out, resume scan '
+      f'Inside a worker a body costs {1e3 * m["per_body_worker"]:.1f} ms (CPU time '
+      f'computing, what a dedicated core spends, plus the wall time writing; the least '
+      f'contended run). The client receives {one["result_bytes"]} bytes '
+      f'per task, whatever its size (counts and times; the workers write the data: a task of '
+      f'a NetCDF sweep would send {m["netcdf_result_bytes_per_body"]:.0f} bytes per body) '
+      f'and spends **{1e3 * m["client_per_task"]:.1f} ms of CPU per task**; its one-off costs on a {MAP[0]} × {MAP[1]} store (lay-out, resume scan '
       f'of the flags, final count of the masked points) are {constant:.2f} s + '
       f'{1e3 * per_chunk:.2f} ms per chunk object read (timed on blocks of '
       f'{" and ".join(map(str, ONE_OFF_CHUNKS))} bodies). On disk: '
       f'**{m["bytes_per_body"]:.0f} bytes per body**, {m["files_per_chunk"]:.0f} files per '
       f'chunk.\n')
     w(f'Extrapolation to a {MAP[0]} × {MAP[1]} map (10⁶ bodies) on N workers like these. '
-      'Model: the tasks run in rounds of N, each costing the measured compute + write per '
-      'body inside a worker; the scheduler handles the tasks one after another at its CPU '
+      'Model: the tasks run in rounds of N on dedicated cores, each costing the measured '
+      'CPU + write per body inside a worker; the scheduler handles the tasks one after another at its CPU '
       'per task, plus its upkeep; the client likewise at its CPU per task; the wall time is '
       'the largest of the three plus the client\'s one-off costs. Rows: tasks of ~1 s, the '
       f'default chunk of a .zarr output ({DEFAULT_STORE_CHUNK_SIZE} bodies), and 8 rounds of '

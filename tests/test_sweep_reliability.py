@@ -365,6 +365,15 @@ def test_bad_input_for_a_zarr_store_one_line_exit_2(override, words, tmp_path, c
 
 
 @pytest.mark.slow
+def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
+    # Delta/a = 1e-300 passes the command line, but the body refuses a length below its range
+    _fails_in_one_line(['--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300', '1e-300', '1',
+                        '--out', str(tmp_path / 'x.zarr'), '--workers', '1', '--quiet'],
+                       capsys, 'no body of the grid could be computed', 'nothing written')
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
 def test_unreachable_scheduler_creates_no_store(tmp_path):
     from dask_helpers import free_port
     result = subprocess.run(
