@@ -11,9 +11,9 @@ client has seen every block complete, then 'complete').
 
 **Completion is the store's own state.** A task (:func:`write_block`, on a worker) computes
 its block, writes the block's chunk of every variable (zarr region writes), and only then
-its ``computed`` chunk. Zarr's local store writes each chunk object to a temporary name and renames it, so an
-object is whole or absent; a worker killed before the second write leaves the flags at 0,
-and the block counts as missing. To resume, the client reads ``computed`` (one byte per
+its ``computed`` chunk. Zarr's local store writes each chunk object to a temporary name and
+renames it, so an object is whole or absent; a worker killed before the flags are written
+leaves them at 0, and the block counts as missing. To resume, the client reads ``computed`` (one byte per
 point) and submits the blocks not complete (:func:`complete_blocks`); their chunks are
 simply written again. A task run twice (a worker thought lost that was not) writes the same
 bytes twice.
