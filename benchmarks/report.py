@@ -3,6 +3,7 @@
 import math
 
 import ros_layer
+import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
 
 from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS
@@ -224,6 +225,7 @@ def write_report(path, ctx):
 
     # --- the node and what is built on the physics
     out.extend(ros_layer.report_lines(ctx['ros_layer']))
+    out.extend(sweep_scaling.report_lines(ctx['sweep_scaling']))
 
     # --- figure
     w('## Work-precision plot\n')

@@ -39,6 +39,7 @@ from twodisk_ros import TwoDiskBody  # noqa: E402
 from twodisk_ros.outputs import OutputError, check_output  # noqa: E402
 from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
+import sweep_scaling  # noqa: E402
 
 
 def _run(cmd):
@@ -238,6 +239,8 @@ def main(argv=None):
 
     log('the node and the capabilities on the physics: poses, recording, real time, forces')
     ros = ros_layer.measure(builds, quick=args.quick, log=log)
+    log('the sweep on 1, 2, 4 workers and its extrapolation to a cluster')
+    scaling = sweep_scaling.measure(quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
 
     # why a target was missed
@@ -304,7 +307,8 @@ def main(argv=None):
                reference_check_rtol=REFERENCE_CHECK_RTOL, closed_form_check=check_text,
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
-               ros_layer=ros, commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
+               ros_layer=ros, sweep_scaling=scaling,
+               commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
                elapsed=elapsed)
     write_report(args.out, ctx)
     data = dict(date=date, machine=machine, elapsed=elapsed, quick=args.quick,
@@ -320,6 +324,7 @@ def main(argv=None):
                 hours=[h.as_dict() for h in hours],
                 ratios=[r.as_dict() for r in ratios],
                 ros_layer=ros_layer.as_dict(ros),
+                sweep_scaling=scaling,
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))

@@ -1,7 +1,7 @@
 """Outputs, runaway requests and --help of ``twodisk-sweep`` and ``twodisk-animate``.
 
 Every command runs as a real entry point in a subprocess. Most run inside a wrapper that
-makes importing Dask, distributed and xarray (and, for the early refusals of
+makes importing Dask, distributed, xarray and zarr (and, for the early refusals of
 ``twodisk-animate``, scipy and matplotlib) raise: a refusal that still comes out as one line
 with exit 2 was made before any of them was imported (not a timing claim). The runaway
 requests run under an address-space limit (RLIMIT_AS) so that a regression fails with a
@@ -30,7 +30,7 @@ ENV.pop('TWODISK_DEBUG', None)
 SWEEP = 'twodisk_ros.sweep'
 ANIMATE = 'twodisk_ros.plotting.animate_cli'      # twodisk-animate in setup.py
 ANIMATION = 'twodisk_ros.plotting.animation'
-DASK_LIKE = ('dask', 'distributed', 'xarray')
+DASK_LIKE = ('dask', 'distributed', 'xarray', 'zarr')
 HEAVY = DASK_LIKE + ('scipy', 'matplotlib')
 REFUSED = 'imported before the command line was checked'
 #: Address space for the runaway requests (B): Python with numpy needs ~0.5 GiB here.
@@ -144,6 +144,27 @@ def test_sweep_refuses_existing_maps(tmp_path):
     _one_line_exit_2(result, 'barrier.png exists', '--overwrite')
     assert (maps / 'barrier.png').read_bytes() == b'an earlier map'
     assert _listing(tmp_path) == ['maps'] and _listing(maps) == ['barrier.png']
+
+
+def test_sweep_refuses_an_existing_zarr_store_before_dask(tmp_path):
+    import numpy as np
+    from twodisk_ros.sweep.spec import SweepSpec
+    from twodisk_ros.sweep.store import create_store, finish_store
+    store = tmp_path / 'family.zarr'
+    finish_store(create_store(store, SweepSpec(np.array([1.0]), np.array([0.5]),
+                                               chunk_size=1)))
+    before = sorted((p, p.stat().st_mtime_ns) for p in store.rglob('*'))
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', store, cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'family.zarr exists', '--overwrite')
+    assert sorted((p, p.stat().st_mtime_ns) for p in store.rglob('*')) == before
+    # a directory the sweep did not write is never replaced, not even with --overwrite
+    (tmp_path / 'other.zarr').mkdir()
+    (tmp_path / 'other.zarr' / 'zarr.json').write_text('{"zarr_format": 3}')
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', tmp_path / 'other.zarr', '--overwrite',
+                     cwd=tmp_path, blocked=DASK_LIKE)
+    _one_line_exit_2(result, 'not a twodisk-sweep Zarr store', 'even with --overwrite')
+    assert _listing(tmp_path / 'other.zarr') == ['zarr.json']
+    assert _listing(tmp_path) == ['family.zarr', 'other.zarr']
 
 
 @pytest.mark.parametrize('name', ['family.csv', 'family', 'family.png'])

@@ -16,6 +16,11 @@ them through :func:`replacing`:
   atomic rename only when complete, so an interrupted or failed command leaves the old file
   byte for byte as it was (and no half-written new one).
 
+An output that is a directory of files (a Zarr store, ``twodisk-sweep --out FILE.zarr``) is
+checked by :func:`check_output_store`: the same rules, except that the existing path must be
+a directory *the command recognises as its own output* (a store it wrote) to be replaced with
+``--overwrite``; any other directory, and any file, is refused even then.
+
 Each refusal is an :class:`OutputError` whose message is one line naming the path, what is
 wrong and what is allowed; the commands print it and exit 2.
 """
@@ -25,7 +30,8 @@ import os
 import stat
 import tempfile
 
-__all__ = ['OutputError', 'check_output', 'check_output_dir', 'replacing', 'temporary_beside']
+__all__ = ['OutputError', 'check_output', 'check_output_dir', 'check_output_store', 'replacing',
+           'temporary_beside']
 
 
 class OutputError(ValueError):
@@ -39,6 +45,23 @@ def _kind(mode):
         if test(mode):
             return name
     return 'not a regular file'
+
+
+def _check_suffix(text, suffixes):
+    if suffixes:
+        suffix = os.path.splitext(text.rstrip(os.sep))[1].lower()
+        if suffix not in suffixes:
+            allowed = ', '.join(suffixes)
+            raise OutputError(f'{text}: cannot write a {suffix or "suffix-less"} file here '
+                              f'(allowed: {allowed})')
+
+
+def _check_parent(text):
+    parent = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(parent):
+        raise OutputError(f'{text}: directory {parent} does not exist')
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f'{text}: directory {parent} is not writable')
 
 
 def check_output(path, *, overwrite=False, suffixes=None, option='--overwrite'):
@@ -59,12 +82,7 @@ def check_output(path, *, overwrite=False, suffixes=None, option='--overwrite'):
     text = os.fspath(path)
     if not text:
         raise OutputError('the output path is empty')
-    if suffixes:
-        suffix = os.path.splitext(text)[1].lower()
-        if suffix not in suffixes:
-            allowed = ', '.join(suffixes)
-            raise OutputError(f'{text}: cannot write a {suffix or "suffix-less"} file here '
-                              f'(allowed: {allowed})')
+    _check_suffix(text, suffixes)
     try:
         info = os.stat(text)
     except FileNotFoundError:
@@ -78,11 +96,34 @@ def check_output(path, *, overwrite=False, suffixes=None, option='--overwrite'):
                               'regular file (or a new name)')
         if not overwrite:
             raise OutputError(f'{text} exists: pass {option} to replace it')
-    parent = os.path.dirname(os.path.abspath(text))
-    if not os.path.isdir(parent):
-        raise OutputError(f'{text}: directory {parent} does not exist')
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise OutputError(f'{text}: directory {parent} is not writable')
+    _check_parent(text)
+    return path
+
+
+def check_output_store(path, *, overwrite=False, suffixes=None, option='--overwrite',
+                       recognised=lambda path: False, what='store'):
+    """Check that the directory output ``path`` may be written; return it or raise
+    :class:`OutputError`.
+
+    As :func:`check_output`, for an output that is a directory (a Zarr store): an existing
+    ``path`` is refused unless ``overwrite``, and even then unless it is a directory for
+    which ``recognised(path)`` is true (a ``what`` the command wrote itself; anything else
+    it never replaces or removes).
+    """
+    text = os.fspath(path)
+    if not text:
+        raise OutputError('the output path is empty')
+    _check_suffix(text, suffixes)
+    if os.path.lexists(text):
+        if os.path.islink(text) or not os.path.isdir(text):
+            raise OutputError(f'{text} exists and is not a directory: the output must be a '
+                              f'{what} directory (or a new name)')
+        if not recognised(text):
+            raise OutputError(f'{text} exists and is not a {what} written by this command: '
+                              f'refused even with {option} (choose a new name)')
+        if not overwrite:
+            raise OutputError(f'{text} exists: pass {option} to replace it')
+    _check_parent(text)
     return path
 
 

@@ -2,18 +2,20 @@
 
 Usage::
 
-    twodisk-sweep --b-over-a START STOP N --delta-over-a START STOP N --out FILE.nc
+    twodisk-sweep --b-over-a START STOP N --delta-over-a START STOP N --out FILE.nc|FILE.zarr
                   [--mass-model laminae|solid] [--reference-speed W] [--scheduler ADDRESS]
                   [--workers N] [--chunk-size K] [--plot DIR] [--overwrite] [--fresh]
                   [--keep-parts] [--quiet]
 
 The whole command line is checked first (numbers, the size of the grid against the memory of
 the machine, the outputs), before Dask or xarray is imported: a mistake costs a fraction of a
-second. Outputs follow :mod:`twodisk_ros.outputs`: ``--out`` must end in ``.nc``; an existing
-output (``FILE.nc``, or a ``DIR/NAME.png`` of ``--plot``) is refused unless ``--overwrite``;
-files are written through hidden temporary names and renamed, so an interrupted or failed
-sweep leaves them as they were. The resume cache ``FILE.nc.parts/`` is not an output: an
-interrupted sweep resumes with or without ``--overwrite`` (``--fresh`` discards the cache).
+second. Outputs follow :mod:`twodisk_ros.outputs`: ``--out`` ends in ``.nc`` (a NetCDF file
+written by the client) or ``.zarr`` (a Zarr store written by the workers); an existing output
+(``FILE.nc``, a finished ``FILE.zarr``, or a ``DIR/NAME.png`` of ``--plot``) is refused unless
+``--overwrite``; files are written through hidden temporary names and renamed, so an
+interrupted or failed sweep leaves them as they were. The resume state (``FILE.nc.parts/``,
+or an interrupted ``FILE.zarr`` itself) is resumed with or without ``--overwrite``
+(``--fresh`` discards it). docs/sweeps.md has the rules.
 
 Exit status: 0 written; 1 a task failed (finished chunks are kept: run again to resume);
 2 bad input, a grid too large for this machine, a grid without any valid body, unreachable
@@ -29,8 +31,9 @@ import sys
 import tempfile
 
 from ..outputs import OutputError, check_output, check_output_dir
-from .request import (DEFAULT_CHUNK_SIZE, MAX_BODIES, SweepError, check_size, check_some_valid,
-                      grid_range, linspace_grid)
+from .request import (DEFAULT_CHUNK_SIZE, DEFAULT_STORE_CHUNK_SIZE, FORMATS, MAX_BODIES,
+                      SweepError, check_size, check_some_valid, default_chunk_size, grid_range,
+                      linspace_grid, output_format, store_plan)
 
 __all__ = ['main', 'PROG', 'MAX_WORKERS_PER_CORE']
 
@@ -55,7 +58,7 @@ def _parser():
     parser = _Parser(
         prog=PROG,
         description='Compute maps of the rolling two-disk bodies over b/a and Delta/a '
-                    '(a = g = M = 1) on Dask and save them as NetCDF.',
+                    '(a = g = M = 1) on Dask and save them as NetCDF (.nc) or Zarr (.zarr).',
         epilog='Exit status: 0 done, 1 a task failed, 2 bad input / grid too large or without '
                'a valid body / unreachable scheduler / unwritable output, 130 interrupted '
                '(run again to resume).')
@@ -64,9 +67,11 @@ def _parser():
     parser.add_argument('--delta-over-a', nargs=3, required=True,
                         metavar=('START', 'STOP', 'N'),
                         help='grid of Delta/a, inclusive; points with Delta/a >= 1 are masked')
-    parser.add_argument('--out', required=True, metavar='FILE.nc',
-                        help='NetCDF output file (.nc); an existing one is refused unless '
-                             '--overwrite')
+    parser.add_argument('--out', required=True, metavar='FILE.nc|FILE.zarr',
+                        help='output: a NetCDF file (.nc, small maps) or a Zarr store (.zarr, '
+                             'large maps, written by the workers, its own resume state); an '
+                             'existing one is refused unless --overwrite (an interrupted '
+                             '.zarr of the same sweep is resumed)')
     parser.add_argument('--mass-model', default='laminae', choices=('laminae', 'solid'),
                         help='laminae (two thin disks, default) or solid (convex hull)')
     parser.add_argument('--reference-speed', default='0.5', metavar='W',
@@ -78,19 +83,22 @@ def _parser():
     parser.add_argument('--workers', metavar='N',
                         help='worker processes of the local cluster (default: every core)')
     parser.add_argument('--chunk-size', default=None, metavar='K',
-                        help='bodies per task (default 16, ~1 s of work)')
+                        help=f'the most bodies per task (default {DEFAULT_CHUNK_SIZE} for .nc, '
+                             f'{DEFAULT_STORE_CHUNK_SIZE} for .zarr; fewer on small grids)')
     parser.add_argument('--plot', metavar='DIR',
                         help='write one PNG map per variable to DIR/NAME.png (DIR is created '
                              'if its parent exists)')
     parser.add_argument('--overwrite', action='store_true',
-                        help='replace an existing FILE.nc and existing maps (they are replaced '
-                             'only once the new ones are complete); the resume cache is kept '
-                             'either way')
+                        help='replace an existing FILE.nc, a finished FILE.zarr and existing '
+                             'maps; the resume state is kept either way')
     parser.add_argument('--fresh', action='store_true',
-                        help='discard the resume cache FILE.nc.parts/ of an earlier sweep')
+                        help='discard the resume state of an earlier sweep (FILE.nc.parts/, '
+                             'an interrupted FILE.zarr) and compute everything again')
     parser.add_argument('--keep-parts', action='store_true',
-                        help='keep FILE.nc.parts/ after the output is written')
-    parser.add_argument('--quiet', action='store_true', help='no progress line')
+                        help='.nc: keep FILE.nc.parts/ after the output is written')
+    parser.add_argument('--quiet', action='store_true',
+                        help='no progress bar (there is none either when stderr is not a '
+                             'terminal); the summary line is still printed')
     return parser
 
 
@@ -123,8 +131,9 @@ def _plot_names():
 
 
 def _checked(args):
-    """Everything of the command line checked, nothing allocated or imported beyond numpy
-    (scipy with --plot); returns (b range, Delta range, reference speed, chunk, workers).
+    """Everything of the command line checked, nothing allocated or imported beyond numpy and
+    the names of the quantities (scipy; the spec is built only once the grid's size passed);
+    returns (SweepSpec, format, workers).
 
     Raises _Usage, SweepError or OutputError (one line each)."""
     workers = None
@@ -145,23 +154,36 @@ def _checked(args):
     if not 0 <= speed <= MAX_REFERENCE_SPEED:
         raise _Usage(f'--reference-speed must be finite, 0 <= W <= {MAX_REFERENCE_SPEED:g}, '
                      f'got {args.reference_speed!r}')
-    chunk = (DEFAULT_CHUNK_SIZE if args.chunk_size is None
+    fmt = output_format(args.out)
+    chunk = (default_chunk_size(b[2] * d[2], fmt) if args.chunk_size is None
              else _integer('--chunk-size', args.chunk_size))
     if chunk > MAX_BODIES:
         raise _Usage(f'--chunk-size must be an integer from 1 to {MAX_BODIES} (the most '
                      f'bodies of a sweep), got {args.chunk_size!r}')
-    check_size(b[2], d[2], chunk)
+    if os.path.isdir(args.out) and fmt != 'zarr':    # said first: the suffix is not the problem
+        raise OutputError(f'{args.out} is a directory: --out must name a .nc file or a .zarr '
+                          f'store')
+    if fmt is None:
+        check_output(args.out, suffixes=tuple(FORMATS))    # the refusal of the suffix
+    check_size(b[2], d[2], chunk, fmt)
     check_some_valid(d[0])
-    if os.path.isdir(args.out):       # said first: the suffix is not the problem then
-        raise OutputError(f'{args.out} is a directory: --out must name a .nc file')
-    check_output(args.out, overwrite=args.overwrite, suffixes=('.nc',))
-    parts = f'{args.out}.parts'
-    if os.path.lexists(parts) and not os.path.isdir(parts):
-        raise SweepError(f'{parts} (the resume cache of {args.out}) exists and is not a '
-                         f'directory')
+    if fmt == 'zarr' and args.keep_parts:
+        raise _Usage('--keep-parts is for a .nc output only (a .zarr store is its own resume '
+                     'state)')
+    from .spec import SweepSpec     # (the names of the quantities: scipy, no Dask)
+    spec = SweepSpec(linspace_grid('--b-over-a', *b), linspace_grid('--delta-over-a', *d),
+                     args.mass_model, speed, chunk)
+    if fmt == 'zarr':
+        store_plan(args.out, spec.manifest(), overwrite=args.overwrite, fresh=args.fresh)
+    else:
+        check_output(args.out, overwrite=args.overwrite, suffixes=tuple(FORMATS))
+        parts = f'{args.out}.parts'
+        if os.path.lexists(parts) and not os.path.isdir(parts):
+            raise SweepError(f'{parts} (the resume cache of {args.out}) exists and is not a '
+                             f'directory')
     if args.plot:
         check_output_dir(args.plot, overwrite=args.overwrite, names=_plot_names())
-    return b, d, speed, chunk, workers
+    return spec, fmt, workers
 
 
 def _write_maps(dataset, folder, overwrite):
@@ -197,46 +219,41 @@ def main(argv=None):
     """Run the command line; returns the exit status (see the module docstring)."""
     try:
         args = _parser().parse_args(argv)
-        (b0, b1, nb), (d0, d1, nd), speed, chunk, workers = _checked(args)
+        spec, fmt, workers = _checked(args)
     except (_Usage, SweepError, OutputError) as error:
         return _fail(error)
     # checked: from here on xarray (run, dataset) and, in dask_client, Dask
     from .parts import PartsCache, PartsMismatch, parts_folder
-    from .run import SweepSpec, dask_client, run_sweep
-    try:
-        spec = SweepSpec(linspace_grid('--b-over-a', b0, b1, nb),
-                         linspace_grid('--delta-over-a', d0, d1, nd), args.mass_model,
-                         speed, chunk)
-    except SweepError as error:
-        return _fail(error)
+    from .progress import summary_line
+    from .run import dask_client, run_sweep
     progress = None if args.quiet else sys.stderr
-    try:
-        cache = PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
-    except PartsMismatch as error:
-        return _fail(error)
-    except OSError as error:
-        return _fail(f'cannot write {args.out}.parts/: {error.strerror or error}')
+    cache = None
+    kept = f'{args.out}.parts/' if fmt == 'netcdf' else args.out
+    if fmt == 'netcdf':
+        try:
+            cache = PartsCache(parts_folder(args.out), spec.manifest(), fresh=args.fresh)
+        except PartsMismatch as error:
+            return _fail(error)
+        except OSError as error:
+            return _fail(f'cannot write {args.out}.parts/: {error.strerror or error}')
     try:
         with dask_client(args.scheduler, workers) as client:
-            run = run_sweep(spec, client, out=args.out, progress=progress,
+            run = run_sweep(spec, client, out=args.out, progress=progress, fresh=args.fresh,
                             keep_parts=args.keep_parts, overwrite=args.overwrite)
-    except (SweepError, PartsMismatch) as error:
-        if not cache.finished():
+    except (SweepError, PartsMismatch, OutputError) as error:
+        if cache is not None and not cache.finished():
             cache.remove()    # nothing to resume: leave no empty cache behind
         return _fail(error)
     except OSError as error:
         return _fail(f'cannot write {args.out}: {error}')
     except KeyboardInterrupt:
-        print(f'{PROG}: interrupted; finished chunks are kept in {args.out}.parts/ - run the '
-              f'same command again to resume', file=sys.stderr)
+        print(f'{PROG}: interrupted; finished chunks are kept in {kept} - run the same '
+              f'command again to resume', file=sys.stderr)
         return 130
-    except Exception as error:  # noqa: BLE001 (a task died: keep the cache, one line)
+    except Exception as error:  # noqa: BLE001 (a task died: keep the state, one line)
         return _fail(f'a task failed ({type(error).__name__}: {error}); finished chunks are '
-                     f'kept in {args.out}.parts/, run again to resume', status=1)
-    masked = int((run.dataset['failure'] != '').sum())
-    print(f'{PROG}: wrote {run.output} ({spec.size} bodies, {masked} masked; '
-          f'{run.computed} chunks computed, {run.resumed} resumed, {run.seconds:.1f} s)',
-          file=sys.stderr)
+                     f'kept in {kept}, run again to resume', status=1)
+    print(f'{PROG}: {summary_line(run)}', file=sys.stderr)
     if args.plot:
         try:
             written = _write_maps(run.dataset, args.plot, args.overwrite)

@@ -1,10 +1,11 @@
-"""The result of a sweep as an xarray Dataset, and its NetCDF file.
+"""The result of a sweep as an xarray Dataset, its NetCDF file, and the layout of its Zarr store.
 
 Coordinates ``b_over_a`` and ``delta_over_a`` (dimensionless, a = 1); one float64 variable per
 name of :data:`~twodisk_ros.sweep.quantities.VARIABLES` with ``units`` and ``description``
 attributes, NaN where a body failed; ``failure`` (str, '' on success) says why. The package
-version and the sweep's parameters are global attributes. Files are NetCDF3 (scipy backend),
-written to a hidden temporary name and renamed.
+version and the sweep's parameters are global attributes. NetCDF files are NetCDF3 (scipy
+backend), written to a hidden temporary name and renamed. A Zarr store
+(:mod:`~twodisk_ros.sweep.store`) has the same variables, chunked, and ``computed``.
 """
 
 from pathlib import Path
@@ -15,7 +16,35 @@ import xarray as xr
 from ..outputs import replacing
 from .quantities import FAMILIES, VARIABLES
 
-__all__ = ['build_dataset', 'write_netcdf', 'read_netcdf']
+__all__ = ['build_dataset', 'template_dataset', 'write_netcdf', 'read_netcdf', 'read_sweep',
+           'COMPUTED']
+
+#: The completion flags of a Zarr store (int8 per point; store.py).
+COMPUTED = 'computed'
+DIMS = ('b_over_a', 'delta_over_a')
+
+
+def _variable_attrs():
+    """name → attributes of every variable of the output (``failure`` included)."""
+    attrs = {name: {'units': units, 'description': description}
+             for name, (units, description) in VARIABLES.items()}
+    attrs['stable_family'].update({
+        'flag_values': np.array(sorted(FAMILIES), dtype=np.int32),
+        'flag_meanings': ' '.join(FAMILIES[k].replace(' ', '_') for k in sorted(FAMILIES))})
+    attrs['failure'] = {'units': '1', 'description': "why the point is masked (NaN); '' if "
+                                                     "computed"}
+    return attrs
+
+
+def _coords(b, d):
+    return {
+        'b_over_a': ('b_over_a', b, {'units': '1', 'long_name': 'b/a',
+                                     'description': 'semi-axis b over the semi-axis a along '
+                                                    'the common axis (a = 1)'}),
+        'delta_over_a': ('delta_over_a', d, {'units': '1', 'long_name': 'Delta/a',
+                                             'description': 'half the distance between the '
+                                                            'disk centres over a'}),
+    }
 
 
 def build_dataset(b_over_a, delta_over_a, arrays, attrs):
@@ -26,8 +55,8 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
     b_over_a, delta_over_a : 1-D array_like
         Grid coordinates (dimensionless).
     arrays : dict
-        name → flat array of ``len(b_over_a) * len(delta_over_a)`` values in C order (b/a
-        major), for every name of ``VARIABLES`` and ``failure``.
+        name → array of ``len(b_over_a) * len(delta_over_a)`` values, flat in C order (b/a
+        major) or of the grid's shape, for every name of ``VARIABLES`` and ``failure``.
     attrs : dict
         Global attributes (str, int or float values).
 
@@ -38,26 +67,36 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
     shape = (b.size, d.size)
-    dims = ('b_over_a', 'delta_over_a')
-    data = {}
-    for name, (units, description) in VARIABLES.items():
-        data[name] = (dims, np.asarray(arrays[name], dtype=float).reshape(shape),
-                      {'units': units, 'description': description})
-    data['stable_family'][2].update({
-        'flag_values': np.array(sorted(FAMILIES), dtype=np.int32),
-        'flag_meanings': ' '.join(FAMILIES[k].replace(' ', '_') for k in sorted(FAMILIES))})
+    attrs_of = _variable_attrs()
+    data = {name: (DIMS, np.asarray(arrays[name], dtype=float).reshape(shape), attrs_of[name])
+            for name in VARIABLES}
     failure = np.asarray(arrays['failure'], dtype=str).reshape(shape)
-    data['failure'] = (dims, failure, {'units': '1', 'description':
-                                       "why the point is masked (NaN); '' if computed"})
-    coords = {
-        'b_over_a': ('b_over_a', b, {'units': '1', 'long_name': 'b/a',
-                                     'description': 'semi-axis b over the semi-axis a along '
-                                                    'the common axis (a = 1)'}),
-        'delta_over_a': ('delta_over_a', d, {'units': '1', 'long_name': 'Delta/a',
-                                             'description': 'half the distance between the '
-                                                            'disk centres over a'}),
-    }
-    return xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    data['failure'] = (DIMS, failure, attrs_of['failure'])
+    return xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+
+
+def template_dataset(b_over_a, delta_over_a, block, attrs):
+    """The sweep's Dataset with lazy (Dask) variables, and the encoding that chunks them in
+    ``block`` = (rows, columns): what ``to_zarr(compute=False, encoding=...)`` lays out as an
+    empty store. Floats NaN, ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
+    (int8; 1 once a block is complete). Returns (Dataset, encoding).
+
+    Each variable is one Dask chunk (a graph of one task per variable, however many blocks:
+    nothing of it is computed); the store's chunks come from the encoding."""
+    import dask.array as da
+    b = np.asarray(b_over_a, dtype=float)
+    d = np.asarray(delta_over_a, dtype=float)
+    shape, chunks = (b.size, d.size), tuple(int(x) for x in block)
+    attrs_of = _variable_attrs()
+    data = {name: (DIMS, da.full(shape, np.nan, chunks=-1), attrs_of[name])
+            for name in VARIABLES}
+    data['failure'] = (DIMS, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=-1),
+                       attrs_of['failure'])
+    data[COMPUTED] = (DIMS, da.zeros(shape, dtype=np.int8, chunks=-1), {
+        'units': '1', 'description': '1 where the point was computed and written (its chunk '
+                                     'complete), 0 where not yet (an interrupted sweep)'})
+    dataset = xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+    return dataset, {name: {'chunks': chunks} for name in dataset.data_vars}
 
 
 def write_netcdf(dataset, path):
@@ -73,10 +112,16 @@ def write_netcdf(dataset, path):
 
 def read_netcdf(path):
     """The Dataset of a sweep file, in memory, variables in the order written (file closed)."""
-    with xr.open_dataset(path, engine='scipy') as dataset:
+    return read_sweep(path)
+
+
+def read_sweep(path):
+    """The Dataset of a sweep's output, NetCDF file or Zarr store (the engine is chosen by
+    xarray), in memory, variables in the order written, ``failure`` as ``str``."""
+    with xr.open_dataset(path) as dataset:
         dataset = dataset.load()
     order = [name for name in (*VARIABLES, 'failure') if name in dataset.data_vars]
     dataset = dataset[order + [n for n in dataset.data_vars if n not in order]]
-    if 'failure' in dataset:
-        dataset['failure'] = dataset['failure'].astype(str)
+    if 'failure' in dataset:     # (numpy's StringDType from Zarr: str through object)
+        dataset['failure'] = dataset['failure'].astype(object).astype(str)
     return dataset

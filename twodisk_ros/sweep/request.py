@@ -6,32 +6,55 @@ line here, so a typo costs the start of Python, not the start of Dask.
 - :func:`grid_range` checks START, STOP, N of a grid (without building it) and
   :func:`linspace_grid` builds it;
 - :func:`check_size` estimates the memory and work of a grid and refuses a runaway one;
-- :func:`check_some_valid` refuses a grid in which no body can be valid (every Δ/a ≥ 1).
+- :func:`check_some_valid` refuses a grid in which no body can be valid (every Δ/a ≥ 1);
+- :func:`output_format` tells the output's format by its suffix, :func:`store_info` what an
+  existing Zarr store holds (its JSON metadata only, without zarr).
 
 Memory estimate (bytes, measured on this machine with ``benchmarks``-style scripts, peak RSS
 of the client process, rounded up): :data:`BYTES_PER_BODY` for the result arrays, the
 xarray Dataset and its NetCDF encoding (0.3 KiB with empty ``failure`` strings, 0.9 KiB with
-~100-character ones; a failure is at most 200 characters); :data:`BYTES_PER_TASK` per Dask
-task (future, task state and its graph in the client and the local scheduler: 18 KiB peak per
-task for 20 000 tasks); :data:`BYTES_PER_AXIS_VALUE` for the manifest of the resume cache.
+~100-character ones; a failure is at most 200 characters); for a Zarr store the client holds
+no results, only :data:`BYTES_PER_BODY_ZARR` (the completion flags read to resume, the
+``failure`` strings read to count the masked points); :data:`BYTES_PER_TASK` per Dask task
+(future, task state and its graph in the client and the local scheduler: 18 KiB peak per task
+for 20 000 tasks); :data:`BYTES_PER_AXIS_VALUE` for the manifest of the resume state.
 """
 
+import json
 import math
+import os
 
 import numpy as np
 
 from ..limits import LimitError, check_memory, describe_bytes
 
 __all__ = ['SweepError', 'linspace_grid', 'grid_range', 'estimate', 'check_size',
-           'check_some_valid', 'DEFAULT_CHUNK_SIZE', 'MAX_BODIES', 'BYTES_PER_BODY',
-           'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE', 'CORE_SECONDS_PER_BODY']
+           'check_some_valid', 'default_chunk_size', 'output_format', 'store_info',
+           'StoreInfo', 'FORMATS', 'DEFAULT_CHUNK_SIZE', 'DEFAULT_STORE_CHUNK_SIZE',
+           'MIN_CHUNKS', 'MAX_BODIES',
+           'BYTES_PER_BODY', 'BYTES_PER_BODY_ZARR', 'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE',
+           'CORE_SECONDS_PER_BODY', 'STORE_MANIFEST', 'STORE_STATE']
 
-#: Bodies per task: ~1 s of work on one core (benchmarks/sweep_rate.py).
+#: Bodies per task of a NetCDF sweep (the default of the library too): ~1 s of work on one
+#: core (benchmarks/sweep_rate.py), so the scheduler's ~1 ms per task stays below 1 %.
 DEFAULT_CHUNK_SIZE = 16
+#: Bodies per task of a Zarr sweep: one chunk of every variable, 17 files of a few kB; far
+#: fewer files, tasks and client reads (~0.3 ms per chunk) than 16-body chunks on the large
+#: maps Zarr is for (docs/sweeps.md "Scaling"; benchmarks/sweep_scaling.py).
+DEFAULT_STORE_CHUNK_SIZE = 1024
+#: Without --chunk-size a grid is cut into at least this many tasks (smaller chunks on small
+#: grids), so that a small map still spreads over the cores.
+MIN_CHUNKS = 16
+#: Output suffix → format.
+FORMATS = {'.nc': 'netcdf', '.zarr': 'zarr'}
+#: Attributes of a sweep's Zarr store: the manifest (JSON) and 'complete' / 'incomplete'.
+STORE_MANIFEST, STORE_STATE = 'sweep_manifest', 'sweep_state'
 #: At most this many bodies in one sweep (~220 core-hours at CORE_SECONDS_PER_BODY).
 MAX_BODIES = 10_000_000
 #: Client memory per body (B): result arrays, Dataset, NetCDF encoding (see the docstring).
 BYTES_PER_BODY = 2048
+#: Client memory per body with a Zarr output (B; see the docstring).
+BYTES_PER_BODY_ZARR = 64
 #: Client and local-scheduler memory per task (B).
 BYTES_PER_TASK = 20 * 1024
 #: Memory per grid value of the resume cache's manifest (float.hex strings) (B).
@@ -85,11 +108,22 @@ def linspace_grid(name, start, stop, n):
     return np.linspace(start, stop, n)
 
 
-def estimate(n_b, n_delta, chunk_size):
-    """(bytes of memory, core-seconds of work) of a sweep of ``n_b`` × ``n_delta`` bodies."""
+def default_chunk_size(bodies, fmt='netcdf'):
+    """Bodies per task when --chunk-size is not given: :data:`DEFAULT_CHUNK_SIZE` (NetCDF) or
+    :data:`DEFAULT_STORE_CHUNK_SIZE` (Zarr), smaller on a small grid so that it has at least
+    :data:`MIN_CHUNKS` tasks. Depends on the grid only, so the same command resumes."""
+    base = DEFAULT_STORE_CHUNK_SIZE if fmt == 'zarr' else DEFAULT_CHUNK_SIZE
+    return max(1, min(base, math.ceil(bodies / MIN_CHUNKS)))
+
+
+def estimate(n_b, n_delta, chunk_size, fmt='netcdf'):
+    """(bytes of client memory, core-seconds of work) of a sweep of ``n_b`` × ``n_delta``
+    bodies written as ``fmt`` ('netcdf' or 'zarr'); tasks counted as if the grid were cut
+    into runs of ``chunk_size`` (rectangular blocks give at most twice as many)."""
     bodies = n_b * n_delta
-    tasks = -(-bodies // max(1, int(chunk_size)))
-    memory = (bodies * BYTES_PER_BODY + tasks * BYTES_PER_TASK
+    tasks = 2 * -(-bodies // max(1, int(chunk_size)))
+    per_body = BYTES_PER_BODY_ZARR if fmt == 'zarr' else BYTES_PER_BODY
+    memory = (bodies * per_body + tasks * BYTES_PER_TASK
               + (n_b + n_delta) * BYTES_PER_AXIS_VALUE)
     return memory, bodies * CORE_SECONDS_PER_BODY
 
@@ -99,11 +133,11 @@ def _hours(seconds):
     return f'{hours:.3g} core-hours' if hours >= 0.1 else f'{seconds:.3g} core-seconds'
 
 
-def check_size(n_b, n_delta, chunk_size):
+def check_size(n_b, n_delta, chunk_size, fmt='netcdf'):
     """Refuse a sweep that needs more than :data:`MAX_BODIES` bodies or more memory than
     :func:`~twodisk_ros.limits.memory_limit` allows (SweepError, one line)."""
     bodies = n_b * n_delta
-    memory, work = estimate(n_b, n_delta, chunk_size)
+    memory, work = estimate(n_b, n_delta, chunk_size, fmt)
     what = (f'the grid of {n_b} x {n_delta} = {bodies} bodies in tasks of {chunk_size} '
             f'(~{_hours(work)} of work)')
     if bodies > MAX_BODIES:
@@ -112,7 +146,8 @@ def check_size(n_b, n_delta, chunk_size):
     try:
         check_memory(memory, what)
     except LimitError as error:
-        raise SweepError(f'{error} (a larger --chunk-size needs less)') from None
+        hint = '' if fmt == 'zarr' else ', a .zarr output far less'
+        raise SweepError(f'{error} (a larger --chunk-size needs less{hint})') from None
     return memory, work
 
 
@@ -123,3 +158,58 @@ def check_some_valid(delta_start):
         raise SweepError(f'--delta-over-a: every point has Delta/a >= 1 (START = '
                          f'{delta_start!r}): no body of the grid is valid (needs 0 < Delta/a '
                          f'< 1)')
+
+
+def output_format(path):
+    """'netcdf' or 'zarr' by the suffix of ``path`` (lower case), None for another one."""
+    return FORMATS.get(os.path.splitext(os.fspath(path).rstrip('/'))[1].lower())
+
+
+class StoreInfo:
+    """What an existing Zarr store of a sweep holds: its ``manifest`` (dict) and whether the
+    sweep finished (``complete``)."""
+
+    def __init__(self, manifest, complete):
+        self.manifest, self.complete = manifest, complete
+
+
+def store_info(path):
+    """The :class:`StoreInfo` of the sweep store at ``path``, or None if it is not one (no
+    such directory, or a directory that is not a store written by ``twodisk-sweep``).
+
+    Reads the store's root metadata (``zarr.json``) with :mod:`json` only."""
+    try:
+        with open(os.path.join(os.fspath(path), 'zarr.json'), encoding='utf-8') as handle:
+            attrs = json.load(handle).get('attributes', {})
+        manifest = json.loads(attrs[STORE_MANIFEST])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return StoreInfo(manifest, attrs.get(STORE_STATE) == 'complete')
+
+
+def store_plan(path, manifest, *, overwrite=False, fresh=False):
+    """What a sweep with ``manifest`` does with the Zarr output ``path``: 'create' (no such
+    path), 'resume' (an interrupted store of the same sweep), or 'replace' (a store of this
+    command that ``--overwrite`` or ``--fresh`` may discard); json only, no zarr.
+
+    Rules (docs/sweeps.md "Outputs and --overwrite"): an interrupted store of the same sweep
+    is resumed, with or without ``overwrite`` (``fresh`` discards it); a finished store is
+    replaced only with ``overwrite``; an interrupted store of another grid or options only
+    with ``overwrite`` or ``fresh``; anything else at ``path`` (a file, a foreign directory)
+    never. Refusals raise :class:`~twodisk_ros.outputs.OutputError` or
+    :class:`SweepError`, one line each.
+    """
+    from ..outputs import check_output_store
+    text = os.fspath(path)
+    info = store_info(text) if os.path.isdir(text) and not os.path.islink(text) else None
+    if info is not None and not info.complete:
+        if info.manifest == manifest and not fresh:
+            return 'resume'
+        if info.manifest != manifest and not (overwrite or fresh):
+            raise SweepError(f'{text} holds an interrupted sweep of a different grid or '
+                             f'options (or package version): pass --overwrite to replace '
+                             f'it, or choose another name')
+        overwrite = True
+    check_output_store(text, overwrite=overwrite, suffixes=('.zarr',),
+                       recognised=lambda p: info is not None, what='twodisk-sweep Zarr store')
+    return 'create' if info is None else 'replace'

@@ -1,17 +1,24 @@
-"""A sweep over the family of bodies on Dask: grid, chunks, progress and resume.
+"""A sweep over the family of bodies on Dask: tasks, results, progress and resume.
 
-The grid (b/a × Δ/a, inclusive as :func:`numpy.linspace`) is flattened in C order (b/a major)
-and cut into chunks of consecutive points; each chunk is one Dask task running
-:func:`~twodisk_ros.sweep.quantities.timed_chunk` on a worker (which imports the physics
-only, not xarray). Results come back to the
-client, which saves each finished chunk in the resume cache
-(:class:`~twodisk_ros.sweep.parts.PartsCache`, ``FILE.nc.parts/``) as it completes, so
-workers need no shared file system and an interrupted sweep recomputes only the chunks it had
-not finished. The default chunk holds 16 bodies, ~0.5 s of work on one core (benchmarks/
-sweep_rate.py measures the per-task overhead of the scheduler at a few ms). Every worker
-gets the plugin :class:`~twodisk_ros.sweep.worker.SweepWorkerSetup` first, which undoes the
-allocator setting of Dask's nanny that made a body 1.7× as costly on a worker as in a plain
-process.
+The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`); each block is one
+Dask task on a worker. Where the results go depends on the output's suffix:
+
+- ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.quantities.timed_chunk`) sends
+  its block's values back to the client, which saves each finished block in the resume cache
+  (:class:`~twodisk_ros.sweep.parts.PartsCache`, ``FILE.nc.parts/``) and writes the NetCDF
+  file at the end. Workers need no shared file system; the client holds the whole map.
+- ``FILE.zarr`` (large maps): the client lays out the store
+  (:func:`~twodisk_ros.sweep.store.create_store`), and each task
+  (:func:`~twodisk_ros.sweep.store.write_block`) writes its block into it and returns a few
+  numbers; the client carries no data. The store's completion flags are the resume state.
+  Workers and client must share the file system.
+
+The default chunk holds 16 bodies for NetCDF, ~0.5-1 s of work on one core, and 1024 for Zarr
+(far fewer tasks, files and reads on large maps), against ~1 ms of scheduler CPU and a few ms
+of client CPU per task (benchmarks/sweep_scaling.py; docs/sweeps.md "Scaling"). Every
+worker gets the plugin :class:`~twodisk_ros.sweep.worker.SweepWorkerSetup` first, which
+undoes the allocator setting of Dask's nanny that made a body 1.7× as costly on a worker as
+in a plain process.
 
 Clusters (:func:`dask_client`): by default a ``LocalCluster`` of worker processes on every
 core, listening on 127.0.0.1 only, without dashboard; or any running scheduler given by its
@@ -29,12 +36,13 @@ import time
 
 import numpy as np
 
-from .. import __version__
 from ..outputs import OutputError, check_output
 from .dataset import build_dataset, write_netcdf
 from .parts import PartsCache, parts_folder
-from .quantities import MASS_MODELS, VARIABLES, timed_chunk
-from .request import DEFAULT_CHUNK_SIZE, SweepError, linspace_grid
+from .progress import SweepProgress
+from .quantities import VARIABLES, timed_chunk
+from .request import DEFAULT_CHUNK_SIZE, SweepError, linspace_grid, output_format, store_plan
+from .spec import SweepSpec
 
 __all__ = ['SweepSpec', 'SweepRun', 'SweepError', 'linspace_grid', 'dask_client', 'run_sweep',
            'parts_folder', 'DEFAULT_CHUNK_SIZE', 'CONNECT_TIMEOUT']
@@ -43,84 +51,21 @@ __all__ = ['SweepSpec', 'SweepRun', 'SweepError', 'linspace_grid', 'dask_client'
 CONNECT_TIMEOUT = 5.0
 
 
-@dataclass(frozen=True)
-class SweepSpec:
-    """What to compute: the grid (b/a, Δ/a), the mass model, μ's reference speed, chunking."""
-
-    b_over_a: np.ndarray
-    delta_over_a: np.ndarray
-    mass_model: str = 'laminae'
-    reference_speed: float = 0.5     #: kinematic |ω| for mu_required (units √(g/a))
-    chunk_size: int = DEFAULT_CHUNK_SIZE
-
-    def __post_init__(self):
-        if self.mass_model not in MASS_MODELS:
-            raise SweepError(f'mass model must be one of {", ".join(MASS_MODELS)}, got '
-                             f'{self.mass_model!r}')
-        if not (math.isfinite(self.reference_speed) and self.reference_speed >= 0):
-            raise SweepError(f'reference speed must be finite and >= 0, got '
-                             f'{self.reference_speed!r}')
-        if int(self.chunk_size) != self.chunk_size or self.chunk_size < 1:
-            raise SweepError(f'chunk size must be an integer >= 1, got {self.chunk_size!r}')
-
-    @property
-    def shape(self):
-        """(number of b/a values, number of Δ/a values)."""
-        return (len(self.b_over_a), len(self.delta_over_a))
-
-    @property
-    def size(self):
-        """Number of bodies."""
-        return self.shape[0] * self.shape[1]
-
-    def points(self):
-        """(b/a, Δ/a) of every grid point, flat, C order (b/a major)."""
-        b, d = np.meshgrid(self.b_over_a, self.delta_over_a, indexing='ij')
-        return b.ravel(), d.ravel()
-
-    def chunks(self):
-        """The slices of the flat grid, one per task."""
-        size, step = self.size, int(self.chunk_size)
-        return [slice(start, min(start + step, size)) for start in range(0, size, step)]
-
-    def manifest(self):
-        """JSON description of the sweep (floats as ``float.hex``: exact)."""
-        return {'format': 1, 'package_version': __version__,
-                'b_over_a': [float(x).hex() for x in self.b_over_a],
-                'delta_over_a': [float(x).hex() for x in self.delta_over_a],
-                'mass_model': self.mass_model,
-                'reference_speed': float(self.reference_speed).hex(),
-                'chunk_size': int(self.chunk_size), 'variables': list(VARIABLES)}
-
-    def attrs(self):
-        """Global attributes of the output."""
-        b, d = self.b_over_a, self.delta_over_a
-        return {
-            'title': 'Quantities of the rolling two-disk bodies over b/a and Delta/a',
-            'source': f'twodisk_ros {__version__} (twodisk_ros.sweep)',
-            'package_version': __version__,
-            'units_convention': 'a = 1, g = 1, M = 1: lengths in a, times in sqrt(a/g), '
-                                'angular speeds in sqrt(g/a)',
-            'mass_model': self.mass_model,
-            'reference_speed': float(self.reference_speed),
-            'reference_speed_units': 'sqrt(g/a)',
-            'b_over_a_grid': f'linspace({float(b[0])!r}, {float(b[-1])!r}, {len(b)})',
-            'delta_over_a_grid': f'linspace({float(d[0])!r}, {float(d[-1])!r}, {len(d)})',
-            'chunk_size': int(self.chunk_size),
-        }
-
-
 @dataclass
 class SweepRun:
     """The outcome of :func:`run_sweep`."""
 
-    dataset: object           #: xarray.Dataset
+    dataset: object           #: xarray.Dataset (a Zarr store's: read lazily)
     computed: int             #: chunks computed by this run
-    resumed: int              #: chunks taken from the resume cache
+    resumed: int              #: chunks taken from the resume state
     seconds: float            #: wall time (s)
-    output: Path = None       #: the NetCDF file written, if any
+    output: Path = None       #: the NetCDF file or Zarr store written, if any
     chunk_seconds: list = field(default_factory=list)   #: wall time per computed chunk (s)
     chunk_cpu_seconds: list = field(default_factory=list)   #: worker CPU time per chunk (s)
+    chunk_write_seconds: list = field(default_factory=list)  #: Zarr: worker write time (s)
+    bodies: int = 0           #: bodies of the grid
+    bodies_computed: int = 0  #: bodies computed by this run
+    masked: int = 0           #: points whose body could not be computed (failure != '')
 
 
 def _check_address(address):
@@ -186,64 +131,62 @@ def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
             cluster.close()
 
 
-class _Progress:
-    """A one-line progress report on a stream (redrawn on a terminal, else ~every 5 s)."""
+def _collect(client, futures, bar, on_chunk, handle):
+    """Wait for ``futures`` (future → chunk index) as they finish; ``handle(index, result)``
+    returns the bodies of a chunk; cancels the rest on any exception (Ctrl-C included)."""
+    from distributed import as_completed
+    computed = 0
+    try:
+        for future in as_completed(futures, loop=client.loop):
+            # dropping the last reference lets the scheduler forget the result
+            index = futures.pop(future)
+            bar.update(handle(index, future.result()))
+            computed += 1
+            if on_chunk is not None:
+                on_chunk(index, computed)
+    finally:
+        pending = [f for f in futures if not f.done()]
+        if pending:
+            client.cancel(pending)
+        bar.close()
+    return computed
 
-    def __init__(self, stream, total_chunks, total_bodies, resumed_chunks, resumed_bodies):
-        self.stream, self.total, self.bodies = stream, total_chunks, total_bodies
-        self.done, self.done_bodies = resumed_chunks, resumed_bodies
-        self.resumed = resumed_chunks
-        self.start = self.last = time.monotonic()
-        self.tty = bool(getattr(stream, 'isatty', lambda: False)())
 
-    def update(self, bodies):
-        self.done += 1
-        self.done_bodies += bodies
-        now = time.monotonic()
-        if self.stream is None or (not self.tty and now - self.last < 5.0
-                                   and self.done < self.total):
-            return
-        self.last = now
-        elapsed = now - self.start
-        rate = (self.done - self.resumed) / elapsed if elapsed > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else math.inf
-        text = (f'twodisk-sweep: {self.done}/{self.total} chunks '
-                f'({100 * self.done / self.total:.0f} %), {self.done_bodies}/{self.bodies} '
-                f'bodies, {elapsed:.1f} s' + (f', ~{left:.0f} s left' if self.done < self.total
-                                             else ''))
-        self.stream.write(('\r' + text + ' ' * 4) if self.tty else text + '\n')
-        if self.tty and self.done >= self.total:
-            self.stream.write('\n')
-        self.stream.flush()
+def _all_masked(spec, first_failure):
+    b, d = spec.b_over_a[0], spec.delta_over_a[0]
+    return SweepError(f'no body of the grid could be computed: all {spec.size} points are '
+                      f'masked (e.g. b/a = {float(b)!r}, Delta/a = {float(d)!r}: '
+                      f'{first_failure}); nothing written')
 
 
 def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=False,
               keep_parts=False, overwrite=True):
-    """Compute the sweep ``spec`` on the Dask ``client``; resume from ``out``'s cache.
+    """Compute the sweep ``spec`` on the Dask ``client``; resume from ``out``'s state.
 
     Parameters
     ----------
     spec : SweepSpec
     client : distributed.Client
     out : path-like, optional
-        NetCDF file to write. Finished chunks are cached in ``out.parts/`` as they complete
-        and reused by a later run of the same sweep; the cache is removed once ``out`` is
-        written (unless ``keep_parts``). Without ``out`` nothing is written.
+        ``FILE.nc``: finished chunks are cached in ``FILE.nc.parts/`` as they complete and
+        reused by a later run of the same sweep; the cache is removed once the file is
+        written (unless ``keep_parts``). ``FILE.zarr``: the workers write each chunk into the
+        store; an interrupted store of the same sweep is resumed (docs/sweeps.md). Without
+        ``out`` nothing is written.
     progress : file, optional
-        Stream for the progress line (None: silent).
+        Stream for the progress bar (None, or not a terminal: none).
     on_chunk : callable, optional
         ``on_chunk(index, computed)`` after each computed chunk is saved (``computed``
         counts this run's chunks); an exception raised there stops the sweep (saved chunks
         stay saved).
     fresh : bool
-        Discard the cache of a different or earlier sweep instead of refusing / resuming.
+        Discard the resume state of a different or earlier sweep instead of refusing /
+        resuming.
     keep_parts : bool
-        Keep ``out.parts/`` after writing ``out``.
+        ``FILE.nc``: keep ``FILE.nc.parts/`` after writing the file.
     overwrite : bool
-        Replace an existing ``out`` (checked again just before writing; the command line
-        checks it before any work too). ``out`` is written through a hidden temporary file
-        renamed over it (:func:`~twodisk_ros.outputs.replacing`): until the new file is
-        complete the old one stays as it was.
+        Replace an existing output (a NetCDF file through a hidden temporary file renamed
+        over it when complete; a finished Zarr store of this command is removed first).
 
     Returns
     -------
@@ -253,78 +196,125 @@ def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=
     ------
     SweepError
         If no body of the grid could be computed (every point masked): nothing is written
-        and the resume cache is removed (unless ``keep_parts``); or if ``out`` cannot be
+        and the resume state is removed (unless ``keep_parts``); a Zarr store that holds
+        another sweep or that some worker cannot see; or if a NetCDF ``out`` cannot be
         written (the resume cache is kept: run again to write it).
+    OutputError
+        If ``out`` may not be written (see :mod:`twodisk_ros.outputs`).
     """
-    from distributed import as_completed
-
     from .worker import SweepWorkerSetup
 
     started = time.perf_counter()
     # glibc's allocator as in a plain process: without it a body costs 1.7x the CPU time on a
     # worker (Dask's MALLOC_TRIM_THRESHOLD_; twodisk_ros.sweep.worker); idempotent per worker
     client.register_plugin(SweepWorkerSetup())
+    if out is not None and output_format(out) == 'zarr':
+        run = _run_zarr(spec, client, Path(out), progress, on_chunk, fresh, overwrite)
+    else:
+        run = _run_in_memory(spec, client, out, progress, on_chunk, fresh, keep_parts,
+                             overwrite)
+    run.seconds = time.perf_counter() - started
+    return run
+
+
+def _run_in_memory(spec, client, out, progress, on_chunk, fresh, keep_parts, overwrite):
+    """Results to the client, resume cache FILE.nc.parts/, NetCDF written at the end."""
+    if out is not None and output_format(out) != 'netcdf':
+        raise OutputError(f'{out}: cannot write this suffix (allowed: .nc, .zarr)')
     cache = PartsCache(parts_folder(out), spec.manifest(), fresh=fresh) if out else None
-    chunks = spec.chunks()
-    b_flat, d_flat = spec.points()
-    arrays = {name: np.full(spec.size, math.nan) for name in VARIABLES}
-    arrays['failure'] = np.full(spec.size, '', dtype=object)
-    done = set(cache.finished()) & set(range(len(chunks))) if cache else set()
+    blocks = spec.blocks()
+    arrays = {name: np.full(spec.shape, math.nan) for name in VARIABLES}
+    arrays['failure'] = np.full(spec.shape, '', dtype=object)
+    done = set(cache.finished()) & set(range(len(blocks))) if cache else set()
+    run = SweepRun(None, 0, len(done), 0.0, bodies=spec.size)
 
     def store(index, result):
-        part = chunks[index]
+        block = blocks[index]
+        shape = arrays['failure'][block].shape
         for name in arrays:
-            arrays[name][part] = result[name]
+            arrays[name][block] = np.asarray(result[name]).reshape(shape)
+        return arrays['failure'][block].size
 
     for index in sorted(done):
         store(index, cache.load(index))
-    bar = _Progress(progress, len(chunks), spec.size, len(done),
-                    sum(chunks[i].stop - chunks[i].start for i in done))
-    todo = [i for i in range(len(chunks)) if i not in done]
-    futures = {}
-    for index in todo:
-        part = chunks[index]
-        future = client.submit(timed_chunk, b_flat[part], d_flat[part], spec.mass_model,
-                               spec.reference_speed, pure=False)
-        futures[future] = index
-    computed, chunk_seconds, chunk_cpu = 0, [], []
-    try:
-        for future in as_completed(futures, loop=client.loop):
-            # dropping the last reference lets the worker forget the result (saved below)
-            index = futures.pop(future)
-            result, seconds, cpu = future.result()
-            store(index, result)
-            if cache is not None:
-                cache.save(index, result)
-            computed += 1
-            chunk_seconds.append(seconds)
-            chunk_cpu.append(cpu)
-            bar.update(chunks[index].stop - chunks[index].start)
-            if on_chunk is not None:
-                on_chunk(index, computed)
-    finally:
-        pending = [f for f in futures if not f.done()]
-        if pending:
-            client.cancel(pending)
-    arrays['failure'] = arrays['failure'].astype(str)
-    if spec.size and np.all(arrays['failure'] != ''):
+
+    def handle(index, finished):
+        result, seconds, cpu = finished
+        bodies = store(index, result)
+        if cache is not None:
+            cache.save(index, result)
+        run.chunk_seconds.append(seconds)
+        run.chunk_cpu_seconds.append(cpu)
+        run.bodies_computed += bodies
+        return bodies
+
+    futures = {client.submit(timed_chunk, *spec.block_points(blocks[index]), spec.mass_model,
+                             spec.reference_speed, pure=False): index
+               for index in range(len(blocks)) if index not in done}
+    bar = SweepProgress(progress, spec.size, sum(arrays['failure'][blocks[i]].size
+                                                 for i in done))
+    run.computed = _collect(client, futures, bar, on_chunk, handle)
+    failure = arrays['failure'].astype(str)
+    arrays['failure'] = failure
+    run.masked = int(np.count_nonzero(failure != ''))
+    if spec.size and run.masked == spec.size:
         if cache is not None and not keep_parts:
             cache.remove()      # nothing worth resuming: the same grid fails the same way
-        first = (f'b/a = {float(b_flat[0])!r}, Delta/a = {float(d_flat[0])!r}: '
-                 f'{arrays["failure"][0]}')
-        raise SweepError(f'no body of the grid could be computed: all {spec.size} points are '
-                         f'masked (e.g. {first}); nothing written')
-    dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs())
-    written = None
+        raise _all_masked(spec, failure.flat[0])
+    run.dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs())
     if out:
         try:
             check_output(out, overwrite=overwrite)
-            written = write_netcdf(dataset, out)
+            run.output = write_netcdf(run.dataset, out)
         except (OSError, OutputError) as error:
             raise SweepError(f'cannot write {out}: {getattr(error, "strerror", None) or error}'
                              f'; the finished chunks are kept in {parts_folder(out)}/, run '
                              f'again to write it') from None
         if not keep_parts:
             cache.remove()
-    return SweepRun(dataset, computed, len(done), time.perf_counter() - started, written,
-                    chunk_seconds, chunk_cpu)
+    return run
+
+
+def _run_zarr(spec, client, path, progress, on_chunk, fresh, overwrite):
+    """The workers write the store; the client submits blocks and counts."""
+    from . import store as zstore
+    path = path.absolute()
+    plan = store_plan(path, spec.manifest(), overwrite=overwrite, fresh=fresh)
+    if plan == 'replace':
+        zstore.remove_store(path)
+    if plan != 'resume':
+        zstore.create_store(path, spec)
+    unseen = zstore.unseen_by_workers(client, path)
+    if unseen:
+        raise SweepError(f'{len(unseen)} Dask worker(s) cannot see {path} (e.g. {unseen[0]}): '
+                         f'a .zarr output needs a file system shared by the client and every '
+                         f'worker at the same path; use a .nc output otherwise')
+    blocks = spec.blocks()
+    done = zstore.complete_blocks(path, spec) if plan == 'resume' else set()
+    run = SweepRun(None, 0, len(done), 0.0, output=path, bodies=spec.size)
+
+    def handle(index, result):
+        run.chunk_seconds.append(result['seconds'])
+        run.chunk_cpu_seconds.append(result['cpu_seconds'])
+        run.chunk_write_seconds.append(result['write_seconds'])
+        run.bodies_computed += result['bodies']
+        return result['bodies']
+
+    def size(block):
+        return (block[0].stop - block[0].start) * (block[1].stop - block[1].start)
+
+    futures = {client.submit(zstore.write_block, os.fspath(path), blocks[index],
+                             spec.b_over_a[blocks[index][0]],
+                             spec.delta_over_a[blocks[index][1]], spec.mass_model,
+                             spec.reference_speed, pure=False): index
+               for index in range(len(blocks)) if index not in done}
+    bar = SweepProgress(progress, spec.size, sum(size(blocks[i]) for i in done))
+    run.computed = _collect(client, futures, bar, on_chunk, handle)
+    run.masked = zstore.masked_count(path)
+    if spec.size and run.masked == spec.size:
+        first = str(zstore.open_store(path)['failure'].values.flat[0])
+        zstore.remove_store(path)   # nothing worth resuming: the same grid fails the same way
+        raise _all_masked(spec, first)
+    zstore.finish_store(path)
+    run.dataset = zstore.open_store(path)
+    return run

@@ -1,0 +1,84 @@
+"""A real Dask cluster for tests: ``dask scheduler`` and ``dask worker`` processes on 127.0.0.1.
+
+Each process gets a session (process group) of its own, so a test can kill one worker with
+everything it started, and :func:`stop` ends them all (terminate, wait, kill the group).
+"""
+
+import contextlib
+import os
+from pathlib import Path
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+REPO = Path(__file__).resolve().parents[1]
+ENV = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get('PYTHONPATH', ''))
+ENV.pop('DASK_SCHEDULER_ADDRESS', None)
+DASK = str(Path(sys.executable).with_name('dask'))
+NO_DASHBOARD = ['--no-dashboard', '--dashboard-address', '127.0.0.1:0']
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+def stop(procs):
+    """Terminate every process, wait, then kill the group of any that overran."""
+    for proc in procs:
+        if proc.poll() is None:
+            proc.terminate()
+    for proc in procs:
+        try:
+            proc.wait(timeout=15)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)   # the group this helper started with the proc
+            proc.wait(timeout=5)
+
+
+def wait_for_workers(address, count, timeout=60):
+    """Return once the scheduler at ``address`` has ``count`` workers (polls while it starts)."""
+    from distributed import Client
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            with Client(address, timeout='20s', set_as_default=False) as client:
+                client.wait_for_workers(count, timeout=timeout)
+            return
+        except (OSError, TimeoutError):
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.5)
+
+
+@contextlib.contextmanager
+def cluster(folder, workers=2):
+    """(address, [scheduler, worker...] Popen) of a scheduler and ``workers`` single-thread
+    worker processes (each under a nanny, each its own ``dask worker`` command), logs in
+    ``folder``; everything stopped on exit."""
+    port = free_port()
+    address = f'tcp://127.0.0.1:{port}'
+    procs, logs = [], []
+    try:
+        log = open(Path(folder) / 'scheduler.log', 'w')
+        logs.append(log)
+        procs.append(subprocess.Popen(
+            [DASK, 'scheduler', '--host', '127.0.0.1', '--port', str(port), *NO_DASHBOARD],
+            stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder, start_new_session=True))
+        for k in range(workers):
+            log = open(Path(folder) / f'worker{k}.log', 'w')
+            logs.append(log)
+            procs.append(subprocess.Popen(
+                [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
+                 '--nthreads', '1', *NO_DASHBOARD],
+                stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder,
+                start_new_session=True))
+        wait_for_workers(address, workers)
+        yield address, procs
+    finally:
+        stop(procs)
+        for log in logs:
+            log.close()

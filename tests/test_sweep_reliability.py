@@ -1,0 +1,433 @@
+"""Outputs and reliability of ``twodisk-sweep``: Zarr and NetCDF, resume, killed workers, refusals.
+
+The reference of every comparison is an undisturbed sweep of the same grid (the values
+themselves are checked against the library in tests/test_sweep.py): a disturbed sweep must
+give it bitwise. Interruptions happen at a deterministic point — the client raises SIGINT on
+itself, or kills a busy worker, right after its k-th finished chunk (a wrapper around
+``run_sweep`` used only here) — never after a sleep. Clusters listen on 127.0.0.1 only; every
+process a test starts is stopped in a ``finally``.
+"""
+
+import fcntl
+import os
+from pathlib import Path
+import pty
+import struct
+import subprocess
+import sys
+import termios
+import time
+
+import numpy as np
+import pytest
+
+from dask_helpers import ENV, cluster
+from twodisk_ros.sweep.cli import main
+from twodisk_ros.sweep.dataset import read_sweep
+from twodisk_ros.sweep.run import SweepSpec, dask_client, run_sweep
+from twodisk_ros.sweep.spec import block_shape
+
+# 6 x 8 = 48 bodies, both stable families, and Delta/a = 1 (masked) in the last column
+B_GRID, D_GRID = ('0.5', '1.5', '6'), ('0.3', '1', '8')
+TOTAL = 48
+
+
+def _spec(chunk):
+    return SweepSpec(np.linspace(0.5, 1.5, 6), np.linspace(0.3, 1.0, 8), chunk_size=chunk)
+
+
+def _argv(out, *more):
+    return ['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out), *more]
+
+
+@pytest.fixture(scope='module')
+def client():
+    with dask_client(workers=2) as c:
+        yield c
+
+
+@pytest.fixture(scope='module')
+def reference(client):
+    """The undisturbed sweep, in memory (no output file)."""
+    return run_sweep(_spec(5), client, progress=None).dataset
+
+
+def _same(x, y):
+    """Bitwise-equal variables (NaN equal to NaN), coordinates and variable attributes."""
+    for name in y.data_vars:
+        np.testing.assert_array_equal(x[name].values, y[name].values, err_msg=name)
+        assert x[name].attrs.keys() == y[name].attrs.keys(), name
+    for name in ('b_over_a', 'delta_over_a'):
+        np.testing.assert_array_equal(x[name].values, y[name].values)
+
+
+def _flags(store):
+    """The store's completion flags, read with zarr (not with the sweep's code)."""
+    import zarr
+    return zarr.open_array(Path(store) / 'computed', mode='r')[...]
+
+
+def _idle(dask_worker):
+    return not dask_worker.state.executing
+
+
+def _wait_until_idle(client, timeout=60):
+    """Return once no worker runs a task: a task the client cancelled still finishes (and
+    writes its block) on its worker."""
+    deadline = time.monotonic() + timeout
+    while not all(client.run(_idle).values()):
+        assert time.monotonic() < deadline, 'the workers never went idle'
+        time.sleep(0.05)
+
+
+def _tree(folder):
+    """path → (inode, size) of every file: a rewritten chunk gets a new inode (renamed)."""
+    return {p: (p.stat().st_ino, p.stat().st_size) for p in Path(folder).rglob('*')
+            if p.is_file()}
+
+
+# -- the blocks ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('shape', [(1, 1), (1, 7), (7, 1), (6, 8), (13, 5), (3, 100)])
+@pytest.mark.parametrize('chunk', [1, 2, 3, 5, 8, 9, 16, 40, 1000])
+def test_blocks_cover_the_grid_once_within_the_chunk_size(shape, chunk):
+    spec = SweepSpec(np.linspace(0.5, 1.5, shape[0]) if shape[0] > 1 else np.array([1.0]),
+                     np.linspace(0.1, 0.9, shape[1]) if shape[1] > 1 else np.array([0.5]),
+                     chunk_size=chunk)
+    covered = np.zeros(shape, dtype=int)
+    rows, cols = block_shape(*shape, chunk)
+    b, d = spec.points()
+    for block, flat in zip(spec.blocks(), spec.chunks()):
+        covered[block] += 1
+        size = covered[block].size
+        assert 1 <= size <= chunk
+        # a regular chunk grid (Zarr): every block has the block shape, cut at the far edges
+        assert block[0].start % rows == 0 and block[1].start % cols == 0
+        assert block[0].stop - block[0].start == min(rows, shape[0] - block[0].start)
+        assert block[1].stop - block[1].start == min(cols, shape[1] - block[1].start)
+        # the flat indices are the block's points, in the order block_points gives them
+        np.testing.assert_array_equal(b[flat], spec.block_points(block)[0])
+        np.testing.assert_array_equal(d[flat], spec.block_points(block)[1])
+    assert np.all(covered == 1)
+    # not wastefully small: whole rows when a row fits, else pieces of >= half the chunk
+    if chunk >= shape[1]:
+        assert cols == shape[1] and rows > min(shape[0], chunk // shape[1]) / 2
+    else:
+        assert rows == 1 and cols > chunk / 2
+
+
+# -- the two formats -------------------------------------------------------------------------
+
+def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(client, reference, tmp_path):
+    import xarray as xr
+    runs = {suffix: run_sweep(_spec(5), client, out=tmp_path / f'map{suffix}', progress=None,
+                              overwrite=False) for suffix in ('.nc', '.zarr')}
+    for suffix, run in runs.items():
+        assert run.computed == len(_spec(5).blocks()) and run.resumed == 0
+        assert run.bodies == TOTAL and run.masked == 6 * 1     # the Delta/a = 1 column
+        with xr.open_dataset(tmp_path / f'map{suffix}') as opened:   # engine auto-detected
+            for name in reference.data_vars:
+                assert opened[name].attrs['units'] and opened[name].attrs['description']
+            assert opened.attrs['package_version'] and opened.attrs['mass_model'] == 'laminae'
+        _same(read_sweep(tmp_path / f'map{suffix}'), reference)
+    assert np.all(_flags(tmp_path / 'map.zarr') == 1)
+    assert not (tmp_path / 'map.nc.parts').exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['map.nc', 'map.zarr']
+
+
+def test_a_block_killed_mid_write_is_computed_again(client, reference, tmp_path):
+    """Whatever a killed worker left of a block — data without its flags, part of the data,
+    a torn flag object — the block counts as missing and only such blocks are computed."""
+    store, spec = tmp_path / 'map.zarr', _spec(5)
+    total = len(spec.blocks())
+
+    class Stop(Exception):
+        pass
+
+    def stop_at_the_end(index, computed):
+        if computed == total:
+            raise Stop        # every block written, the sweep never marked 'complete'
+
+    with pytest.raises(Stop):
+        run_sweep(spec, client, out=store, progress=None, on_chunk=stop_at_the_end)
+    assert np.all(_flags(store) == 1)
+    # block (0, 0): data written, flags not yet; block (1, 1): part of the data and no flags;
+    # block (2, 0): a torn flag object (a store that does not write objects atomically)
+    (store / 'computed/c/0/0').unlink()
+    (store / 'computed/c/1/1').unlink()
+    for name in ('theta_max', 'mu_required', 'failure'):
+        (store / name / 'c/1/1').unlink(missing_ok=True)
+    flag = store / 'computed/c/2/0'
+    flag.write_bytes(flag.read_bytes()[:5])
+    kept = {p: v for p, v in _tree(store).items() if '/c/' in str(p)
+            and not any(f'/c/{k}' in str(p) for k in ('0/0', '1/1', '2/0'))}
+    again = run_sweep(spec, client, out=store, progress=None, overwrite=False)
+    assert (again.computed, again.resumed) == (3, total - 3)
+    _same(read_sweep(store), reference)
+    tree = _tree(store)
+    assert all(tree[p] == v for p, v in kept.items())    # the other chunks were not rewritten
+
+
+class _Killed(BaseException):
+    pass
+
+
+def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
+    """A worker killed at any write of a block (the k-th of its chunk objects) leaves the
+    block's flags at 0: the flags are the block's last write."""
+    import zarr
+    from twodisk_ros.sweep import store as zstore
+    spec = SweepSpec(np.array([1.0]), np.array([0.5]), chunk_size=1)
+    path = zstore.create_store(tmp_path / 'one.zarr', spec)
+    real = zarr.Array.__setitem__
+    writes = []     # the arrays written by write_block, in order
+    kill_at = None  # kill at this write (0: watch only; None: neither)
+
+    def write(array, selection, value):
+        if kill_at is not None:
+            writes.append(array.basename)
+            if len(writes) == kill_at:
+                raise _Killed
+        real(array, selection, value)
+
+    monkeypatch.setattr(zarr.Array, '__setitem__', write)
+    variables = set(read_sweep(path).data_vars)
+    kill_at = 0         # watch, never kill
+    zstore.write_block(str(path), spec.blocks()[0], spec.b_over_a, spec.delta_over_a,
+                       'laminae', 0.5)
+    assert set(writes) == variables and writes[-1] == 'computed'
+    for k in range(1, len(variables) + 1):
+        kill_at = None
+        zstore.remove_store(path)
+        zstore.create_store(path, spec)
+        writes.clear()
+        kill_at = k
+        with pytest.raises(_Killed):
+            zstore.write_block(str(path), spec.blocks()[0], spec.b_over_a, spec.delta_over_a,
+                               'laminae', 0.5)
+        kill_at = None
+        assert _flags(path)[0, 0] == 0, writes
+        assert zstore.complete_blocks(path, spec) == set()
+
+
+# -- interrupted and resumed -----------------------------------------------------------------
+
+#: The sweep's command line with a hook after the client's k-th finished chunk (argv[1]).
+#: SIGINT: the client signals itself (a real SIGINT through Python's handler). KILL: the
+#: client kills the `dask worker` command (nanny and worker, its process group) of a worker
+#: that is busy, then goes on.
+_HOOKED_CLI = """
+import os, signal, sys
+import twodisk_ros.sweep.run as run
+real, action, after = run.run_sweep, sys.argv[1], int(sys.argv[2])
+def hooked(spec, client, *args, **kwargs):
+    def on_chunk(index, computed):
+        if computed != after:
+            return
+        if action == 'SIGINT':
+            signal.raise_signal(signal.SIGINT)
+        busy = [address for address, keys in client.processing().items() if keys]
+        if not busy:
+            sys.exit('no worker busy')
+        pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
+        os.killpg(os.getpgid(pid), signal.SIGKILL)
+        print(f'killed a busy worker after {computed} chunks', file=sys.stderr)
+    return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
+run.run_sweep = hooked
+from twodisk_ros.sweep.cli import main
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+def _hooked(action, after, argv, timeout=180):
+    return subprocess.run([sys.executable, '-c', _HOOKED_CLI, action, str(after), *argv],
+                          env=ENV, capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.mark.slow
+def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(reference, tmp_path):
+    store = tmp_path / 'map.zarr'
+    argv = _argv(store, '--chunk-size', '1', '--workers', '1')
+    stopped = _hooked('SIGINT', 5, argv)
+    assert stopped.returncode == 130, stopped.stderr
+    assert stopped.stderr.strip().splitlines() == [
+        f'twodisk-sweep: interrupted; finished chunks are kept in {store} - run the same '
+        'command again to resume']
+    flags = _flags(store)
+    finished = int(flags.sum())       # 5, or a few more finished by the worker meanwhile
+    assert 5 <= finished < TOTAL
+    kept = {p: v for p, v in _tree(store).items() if '/computed/c/' in str(p)}
+    assert len(kept) == finished
+    again = subprocess.run([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
+                           capture_output=True, text=True, timeout=180)
+    assert again.returncode == 0, again.stderr
+    assert (f'{TOTAL - finished} chunks computed, {finished} resumed'
+            in again.stderr.strip().splitlines()[-1])
+    tree = _tree(store)
+    assert all(tree[p] == v for p, v in kept.items())     # the finished chunks untouched
+    _same(read_sweep(store), reference)
+    assert np.all(_flags(store) == 1)
+
+
+@pytest.mark.slow
+def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path):
+    store = tmp_path / 'map.zarr'
+    with cluster(tmp_path, workers=2) as (address, procs):
+        result = _hooked('KILL', 3, _argv(store, '--chunk-size', '1', '--scheduler', address))
+        dead = [p for p in procs[1:] if p.poll() is not None]
+    assert result.returncode == 0, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert lines[0] == 'killed a busy worker after 3 chunks', lines
+    assert len(dead) == 1 and dead[0].returncode == -9       # one `dask worker` is gone
+    assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in result.stderr
+    _same(read_sweep(store), reference)
+    assert np.all(_flags(store) == 1)
+
+
+# -- existing outputs ------------------------------------------------------------------------
+
+def _fails_in_one_line(argv, capsys, *words):
+    status = main(argv)
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert len(err.strip().splitlines()) == 1 and 'Traceback' not in err, err
+    for word in words:
+        assert word in err, err
+    return err
+
+
+@pytest.mark.slow
+def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, tmp_path, capsys):
+    store = tmp_path / 'map.zarr'
+    argv = _argv(store, '--chunk-size', '5', '--workers', '1', '--quiet')
+    assert main(argv) == 0
+    capsys.readouterr()
+    before = _tree(store)
+    _fails_in_one_line(argv, capsys, 'map.zarr exists', '--overwrite')
+    assert _tree(store) == before
+    # another grid: refused the same way (the store is finished, whatever it holds)
+    other = ['--b-over-a', '0.5', '1.5', '3', *argv[4:]]
+    _fails_in_one_line(other, capsys, 'map.zarr exists', '--overwrite')
+    assert _tree(store) == before
+    assert main([*argv, '--overwrite']) == 0
+    assert f'{len(_spec(5).blocks())} chunks computed, 0 resumed' in capsys.readouterr().err
+    _same(read_sweep(store), reference)
+
+
+def test_an_interrupted_store_of_another_sweep_is_refused(client, tmp_path, capsys):
+    store = tmp_path / 'map.zarr'
+
+    class Stop(Exception):
+        pass
+
+    with pytest.raises(Stop):
+        run_sweep(_spec(5), client, out=store, progress=None,
+                  on_chunk=lambda index, computed: (_ for _ in ()).throw(Stop()))
+    _wait_until_idle(client)
+    before = _tree(store)
+    _fails_in_one_line(_argv(store, '--chunk-size', '4'), capsys, 'map.zarr holds an '
+                       'interrupted sweep of a different grid or options', '--overwrite')
+    assert _tree(store) == before
+
+
+@pytest.mark.parametrize('make, words', [
+    (lambda p: p.mkdir() or (p / 'notes.txt').write_text('mine'), 'is not a twodisk-sweep'),
+    (lambda p: p.write_text('a file'), 'is not a directory'),
+])
+@pytest.mark.parametrize('overwrite', [[], ['--overwrite']])
+def test_what_the_sweep_did_not_write_is_never_replaced(make, words, overwrite, tmp_path,
+                                                        capsys):
+    store = tmp_path / 'map.zarr'
+    make(store)
+    before = _tree(tmp_path)
+    _fails_in_one_line(_argv(store, *overwrite), capsys, words)
+    assert _tree(tmp_path) == before
+
+
+# -- bad input -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize('override, words', [
+    ({'--b-over-a': ['1.5', '0.5', '3']}, 'reversed'),
+    ({'--delta-over-a': ['0.5', '0.5', '3']}, 'empty range'),
+    ({'--delta-over-a': ['0.25', '0.75', '1']}, 'empty range'),   # one point, two values
+    ({'--b-over-a': ['nan', '1.5', '3']}, 'finite'),
+    ({'--delta-over-a': ['0.25', 'nan', '3']}, 'finite'),
+    ({'--keep-parts': []}, '--keep-parts is for a .nc output only'),
+    ({'--out': ['{tmp}/x.zip']}, 'allowed: .nc, .zarr'),
+])
+def test_bad_input_for_a_zarr_store_one_line_exit_2(override, words, tmp_path, capsys):
+    options = {'--b-over-a': ['0.5', '1.5', '3'], '--delta-over-a': ['0.25', '0.75', '3'],
+               '--out': [str(tmp_path / 'x.zarr')], **override}
+    argv = [x for key, values in options.items()
+            for x in [key, *(v.replace('{tmp}', str(tmp_path)) for v in values)]]
+    _fails_in_one_line(argv, capsys, words)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
+    # Delta/a = 1e-300 passes the command line, but the body refuses a length below its range
+    _fails_in_one_line(['--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300', '1e-300', '1',
+                        '--out', str(tmp_path / 'x.zarr'), '--workers', '1', '--quiet'],
+                       capsys, 'no body of the grid could be computed', 'nothing written')
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_unreachable_scheduler_creates_no_store(tmp_path):
+    from dask_helpers import free_port
+    result = subprocess.run(
+        [sys.executable, '-m', 'twodisk_ros.sweep', *_argv(tmp_path / 'x.zarr'),
+         '--scheduler', f'tcp://127.0.0.1:{free_port()}'],
+        env=ENV, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert 'cannot reach the Dask scheduler' in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+# -- progress --------------------------------------------------------------------------------
+
+def _stderr_on_a_terminal(argv):
+    """(exit status, text) of the command with its stderr on a pseudo-terminal."""
+    leader, follower = pty.openpty()
+    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack('HHHH', 24, 100, 0, 0))
+    proc = subprocess.Popen([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                            stderr=follower)
+    os.close(follower)
+    chunks = []
+    try:
+        while True:
+            try:
+                data = os.read(leader, 65536)
+            except OSError:          # EIO: the command closed the terminal (it ended)
+                break
+            if not data:
+                break
+            chunks.append(data)
+    finally:
+        os.close(leader)
+        try:
+            proc.wait(timeout=120)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(timeout=10)
+    return proc.returncode, b''.join(chunks).decode('utf-8', 'replace')
+
+
+@pytest.mark.slow
+def test_progress_bar_on_a_terminal_only(tmp_path):
+    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'a.nc', '--chunk-size', '8',
+                                               '--workers', '1'))
+    assert status == 0, text
+    # tqdm's bar, ending at 100 % of the bodies, then the summary line
+    assert '100%' in text and f'{TOTAL}/{TOTAL}' in text and 'body/s' in text, text
+    last = text.replace('\r', '\n').strip().splitlines()[-1]
+    assert last.startswith(f'twodisk-sweep: wrote {tmp_path / "a.nc"} ({TOTAL} bodies, '
+                           f'6 masked; 6 chunks computed, 0 resumed; '), last
+    assert last.endswith(' bodies/s)'), last
+    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'b.nc', '--chunk-size', '8',
+                                               '--workers', '1', '--quiet'))
+    assert status == 0 and '%' not in text and len(text.strip().splitlines()) == 1, text
