@@ -44,6 +44,9 @@ SUPERELLIPSE_EXPONENT = (2.0, 100.0)
 #: convergent) doubles its nodes until two results agree to this, relative to the largest.
 MOMENT_RTOL = 2e-15
 _MAX_MOMENT_NODES = 1 << 17
+#: A vertex radius of curvature above this multiple of the size is a flat vertex (zero
+#: curvature, up to rounding), whose order of contact the lamina must give itself.
+FLAT_RADIUS = 1e12
 #: The vertices of a lamina symmetric about its y axis: where the outward normal is ±y or +x.
 VERTEX_AXES = {'-y': (0.0, -1.0), '+y': (0.0, 1.0), '+x': (1.0, 0.0)}
 
@@ -175,9 +178,9 @@ class Lamina(abc.ABC):
         direction = np.array(VERTEX_AXES[axis])
         found = self.support(direction)
         radius = self._vertex_radius(found.parameter)
-        if not math.isfinite(radius):
-            raise ValueError(f'{self!r} is flat at its {axis} vertex (zero curvature) and '
-                             'does not give its order of contact')
+        if not radius < FLAT_RADIUS * self.size:
+            raise ValueError(f'{self!r} is flat at its {axis} vertex (radius of curvature '
+                             f'{radius:.3g} m) and does not give its order of contact')
         return Vertex(axis, direction, np.asarray(found.point, dtype=float),
                       float(found.height), radius, 2.0, 0.5 * radius)
 
