@@ -13,7 +13,7 @@ References, sharing no code with the module under test:
   10× to 1000× the true error) and is the tolerance, itself held below 1e-5 of the size;
 * at flat vertices (superellipse, n > 2), the height at |p| = 1e-3 and 1e-4, p the component
   of n named by the equilibrium, found by brentq on the charts, against the two-term
-  expansion A|p|^q + B p², whose remainder is O(|p|^2q) (measured ≤ 3 L|p|^2q, L below);
+  expansion A|p|^q + B p², whose remainder is O(|p|^2q) (measured ≤ 0.45 L|p|^2q, L below);
 * for ellipses, TwoDiskBody's closed forms (the paper's margin s = b² − 2a² + 2Δ², its
   d²z_G/dθ² with dγ/dθ from central differences of its ground normal), and the small-
   oscillation period of RollingDynamics (effective mass and V″ in the phase u).
@@ -43,7 +43,8 @@ H = 0.02
 FD_CAP, FD_FLOOR = 1e-5, 1e-10
 #: the remainder of the flat-vertex expansion: |z_G − z_G* − A|p|^q − B p²| ≤ 10 L |p|^2q plus
 #: the rounding of z_G (1e-15 of the size), L = size + A²/e (e the lamina's smallest extent:
-#: the vertex's own next term is ~c²/e |t|^2q); measured ≤ 3 L |p|^2q
+#: the vertex's own next term is ~c²/e |t|^2q); measured ≤ 0.45 L |p|^2q (30 random
+#: superellipses, n from 2.01 to 100)
 FLAT_REMAINDER, Z_ROUNDING = 10.0, 1e-15
 EPS = 4 * np.finfo(float).eps
 

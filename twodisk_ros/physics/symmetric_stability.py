@@ -16,8 +16,9 @@ poses are fixed by a symmetry of the body, so z_G is stationary there:
 Along the rolling motion, γ is the angle the body has turned about the contact line AB (the
 arc length of the ground normal's path in the body frame; the kinetic energy is ½ I_AB γ̇²),
 and p a component of the ground normal n: p = n1, n3, n2 for the three poses, with γ = p·rate
-to leading order. With the rolling vertex's support function h(d + t d⊥) = e + c|t|^q + o(t²)
-(:class:`~twodisk_ros.physics.lamina.Vertex`; q = 2, c = ρ/2 for a radius of curvature ρ):
+to leading order. With the rolling vertex's support function
+h(d + t d⊥) = e + y_v t + c|t|^q + o(t²) (:class:`~twodisk_ros.physics.lamina.Vertex`; q = 2,
+c = ρ/2 for a radius of curvature ρ):
 
     z_G − z_G* = A |p|^q + B p² + o(p²)
 
@@ -107,7 +108,8 @@ def _well(a, b, q):
 
 def _verdict(name, stability, order, leading, curvature, margin, well, rate):
     if stability == NOT_AN_EQUILIBRIUM:
-        return f'{name}: not an equilibrium (dz_G/dgamma != 0; the equilibrium nearby is not symmetric)'
+        return (f'{name}: not an equilibrium (dz_G/dgamma != 0: G is off the midpoint of the '
+                'contacts; the equilibrium nearby is not symmetric)')
     if order == 2.0:
         text = (f'{name}: {stability}: d2z_G/dgamma2 = {curvature:.6g} m/rad2 '
                 f'(criterion {margin:.6g} m2)')
@@ -117,7 +119,7 @@ def _verdict(name, stability, order, leading, curvature, margin, well, rate):
     text = (f'{name}: {stability}: flat vertex (infinite radius of curvature), '
             f'z_G - z_G* ~ {leading:.6g} |gamma|^{order:.6g} m; V not twice differentiable, '
             'no linear small-oscillation period')
-    if stability == STABLE and math.isfinite(well):
+    if stability == STABLE and well * rate < 0.1:     # else beyond the expansion's reach
         text += f' (z_G > z_G* only for |gamma| < {well * rate:.3g} rad)'
     return text + ('; the next term, -z_G* p2/2, is negative' if stability == NEUTRAL else '')
 
