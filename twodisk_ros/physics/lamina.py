@@ -338,8 +338,8 @@ class Superellipse(Lamina):
         return AreaMoments(area, np.zeros(2), factor * a * b**3, factor * a**3 * b, 0.0)
 
     def vertex(self, axis):
-        """For n > 2 the four vertices are flat: h(d + t d⊥) = e + |p t|^q e^(1−q)/q + O(|t|^2q),
-        e the extent (a or b) and p the other semi-axis (from the closed-form h)."""
+        """For n > 2 the four vertices are flat: h(d + t d⊥) = e + |r t|^q e^(1−q)/q + O(|t|^2q),
+        e the extent (a or b) and r the other semi-axis (from the closed-form h)."""
         if self.n == 2.0 or axis not in VERTEX_AXES:
             return super().vertex(axis)
         direction = np.array(VERTEX_AXES[axis])
