@@ -12,7 +12,9 @@ Modules, from geometry to motion (docs/physics.md derives each):
 - :mod:`~twodisk_ros.physics.lamina` (with :mod:`~twodisk_ros.physics.lamina_fit`): laminae
   of any symmetric convex shape (ellipse, superellipse, egg, a fitted outline): the
   foundation of general bodies, with :mod:`~twodisk_ros.physics.general_body` (their
-  contact geometry from the support function); not yet used by the cycle, dynamics or node;
+  contact geometry from the support function) and
+  :mod:`~twodisk_ros.physics.symmetric_stability` (the stability of their symmetric
+  equilibria in closed form); not yet used by the cycle, dynamics or node;
 - :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
   :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
 """

@@ -21,7 +21,8 @@ shape ``(..., 2)`` gives ``(...)`` heights and ``(..., 2)`` points.
 Protocol (:class:`Lamina`): ``point(s)``, ``tangent(s)`` (unit, s increasing), ``normal(s)``
 (unit, outward), ``curvature(s)`` (1/m, ≥ 0), ``support(direction)`` (the support function
 h(n) = max over the boundary of r·n, the point attaining it and its parameter), ``moments``
-(area, centroid, second moments of area about the lamina's origin), ``extents`` and ``size``.
+(area, centroid, second moments of area about the lamina's origin), ``extents``, ``size`` and
+``vertex(axis)`` (extent, radius of curvature and order of contact where the normal is ±y, +x).
 """
 
 import abc
@@ -32,7 +33,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 __all__ = ['AreaMoments', 'Egg', 'Ellipse', 'Lamina', 'LENGTH_RANGE', 'SUPERELLIPSE_EXPONENT',
-           'Superellipse', 'Support', 'SupportLamina', 'check_length']
+           'Superellipse', 'Support', 'SupportLamina', 'VERTEX_AXES', 'Vertex', 'check_length']
 
 #: Allowed lengths (m), as for TwoDiskBody: the forms hold up to sixth powers of lengths.
 LENGTH_RANGE = (1e-30, 1e30)
@@ -43,6 +44,11 @@ SUPERELLIPSE_EXPONENT = (2.0, 100.0)
 #: convergent) doubles its nodes until two results agree to this, relative to the largest.
 MOMENT_RTOL = 2e-15
 _MAX_MOMENT_NODES = 1 << 17
+#: A vertex radius of curvature above this multiple of the size is a flat vertex (zero
+#: curvature, up to rounding), whose order of contact the lamina must give itself.
+FLAT_RADIUS = 1e12
+#: The vertices of a lamina symmetric about its y axis: where the outward normal is ±y or +x.
+VERTEX_AXES = {'-y': (0.0, -1.0), '+y': (0.0, 1.0), '+x': (1.0, 0.0)}
 
 
 def check_length(name, value, rule='> 0 (metres)', low=0.0):
@@ -113,6 +119,25 @@ class AreaMoments:
         return self.second_xx + self.central_yy
 
 
+@dataclass(frozen=True)
+class Vertex:
+    """A vertex: the boundary point whose outward normal d lies along an axis.
+
+    Near d the support function is h(d + t d⊥) = extent + (point·d⊥) t + coefficient·|t|^order
+    + o(t²), with d⊥ = d turned by +90° (point·d⊥ = 0 at the ±y vertices). A rounded vertex
+    has order 2 and coefficient radius/2; a flat one (radius = inf, the superellipse's for
+    n > 2) has 1 < order < 2 and no t² term.
+    """
+
+    axis: str               #: '-y' (the far tip, s = 0), '+y' or '+x' (the side)
+    direction: np.ndarray   #: d, the unit outward normal there
+    point: np.ndarray       #: the vertex (m)
+    extent: float           #: h(d) = point·d (m)
+    radius: float           #: radius of curvature (m), inf where the curvature vanishes
+    order: float            #: q in (1, 2]
+    coefficient: float      #: c of c·|t|^q (m)
+
+
 class Lamina(abc.ABC):
     """A convex planar lamina symmetric about the common axis (see the module docstring)."""
 
@@ -141,6 +166,23 @@ class Lamina(abc.ABC):
         """Unit tangent at r(s), direction of increasing s: the normal turned by +90°."""
         n = self.normal(s)
         return np.stack([-n[..., 1], n[..., 0]], axis=-1)
+
+    def _vertex_radius(self, s):
+        curvature = float(self.curvature(s))
+        return 1.0 / curvature if curvature > 0 else math.inf
+
+    def vertex(self, axis):
+        """:class:`Vertex` at ``axis`` '-y', '+y' or '+x' (where the normal is along it)."""
+        if axis not in VERTEX_AXES:
+            raise ValueError(f'axis must be one of {sorted(VERTEX_AXES)}, got {axis!r}')
+        direction = np.array(VERTEX_AXES[axis])
+        found = self.support(direction)
+        radius = self._vertex_radius(found.parameter)
+        if not radius < FLAT_RADIUS * self.size:
+            raise ValueError(f'{self!r} is flat at its {axis} vertex (radius of curvature '
+                             f'{radius:.3g} m) and does not give its order of contact')
+        return Vertex(axis, direction, np.asarray(found.point, dtype=float),
+                      float(found.height), radius, 2.0, 0.5 * radius)
 
     @property
     def extents(self):
@@ -295,6 +337,16 @@ class Superellipse(Lamina):
         factor = 4 * math.gamma(3 / n) * math.gamma(1 / n) / (n * n * math.gamma(1 + 4 / n))
         return AreaMoments(area, np.zeros(2), factor * a * b**3, factor * a**3 * b, 0.0)
 
+    def vertex(self, axis):
+        """For n > 2 the four vertices are flat: h(d + t d⊥) = e + |r t|^q e^(1−q)/q + O(|t|^2q),
+        e the extent (a or b) and r the other semi-axis (from the closed-form h)."""
+        if self.n == 2.0 or axis not in VERTEX_AXES:
+            return super().vertex(axis)
+        direction = np.array(VERTEX_AXES[axis])
+        extent, other = (self.b, self.a) if axis == '+x' else (self.a, self.b)
+        return Vertex(axis, direction, extent * direction, extent, math.inf, self.q,
+                      other**self.q * extent ** (1.0 - self.q) / self.q)
+
 
 class SupportLamina(Lamina):
     """A lamina given by its support function h(φ) of the normal angle, n(φ) = (sin φ, −cos φ).
@@ -313,6 +365,9 @@ class SupportLamina(Lamina):
         """h + h″ at φ (m)."""
         h, _, h2 = self.support_jet(phi)
         return h + h2
+
+    def _vertex_radius(self, s):
+        return float(self.radius_of_curvature(s))
 
     def point(self, s):
         s = np.asarray(s, dtype=float)
