@@ -30,6 +30,7 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.interpolate import CubicSpline
 
+from paper_forms import curvature_at_half_pi
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
 from twodisk_ros.physics import MotionStream, RollingDynamics, simulate, simulate_phase
@@ -73,6 +74,10 @@ RATE_ATOL = {'table': 2e-8, 'direct': 5e-8}
 FD_STEP_T = 1e-3
 #: Step (rad) of the 5-point differences in u of the cycle's poses.
 FD_STEP_U = 1e-3
+#: Small-oscillation period 2π √(m/V″) against m from differences of the poses in u (error
+#: ~1e-12 at FD_STEP_U: measured 2.1e-12) and V″ from the paper's curvature at θ = ±π/2:
+#: measured ≤ 2.2e-12 relative (Oloid, Figure 3 body, all four stable equilibria).
+PERIOD_RTOL = 1e-11
 #: Method agreement: max |position difference| / body size (issue: < ~1e-8).
 AGREEMENT_MAX = 1e-8
 
@@ -160,10 +165,15 @@ def effective_mass_from_poses(cycle, mass, u, h=FD_STEP_U):
             + mass.mass * np.sum(g_u**2, axis=-1))
 
 
-def height_curvature(body, u, h=FD_STEP_U):
-    """d²z_G/du² (m/rad²) by the 5-point second difference of body.phase_height."""
-    z = _along_u(body.phase_height, np.asarray(u, float), h)
-    return np.einsum('k,k...->...', SECOND, z) / h**2
+def height_curvature_half_pi(abd, u):
+    """d²z_G/du² (m/rad²) at θ = ±π/2, from the closed forms of the physics notes.
+
+    V″(θ) = −√2 b³ (b² − 2a² + 2Δ²) / (4a⁴) per unit M g, times (dθ/du)², where dθ/du =
+    (dθ/dη)(dη/du) = (a/b) η_max cos u at η = ±π/2 and η_max = arccos(−a/(a + 2Δ)).
+    """
+    a, b, delta = abd
+    eta_max = math.acos(-a / (a + 2 * delta))
+    return curvature_at_half_pi(a, b, delta) * (a / b * eta_max * math.cos(u)) ** 2
 
 
 def height_theta0(a, b, delta):
@@ -421,13 +431,14 @@ def test_small_oscillation_period(abd):
     periods = dyn.small_oscillation_periods()
     assert len(periods) == 4            # θ = ±π/2 on both branches, all equivalent
     reported = [p for e, p in periods if abs(e.phase - u_eq) < 1e-12][0]
-    assert_allclose([p for _, p in periods], reported, rtol=1e-9)
+    assert_allclose([p for _, p in periods], reported, rtol=5e-14)   # measured 1.5e-14
 
-    # from scratch: T = 2π √(m / k), m from the poses, k = M g d²z_G/du²
+    # from scratch: T = 2π √(m / k), m from the poses (measured 2.1e-12 from the closed form),
+    # k = M g d²z_G/du² from the paper's curvature: measured 2.3e-15 apart
     m = float(effective_mass_from_poses(cycle, mass, u_eq))
-    k = MASS * GRAVITY * float(height_curvature(body, u_eq))
+    k = MASS * GRAVITY * height_curvature_half_pi(abd, u_eq)
     own = 2 * math.pi * math.sqrt(m / k)
-    assert_allclose(reported, own, rtol=1e-8)
+    assert_allclose(reported, own, rtol=PERIOD_RTOL)
 
     # simulated: the deviation T(ε) − T0 is anharmonic, ∝ ε², positive and monotone
     eps = np.array([0.005, 0.01, 0.02, 0.04])
@@ -454,9 +465,10 @@ def test_equilibria_with_periods():
         if eq.stability != STABLE:
             assert period is None
             continue
+        assert abs(abs(eq.theta) - math.pi / 2) < 1e-14      # s < 0: θ = ±π/2 is stable
         m = float(effective_mass_from_poses(cycle, mass, eq.phase))
-        k = MASS * GRAVITY * float(height_curvature(body, eq.phase))
-        assert_allclose(period, 2 * math.pi * math.sqrt(m / k), rtol=1e-8)
+        k = MASS * GRAVITY * height_curvature_half_pi(FIGURE3, eq.phase)
+        assert_allclose(period, 2 * math.pi * math.sqrt(m / k), rtol=PERIOD_RTOL)
     assert sum(period is not None for _, period in entries) == 4
     no_gravity = model(FIGURE3, gravity=0.0)[3].equilibria_with_periods()
     assert len(no_gravity) == 8 and all(period is None for _, period in no_gravity)

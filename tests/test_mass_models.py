@@ -90,7 +90,8 @@ def ruled_polytope_moments(a, b, delta, n):
     tri = hull.points[hull.simplices]  # (m, 3 vertices, 3 coordinates); G is inside the hull
     vol = np.abs(np.einsum('ij,ij->i', tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))) / 6.0
     s = tri.sum(axis=1)
-    second = np.einsum('i,ijk,ijk->k', vol / 20.0, tri, tri) + np.einsum('i,ik,ik->k', vol / 20.0, s, s)
+    second = (np.einsum('i,ijk,ijk->k', vol / 20.0, tri, tri)
+              + np.einsum('i,ik,ik->k', vol / 20.0, s, s))
     return np.concatenate([[vol.sum()], second])
 
 
