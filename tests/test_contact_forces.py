@@ -14,8 +14,11 @@ Nothing here compares the module with its own output. The references are:
   here from the world positions of A, B and G;
 * the symmetries of the body: the mirror image (u → π − u) and the disk swap
   x ↦ (x3, −x2, x1), whose phase map is found here by matching contact vectors;
-* brute force: μ_required against a dense search over the split, the lift-off speed against
-  a dense sweep of the cycle.
+* N_A, N_B, T_A, T_B, S and τ solved from those two laws (six linear equations) with the
+  finite differences, and μ_required from them by bisection on the friction cones
+  (``least_friction``: the least μ for which the two cones' intervals along AB meet), not by
+  the module's squeeze formula;
+* brute force: the lift-off speed against a dense sweep of the cycle.
 
 Units: SI (m, kg, s, rad, N). Tolerances are relative to M g (forces) or M g L (moments,
 L = body size), stated with each constant.
