@@ -14,8 +14,11 @@ Nothing here compares the module with its own output. The references are:
   here from the world positions of A, B and G;
 * the symmetries of the body: the mirror image (u → π − u) and the disk swap
   x ↦ (x3, −x2, x1), whose phase map is found here by matching contact vectors;
-* brute force: μ_required against a dense search over the split, the lift-off speed against
-  a dense sweep of the cycle.
+* N_A, N_B, T_A, T_B, S and τ solved from those two laws (six linear equations) with the
+  finite differences, and μ_required from them by bisection on the friction cones
+  (``least_friction``: the least μ for which the two cones' intervals along AB meet), not by
+  the module's squeeze formula;
+* brute force: the lift-off speed against a dense sweep of the cycle.
 
 Units: SI (m, kg, s, rad, N). Tolerances are relative to M g (forces) or M g L (moments,
 L = body size), stated with each constant.
@@ -28,7 +31,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 from numpy.testing import assert_allclose
-from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from twodisk_ros.physics.body import TwoDiskBody
@@ -57,8 +59,27 @@ FD_STEP = 4e-4
 FORCE_TOL = 2e-8
 #: moment balance: |Σ (P − G) × F_P + τ ê − dH/dt| ≤ MOMENT_TOL · M g L
 MOMENT_TOL = 2e-8
-#: statics and symmetries (table interpolation, ~1e-14 measured): relative to M g
-TIGHT = 1e-11
+#: statics: vertical forces by the lever rule, no friction (relative to M g; torques to
+#: M g L): measured ≤ 1.1e-15 at the stable equilibria and held by the drive anywhere.
+STATIC_ATOL = 5e-15
+#: mirror and disk-swap partners, evaluated at different phases of the tables (relative to
+#: M g; torques to M g L): measured ≤ 6.1e-13, μ_required ≤ 1.8e-12 relative.
+SYMMETRY_ATOL = 2e-12
+SYMMETRY_MU_RTOL = 5e-12
+#: world vectors against their components (relative to M g): measured ≤ 2e-16; the unit
+#: vector ê against B − A from the cycle's positions: ≤ 5e-15.
+WORLD_ATOL = 1e-15
+DIRECTION_ATOL = 2e-14
+EPS = np.finfo(float).eps
+#: μ_required against the one from Newton–Euler by finite differences, times N_min / (M g)
+#: (an error δF in the forces moves μ by ~δF/N_min): measured ≤ 2.8e-9, near lift-off.
+MU_FD_TOL = 1e-8
+#: μ_required of the squeeze rule against the least μ bisected here, relative, per unit of
+#: max(N_A/N_B, N_B/N_A): B's share S − x of a split stored as A's share x carries the rounding
+#: of S, amplified by N_A/N_B when B is nearly unloaded. Measured ≤ 6.6e-16 over 8e5 random
+#: loads with N_A/N_B up to 1e4 (before the discriminant was formed without cancellation:
+#: 3.3e-13, i.e. 7.6e-10 at N_A/N_B = 2300).
+SQUEEZE_RTOL = 2e-15
 
 
 def make(shape, model='laminae', gravity=GRAVITY):
@@ -158,8 +179,81 @@ def test_moment_about_g_equals_rate_of_angular_momentum(shape, mass_model, mode,
     moment += forces.drive_torque[mid][:, None] * direction
     scale = model.weight * model.body.size
     assert np.max(np.abs(moment - rate)) <= MOMENT_TOL * scale
-    if mode == 'dynamic':      # a free motion needs no drive
-        assert np.max(np.abs(forces.drive_torque)) <= 1e-11 * scale
+    if mode == 'dynamic':      # a free motion needs no drive: measured ≤ 6e-14 M g L
+        assert np.max(np.abs(forces.drive_torque)) <= 3e-13 * scale
+
+
+def newton_euler_forces(model, mode, omega0, theta0, centres):
+    """Ground forces at the centres from Newton–Euler with finite differences of the poses.
+
+    G's acceleration and dH_G/dt (H_G = R I_G Rᵀ ω, ω from the orientations) by 5-point
+    differences in time along the simulated motion; A, B and G from ``cycle.positions``.
+    With ê from A to B, p = e_z × ê and the squeeze left out (it changes neither sum), the
+    force and moment balances about G are six linear equations for (N_A, N_B, T_A, T_B, S, τ).
+
+    Returns
+    -------
+    components : ndarray, shape (len(centres), 6)
+        N_A, N_B, T_A, T_B, S (N) and the drive torque τ (N m).
+    forces : ContactForces
+        The module's forces at the centres.
+    """
+    dynamics = model.dynamics
+    inertia = dynamics.mass.inertia
+    n = len(centres)
+    motion = simulate(dynamics, stencil_times(centres, 4), mode=mode, omega0=omega0,
+                      theta0=theta0)
+    rot = dynamics.cycle.state(motion.phase).rotation.reshape(n, 9, 3, 3)
+    g, a, b = (x.reshape(n, 9, 3) for x in dynamics.cycle.positions(motion.phase))
+    momentum = []
+    for i in range(2, 7):     # H at the five inner times of each stencil
+        omega = orientation_rate(rot[:, i - 2:i + 3])
+        r = rot[:, i]
+        momentum.append(np.einsum('kij,jl,kml,km->ki', r, inertia, r, omega))
+    rate = derivative5(np.stack(momentum, axis=1))
+    force = MASS * (second_derivative5(g[:, 2:7]) + [0.0, 0.0, GRAVITY])
+    g, a, b = g[:, 4], a[:, 4], b[:, 4]
+    unit = (b - a) / np.linalg.norm(b - a, axis=-1)[:, None]
+    up = np.broadcast_to([0.0, 0.0, 1.0], unit.shape)
+    p = np.cross(up, unit)
+    arm_a, arm_b = a - g, b - g
+    columns = [(up, np.cross(arm_a, up)), (up, np.cross(arm_b, up)), (p, np.cross(arm_a, p)),
+               (p, np.cross(arm_b, p)), (unit, np.cross(arm_b, unit)), (0 * unit, unit)]
+    matrix = np.stack([np.concatenate(col, axis=-1) for col in columns], axis=-1)
+    components = np.linalg.solve(matrix, np.concatenate([force, rate], axis=-1)[..., None])
+    forces = model.along(motion)
+    middle = slice(4, None, 9)
+    picked = {name: getattr(forces, name)[middle] for name in (
+        'normal_a', 'normal_b', 'tangential_a', 'tangential_b', 'along_ab', 'drive_torque',
+        'mu_required')}
+    return components[..., 0], picked
+
+
+@pytest.mark.parametrize('shape, mass_model, mode, omega0, theta0', [
+    (OLOID, 'laminae', 'dynamic', 6.0, 0.2),     # rolls over the top
+    (OLOID, 'solid', 'dynamic', 2.0, 1.0),       # oscillates in a well
+    (FAT, 'solid', 'kinematic', 3.0, 0.0),
+    (FIGURE3, 'laminae', 'kinematic', None, 0.5),   # 0.99 Ω_c: N_B → 0, μ up to 3.5
+])
+def test_mu_required_from_newton_euler_by_finite_differences(shape, mass_model, mode, omega0,
+                                                             theta0):
+    """N, T, S and μ_required from the motion alone (Newton–Euler, differences in time)."""
+    model = cached(shape, mass_model)
+    if omega0 is None:
+        omega0 = 0.99 * liftoff_speed(model)[0]
+    components, forces = newton_euler_forces(model, mode, omega0, theta0,
+                                             np.linspace(0.1, 2.0, 12))
+    names = ('normal_a', 'normal_b', 'tangential_a', 'tangential_b', 'along_ab')
+    for column, name in enumerate(names):
+        assert_allclose(forces[name], components[:, column], rtol=0,
+                        atol=FORCE_TOL * model.weight)
+    scale = model.weight * model.body.size
+    assert_allclose(forces['drive_torque'], components[:, 5], rtol=0, atol=MOMENT_TOL * scale)
+    # μ_required: the least friction of those components, bisected (least_friction)
+    loaded = np.minimum(components[:, 0], components[:, 1])
+    assert np.all(loaded > 0)
+    assert np.all(np.abs(forces['mu_required'] - least_friction(*components[:, :5].T))
+                  <= MU_FD_TOL * model.weight / loaded)
 
 
 def test_world_vectors_match_components_and_contact_line():
@@ -168,13 +262,13 @@ def test_world_vectors_match_components_and_contact_line():
     forces = model.kinematic(u, 3.0)
     _, a, b = model.dynamics.cycle.positions(u)
     unit = (b - a) / np.linalg.norm(b - a, axis=-1)[:, None]
-    assert_allclose(forces.direction_ab, unit, atol=1e-12)
+    assert_allclose(forces.direction_ab, unit, atol=DIRECTION_ATOL)
     p = np.cross([0.0, 0.0, 1.0], unit)
     for f, n, t, x in ((forces.force_a, forces.normal_a, forces.tangential_a, forces.along_a),
                        (forces.force_b, forces.normal_b, forces.tangential_b, forces.along_b)):
-        assert_allclose(f @ [0, 0, 1.0], n, atol=1e-12 * model.weight)
-        assert_allclose(np.sum(f * p, -1), t, atol=1e-12 * model.weight)
-        assert_allclose(np.sum(f * unit, -1), x, atol=1e-12 * model.weight)
+        assert_allclose(f @ [0, 0, 1.0], n, atol=WORLD_ATOL * model.weight)
+        assert_allclose(np.sum(f * p, -1), t, atol=WORLD_ATOL * model.weight)
+        assert_allclose(np.sum(f * unit, -1), x, atol=WORLD_ATOL * model.weight)
 
 
 def test_drive_torque_supplies_the_power():
@@ -191,10 +285,11 @@ def test_drive_torque_supplies_the_power():
     w, dw = f[:, 2], df[:, 2]
     u_dot, u_ddot = omega / w, -omega**2 * dw / w**3
     expected = (f[:, 0] * u_ddot + 0.5 * df[:, 0] * u_dot**2 + df[:, 1]) / along
+    # measured: τ ≤ 8.8e-14 M g L, u̇ 6.7e-16 relative, ü ≤ 6e-13 Ω² (tables vs tables)
     assert_allclose(forces.drive_torque, expected,
-                    atol=1e-10 * model.weight * body.size)
-    assert_allclose(forces.phase_rate, u_dot, rtol=1e-12)
-    assert_allclose(forces.phase_acceleration, u_ddot, atol=1e-10 * omega**2)
+                    atol=5e-13 * model.weight * body.size)
+    assert_allclose(forces.phase_rate, u_dot, rtol=4e-15)
+    assert_allclose(forces.phase_acceleration, u_ddot, atol=3e-12 * omega**2)
 
 
 # ----------------------------------------------------------------------------- statics
@@ -214,10 +309,11 @@ def test_stable_equilibria_vertical_forces_lever_rule(shape):
     assert len(stable) == 4
     u = np.array([eq.phase for eq in stable])
     for forces in (model.dynamic(u, 0.0), model.forces(u, 0.0, 0.0), model.kinematic(u, 0.0)):
-        scale = TIGHT * model.weight
-        for name in ('tangential_a', 'tangential_b', 'along_ab', 'mu_required'):
+        scale = STATIC_ATOL * model.weight
+        for name in ('tangential_a', 'tangential_b', 'along_ab'):
             assert np.max(np.abs(getattr(forces, name))) <= scale, name
-        assert np.max(np.abs(forces.drive_torque)) <= TIGHT * model.weight * model.body.size
+        assert np.max(forces.mu_required) <= STATIC_ATOL
+        assert np.max(np.abs(forces.drive_torque)) <= STATIC_ATOL * model.weight * model.body.size
         n_a, n_b = lever_rule(model, u)
         assert_allclose(forces.normal_a, n_a, atol=scale)
         assert_allclose(forces.normal_b, n_b, atol=scale)
@@ -230,11 +326,11 @@ def test_held_at_rest_anywhere_by_the_drive():
     u = np.linspace(0.0, TWO_PI, 61)
     forces = model.kinematic(u, 0.0)
     n_a, n_b = lever_rule(model, u)
-    assert_allclose(forces.normal_a, n_a, atol=TIGHT * model.weight)
-    assert_allclose(forces.normal_b, n_b, atol=TIGHT * model.weight)
-    assert np.max(np.abs(forces.tangential_a)) <= TIGHT * model.weight
-    assert np.max(np.abs(forces.along_ab)) <= TIGHT * model.weight
-    assert_allclose(forces.normal_a + forces.normal_b, model.weight, rtol=1e-13)
+    assert_allclose(forces.normal_a, n_a, atol=STATIC_ATOL * model.weight)
+    assert_allclose(forces.normal_b, n_b, atol=STATIC_ATOL * model.weight)
+    assert np.max(np.abs(forces.tangential_a)) <= STATIC_ATOL * model.weight
+    assert np.max(np.abs(forces.along_ab)) <= STATIC_ATOL * model.weight
+    assert_allclose(forces.normal_a + forces.normal_b, model.weight, rtol=STATIC_ATOL)
 
 
 # ----------------------------------------------------------------------------- symmetries
@@ -245,11 +341,11 @@ def test_mirror_branch_mirrors_forces(shape):
     u = np.linspace(-1.5, 1.5, 41)
     for here, there in ((model.dynamic(u, 4.0), model.dynamic(np.pi - u, -4.0)),
                         (model.kinematic(u, 6.0), model.kinematic(np.pi - u, 6.0))):
-        scale = TIGHT * model.weight
+        scale = SYMMETRY_ATOL * model.weight
         for name, sign in (('normal_a', 1), ('normal_b', 1), ('tangential_a', -1),
                            ('tangential_b', -1), ('along_ab', 1)):
             assert_allclose(getattr(there, name), sign * getattr(here, name), atol=scale)
-        assert_allclose(there.mu_required, here.mu_required, rtol=1e-9)
+        assert_allclose(there.mu_required, here.mu_required, rtol=SYMMETRY_MU_RTOL)
 
 
 def swap_phase(body, u):
@@ -278,18 +374,48 @@ def test_disk_swap_swaps_contacts(shape):
     # the turning point θ = θ_max (u = π/2) is the pose θ = 0 (u = 0 or π) with disks swapped
     assert abs(math.remainder(partner[2], math.pi)) < 1e-9
     here, there = model.kinematic(u, 5.0), model.kinematic(partner, 5.0)
-    scale = TIGHT * model.weight
+    scale = SYMMETRY_ATOL * model.weight
     assert_allclose(there.normal_a, here.normal_b, atol=scale)
     assert_allclose(there.normal_b, here.normal_a, atol=scale)
     assert_allclose(there.tangential_a, -here.tangential_b, atol=scale)
     assert_allclose(there.tangential_b, -here.tangential_a, atol=scale)
     assert_allclose(there.along_ab, -here.along_ab, atol=scale)
     assert_allclose(there.drive_torque, -here.drive_torque,
-                    atol=TIGHT * model.weight * model.body.size)
-    assert_allclose(there.mu_required, here.mu_required, rtol=1e-9)
+                    atol=SYMMETRY_ATOL * model.weight * model.body.size)
+    assert_allclose(there.mu_required, here.mu_required, rtol=SYMMETRY_MU_RTOL)
 
 
 # ----------------------------------------------------------------------------- squeeze, μ
+
+def least_friction(normal_a, normal_b, tangential_a, tangential_b, along_ab):
+    """min over the squeeze of max(f_A, f_B), by bisection on μ (independent of the module).
+
+    The friction cones cut the horizontal line of the squeeze x (the share of S taken by A) in
+    two intervals: f_A(x) ≤ μ for |x| ≤ r_A(μ) = √((μ N_A)² − T_A²), f_B(x) ≤ μ for
+    |S − x| ≤ r_B(μ). A split needing no more than μ exists iff both radii are real and
+    r_A + r_B ≥ |S|: increasing in μ, so the least such μ is bisected to adjacent floats
+    between μ_low = max(|T_A|/N_A, |T_B|/N_B) and μ_low + |S|/min(N_A, N_B) (arrays, N > 0).
+    """
+    n_a, n_b, t_a, t_b, s = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (
+        normal_a, normal_b, tangential_a, tangential_b, along_ab)))
+
+    def enough(mu):
+        r_a = np.sqrt(np.maximum((mu * n_a) ** 2 - t_a ** 2, 0.0))
+        r_b = np.sqrt(np.maximum((mu * n_b) ** 2 - t_b ** 2, 0.0))
+        return r_a + r_b >= np.abs(s)
+    low = np.maximum(np.abs(t_a) / n_a, np.abs(t_b) / n_b)
+    high = low + np.abs(s) / np.minimum(n_a, n_b)
+    done = enough(low)
+    high = np.where(done, low, high)
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        if np.all((middle <= low) | (middle >= high)):
+            break
+        ok = enough(middle)
+        high = np.where(ok, middle, high)
+        low = np.where(ok, low, middle)
+    return high
+
 
 def test_squeeze_split_minimises_the_friction_needed():
     rng = np.random.default_rng(7)
@@ -299,24 +425,21 @@ def test_squeeze_split_minimises_the_friction_needed():
     t_a[:50] = 0.0          # degenerate cases: no determinate tangential part, equal loads
     n_b[50:100] = n_a[50:100]
     s[100:120] = 0.0
+    # and loads of very different size (a contact close to lifting off), forces over 5 decades
+    m = 4000
+    n_a = np.concatenate([n_a, 10 ** rng.uniform(-3, 1, m)])
+    n_b = np.concatenate([n_b, 10 ** rng.uniform(-3, 1, m)])
+    t_a, t_b, s = (np.concatenate([v, rng.normal(size=m) * 10 ** rng.uniform(-4, 1, m)])
+                   for v in (t_a, t_b, s))
     x, ratio_a, ratio_b, mu = squeeze_split(n_a, n_b, t_a, t_b, s)
-    brute = np.empty(n)         # bounded Brent on the (unimodal) max of two convex functions
-    for i in range(n):
-        def worst(y, i=i):
-            return max(math.hypot(t_a[i], y) / n_a[i], math.hypot(t_b[i], s[i] - y) / n_b[i])
-        brute[i] = minimize_scalar(worst, bounds=(min(0, s[i]) - 1, max(0, s[i]) + 1),
-                                   method='bounded', options={'xatol': 1e-12}).fun
-    assert np.all(mu <= brute * (1 + 1e-12))
-    assert_allclose(mu, brute, rtol=1e-6)       # Brent converges slowly at the kink
-    # certificate of optimality: either the larger ratio sits at its own minimum (x = 0 for
-    # A, x = S for B), or the two ratios are equal with x between 0 and S
-    at_a = (x == 0) & (ratio_a >= ratio_b)
-    at_b = (x == s) & (ratio_b >= ratio_a)
-    crossing = (np.abs(ratio_a - ratio_b) <= 1e-12 * mu) & (x * (s - x) >= 0)
-    assert np.all(at_a | at_b | crossing)
-    assert_allclose(ratio_a, np.hypot(t_a, x) / n_a, rtol=1e-14)
-    assert_allclose(ratio_b, np.hypot(t_b, s - x) / n_b, rtol=1e-14)
-    assert_allclose(mu, np.maximum(ratio_a, ratio_b), rtol=0)
+    # the least μ from the intersection of the friction cones, bisected to adjacent floats
+    rtol = SQUEEZE_RTOL * np.maximum(n_a / n_b, n_b / n_a)
+    assert np.all(np.abs(mu / least_friction(n_a, n_b, t_a, t_b, s) - 1) <= rtol)
+    # the reported split needs no more than that: f_A, f_B computed here from x
+    assert np.all(np.hypot(t_a, x) / n_a <= mu * (1 + 4 * EPS))
+    assert np.all(np.hypot(t_b, s - x) / n_b <= mu * (1 + 4 * EPS))
+    assert_allclose(ratio_a, np.hypot(t_a, x) / n_a, rtol=4 * EPS)
+    assert_allclose(ratio_b, np.hypot(t_b, s - x) / n_b, rtol=4 * EPS)
     lifted = squeeze_split([-1.0, 1.0], [1.0, 0.0], [0.1, 0.1], [0.1, 0.1], [1.0, 1.0])
     assert np.all(np.isinf(lifted[3]))
 
@@ -333,7 +456,11 @@ def test_mu_just_above_and_below_mu_required():
     assert not report.valid and report.kind == 'slip' and report.index == first
     assert report.reason.startswith(f'the body would slip at t = {t[first]:.6g} s')
     peak_dynamic, _, _ = mu_required_dynamic(model, float(motion.energy[0]), samples=8192)
-    assert peak_dynamic == pytest.approx(peak, rel=1e-3)   # 401 samples vs 8192 phases
+    # the peak over 8192 phases of the cycle against the peak along the motion sampled every
+    # 0.5 ms (measured 3.2e-10 apart; 7e-7 with the 401 samples above)
+    dense = simulate(model.dynamics, np.linspace(0.0, 2.0, 4001), mode='dynamic', omega0=6.0,
+                     theta0=0.2)
+    assert peak_dynamic == pytest.approx(np.max(model.along(dense).mu_required), rel=1e-8)
 
 
 # ----------------------------------------------------------------------------- lift-off
@@ -349,7 +476,7 @@ def test_liftoff_speed_against_a_dense_sweep(shape):
     assert min(below.normal_a.min(), below.normal_b.min()) >= 0
     assert min(above.normal_a.min(), above.normal_b.min()) < 0
     mu = mu_required_kinematic(model, [0.0, 0.5 * speed, speed * (1 + 1e-4)])
-    assert mu[0] <= TIGHT and 0 < mu[1] < np.inf and mu[2] == np.inf
+    assert mu[0] <= STATIC_ATOL and 0 < mu[1] < np.inf and mu[2] == np.inf
 
 
 def test_liftoff_report_along_a_driven_motion():
@@ -380,7 +507,7 @@ def test_extreme_shapes_are_finite(shape):
                  'drive_torque', 'force_a', 'force_b'):
         assert np.all(np.isfinite(getattr(forces, name))), name
     assert_allclose(forces.normal_a + forces.normal_b - forces.force_a[:, 2]
-                    - forces.force_b[:, 2], 0.0, atol=1e-12 * model.weight)
+                    - forces.force_b[:, 2], 0.0, atol=WORLD_ATOL * model.weight)
     speed = liftoff_speed(model)[0]
     assert 0 < speed < np.inf
 
