@@ -7,6 +7,8 @@
   values, typed as rcl types them;
 - :mod:`~twodisk_ros.node.arguments`: the command line checked before rclpy parses it;
 - :mod:`~twodisk_ros.node.simulation`: the settings and the physics objects (no rclpy);
+- :mod:`~twodisk_ros.node.schedule`: the sample schedule, tick → time and stamp (no rclpy;
+  ``twodisk-view`` uses it too);
 - :mod:`~twodisk_ros.node.messages`: physics states → ROS 2 messages;
 - :mod:`~twodisk_ros.node.roller`: the rclpy node and ``main``.
 """

@@ -34,7 +34,7 @@ from .. import __version__
 from ..io import McapRecorder, cdr
 from ..outputs import check_output
 from ..io.cdr_markers import encode_markers
-from . import messages, run_summary, sim_clock
+from . import messages, run_summary, schedule, sim_clock
 from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
 from .descriptors import descriptor, ros_value
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
@@ -218,7 +218,7 @@ class Roller(Node):
             self.get_logger().error(f'outside the rolling model: '
                                     f'{self.simulation.invalid.reason}; the rolling solution '
                                     'is published on, marked invalid in /diagnostics')
-        stamps = self._start_ns + np.round(ticks * (1e9 / rate)).astype(np.int64)
+        stamps = schedule.stamps(self._start_ns, ticks, rate)
         return sample, stamps, self._encode(first, sample, stamps)
 
     def _encode(self, first, sample, stamps):
@@ -432,9 +432,8 @@ class Roller(Node):
 
     def _end_tick(self):
         """One past the last tick of a run with a duration, or None."""
-        if self.settings.duration <= 0:
-            return None
-        return int(math.floor(self.settings.duration * self.settings.rate + 1e-9)) + 1
+        last = schedule.last_tick(self.settings.duration, self.settings.rate)
+        return None if last is None else last + 1
 
     def run_batch(self, keep_going=lambda: True):
         """realtime=false: compute ``duration`` as fast as possible, publishing every sample.

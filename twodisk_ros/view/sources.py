@@ -14,10 +14,10 @@ times (s after the show started) at which each is due. No rclpy here.
 """
 
 from dataclasses import dataclass
-import math
 
 import numpy as np
 
+from ..node import schedule
 from ..node.simulation import Simulation
 from ..physics.body import TwoDiskBody
 from ..plotting.runs import recorded_run
@@ -72,7 +72,7 @@ class LiveSource:
         self.start_ns = None
         rate, duration = settings.rate, settings.duration
         #: ticks 0 … last (None: until stopped), as the node publishes them
-        self.last_tick = int(math.floor(duration * rate + 1e-9)) if duration > 0 else None
+        self.last_tick = schedule.last_tick(duration, rate)
 
     @property
     def has_forces(self):
@@ -88,8 +88,7 @@ class LiveSource:
 
     def stamps(self, ticks):
         """Stamps (ns) of the ticks k: start_ns + round(k × 1e9 / rate), as the node's."""
-        rate = self.settings.rate
-        return self.start_ns + np.round(np.asarray(ticks) * (1e9 / rate)).astype(np.int64)
+        return schedule.stamps(self.start_ns, ticks, self.settings.rate)
 
     def blocks(self):
         """The blocks of the run, in order (for ever when ``duration`` is 0)."""
