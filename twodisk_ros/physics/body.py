@@ -120,20 +120,31 @@ class TwoDiskForms:
 
     def _geometry(self, theta, cos_t, sin_t, sq):
         """Closed forms from θ and σ√Q (works for complex arguments)."""
+        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq)
+        return tuple(np.stack(v, axis=-1) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
+
+    def _geometry_components(self, cos_t, sin_t, sq):
+        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components."""
         a, b, delta = self.a, self.b, self.delta
         d = self._ellipse_terms(cos_t, sin_t)
         rho = a * b / d
         zero = np.zeros_like(rho)
-        r1 = np.stack([rho * sin_t, -(delta + rho * cos_t), zero], axis=-1)
+        r1 = [rho * sin_t, -(delta + rho * cos_t), zero]
         e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
-        r2 = np.stack([zero, delta - a * a * b * cos_t / e, -b * sq / e], axis=-1)
+        r2 = [zero, delta - a * a * b * cos_t / e, -b * sq / e]
+        n, t1, planar, norm_n = self._frame(cos_t, sin_t, sq)
+        height = b * (a * d + delta * b * cos_t) / norm_n
+        return r1, r2, n, t1 + [zero / planar], height, planar, norm_n
+
+    def _frame(self, cos_t, sin_t, sq):
+        """The components of n (three) and of t1 (the first two; the third is 0), the planar
+        norm and |N|, from θ and σ√Q (complex-safe)."""
+        a, b = self.a, self.b
         planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
         norm_n = np.sqrt(planar2 + sq * sq)
-        n = np.stack([-a * a * sin_t, b * b * cos_t, sq], axis=-1) / norm_n[..., None]
+        n = [-a * a * sin_t / norm_n, b * b * cos_t / norm_n, sq / norm_n]
         planar = np.sqrt(planar2)
-        t1 = np.stack([b * b * cos_t, a * a * sin_t, zero], axis=-1) / planar[..., None]
-        height = b * (a * d + delta * b * cos_t) / norm_n
-        return r1, r2, n, t1, height, planar, norm_n
+        return n, [b * b * cos_t / planar, a * a * sin_t / planar], planar, norm_n
 
     def _theta_array(self, theta):
         theta = np.asarray(theta, dtype=float)

@@ -21,8 +21,9 @@ Three models are offered:
 The solid hull is computed in :mod:`twodisk_ros.physics.hull`; docs/physics.md#mass-models.
 """
 
-import math
 from dataclasses import dataclass, fields
+from functools import lru_cache
+import math
 
 import numpy as np
 
@@ -265,6 +266,17 @@ def _moments(principal_moments):
     return moments
 
 
+@lru_cache(maxsize=4096)
+def _unit_hull(d, rtol):
+    """:func:`~twodisk_ros.physics.hull.unit_hull_moments` remembered per (Δ/a, rtol): the
+    quadrature depends on Δ/a only, so a sweep over b/a pays it once per Δ/a (arrays
+    read-only, results identical to a fresh call)."""
+    volume, first, second, error = unit_hull_moments(d, rtol)
+    first.setflags(write=False)
+    second.setflags(write=False)
+    return volume, first, second, error
+
+
 def solid_hull(a, b, delta, mass, *, rtol=1e-9):
     """Uniform solid convex hull of the two disks (the real oloid toy).
 
@@ -296,12 +308,14 @@ def solid_hull(a, b, delta, mass, *, rtol=1e-9):
     Notes
     -----
     See the module docstring for the method. The cost depends on ``delta / a`` only: about
-    1 ms for the Oloid and 5 ms for ``delta / a = 1e-3`` at ``rtol = 1e-9``.
+    1 ms for the Oloid and 5 ms for ``delta / a = 1e-3`` at ``rtol = 1e-9``; the quadrature of
+    each (``delta / a``, ``rtol``) is remembered (4096 of them), so the same ratio costs only
+    the scaling after its first call.
     """
     a, b, d = _geometry(a, b, delta)
     m = _positive('mass', mass, 'kg')
     tol = _rtol(rtol)
-    vol, first, second, err = unit_hull_moments(d / a, tol)
+    vol, first, second, err = _unit_hull(d / a, tol)
     # Map the normalised body (a = b = 1) by diag(b, a, b); the Jacobian is a b**2.
     scale = np.array([b, a, b])
     jac = a * b * b
