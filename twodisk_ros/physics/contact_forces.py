@@ -130,8 +130,12 @@ def kinematic_coefficients(samples, inertia, mass, gravity):
     inertia = np.asarray(inertia, dtype=float)
 
     def times_inertia(x):                                   # (x^T I)_j, x (3, N, B)
-        return np.stack([x[0] * inertia[:, 0, j] + x[1] * inertia[:, 1, j]
-                         + x[2] * inertia[:, 2, j] for j in range(3)])
+        out = np.empty(x.shape)
+        for j in range(3):
+            np.multiply(x[0], inertia[:, 0, j], out=out[j])
+            out[j] += x[1] * inertia[:, 1, j]
+            out[j] += x[2] * inertia[:, 2, j]
+        return out
 
     c = -cross(w, r1)                                       # dG/du, body frame
     dc, dw = np.split(real_spectral_derivative(np.concatenate([c, w]), axis=1), 2)
@@ -143,12 +147,15 @@ def kinematic_coefficients(samples, inertia, mass, gravity):
     p = cross(normal, e)
     force = (mass * gravity * normal, mass * k, mass * c)
     moment = (None, times_inertia(dw) + cross(w, iw), iw)
-    coef = []
-    for f, m in zip(force, moment):
-        moment_a = -cross(r1, f) if m is None else m - cross(r1, f)
-        f_b = cross(moment_a, d) / length2
-        f_n, b_n, f_p, b_p = dot(f, normal), dot(f_b, normal), dot(f, p), dot(f_b, p)
-        coef.append(np.stack([f_n - b_n, b_n, f_p - b_p, b_p, dot(f, e)]))
+    coef = np.empty((3, 5) + length2.shape)
+    for out, f, m in zip(coef, force, moment):
+        moment_a = cross(r1, f)
+        moment_a = np.negative(moment_a, out=moment_a) if m is None else m - moment_a
+        f_b = cross(moment_a, d)
+        f_b /= length2
+        out[1], out[3], out[4] = dot(f_b, normal), dot(f_b, p), dot(f, e)
+        np.subtract(dot(f, normal), out[1], out=out[0])
+        np.subtract(dot(f, p), out[3], out=out[2])
     speed = np.sqrt(dot(w, w))
     kin2 = -real_spectral_derivative(speed) / speed**3
     return coef[0], coef[1] / speed**2 + kin2 * coef[2]

@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
 from .body import TwoDiskBody
 from .orientation import contact_quaternion_samples
-from .spectral import (TAIL_TOLERANCE, refine_grid, spectral_antiderivative,
+from .spectral import (TAIL_TOLERANCE, node_sum, refine_grid, spectral_antiderivative,
                        spectral_derivative, spectral_tail, spectral_tails)
 from .tables import HermiteTable
 
@@ -176,8 +176,8 @@ def displacement_from_rates(arc_rate, turn_rate):
     h0 = np.take_along_axis(h_hat, k0[None], axis=0)[0]
     first = np.arange(n).reshape(k.shape) == k0
     coef = np.where(first, 0.0, h_hat / (1j * np.where(mu == 0, 1.0, mu)))
-    shift = (np.exp(1j * slope * TWO_PI) - 1.0) * coef.sum(axis=0) + h0 * _exp_integral(mu0,
-                                                                                         TWO_PI)
+    shift = (np.exp(1j * slope * TWO_PI) - 1.0) * node_sum(coef) + h0 * _exp_integral(mu0,
+                                                                                        TWO_PI)
     return slope * TWO_PI, shift
 
 

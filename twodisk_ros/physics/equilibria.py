@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .analytic import complex_step
-from .spectral import refine_grid, spectral_derivative_at, spectral_tail
+from .spectral import node_sum, refine_grid, spectral_derivative_at, spectral_tail
 
 __all__ = ['Equilibrium', 'EquilibriumArrays', 'equilibria', 'equilibria_batch', 'stability_map',
            'STABLE', 'UNSTABLE', 'NEUTRAL']
@@ -187,8 +187,8 @@ def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
     coeffs[n // 2] = 0.0
     quarter = (1j ** (np.arange(n) % 4))[:, None]
     weighted = 1j * k * coeffs
-    phase_curvature[turning] = [np.real(np.sum(weighted * quarter, axis=0)),
-                                np.real(np.sum(weighted * quarter.conj(), axis=0))]
+    phase_curvature[turning] = [np.real(node_sum(weighted * quarter)),
+                                np.real(node_sum(weighted * quarter.conj()))]
     curvature[turning] = phase_curvature[turning] / _psi_rates(bodies, phase[turning]) ** 2
     stable = ~neutral & (curvature > 0)
     return EquilibriumArrays(phase=phase, theta=geo.theta, height=geo.height,

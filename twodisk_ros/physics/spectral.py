@@ -10,7 +10,7 @@ import numpy as np
 
 __all__ = ['STALL', 'TAIL_TOLERANCE', 'refine_grid', 'spectral_antiderivative',
            'spectral_derivative', 'spectral_derivative_at', 'spectral_tail', 'spectral_tails',
-           'real_spectral_derivative', 'upsample']
+           'real_spectral_derivative', 'node_sum', 'upsample']
 
 #: A periodic function counts as resolved when :func:`spectral_tail` is below this.
 TAIL_TOLERANCE = 1e-13
@@ -96,6 +96,14 @@ def spectral_derivative(samples):
         coeffs[n // 2] = 0.0
     derivative = np.fft.ifft(1j * _wavenumbers(n, samples.ndim) * coeffs, axis=0)
     return derivative if np.iscomplexobj(samples) else np.real(derivative)
+
+
+def node_sum(samples):
+    """Σ over axis 0 (the nodes) for each column, summed row by row of the transposed array
+    (numpy's pairwise sum): a column's sum depends on that column only, not on how many
+    columns are summed with it (bodies of a batch give the same bits in any batch)."""
+    samples = np.asarray(samples)
+    return np.ascontiguousarray(np.moveaxis(samples, 0, -1)).sum(axis=-1)
 
 
 def real_spectral_derivative(samples, axis=0):

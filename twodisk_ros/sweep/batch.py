@@ -40,6 +40,7 @@ from ..physics.contact_validity import liftoff_speed_batch, mu_required_kinemati
 from ..physics.cycle import TWO_PI, displacement_from_rates, required_resolutions
 from ..physics.equilibria import equilibria_batch
 from ..physics.mass_models import mass_properties
+from ..physics.spectral import node_sum
 from .quantities import VARIABLES, body_quantities
 
 __all__ = ['POINTS', 'BATCH_STAGES', 'batch_quantities']
@@ -163,7 +164,7 @@ def _block(bodies, inertia, nodes, reference_speed, clock):
         values['rollover_speed'] = np.where(neutral, 0.0, speed)
     with clock('cycle_time'):
         w = samples.angular_velocity
-        values['cycle_time'] = np.sum(np.sqrt(dot(w, w)), axis=0) * (TWO_PI / nodes)
+        values['cycle_time'] = node_sum(np.sqrt(dot(w, w))) * (TWO_PI / nodes)
     with clock('contact_length'):
         d = samples.contact_b - samples.contact_a
         lengths = np.sqrt(dot(d, d))
