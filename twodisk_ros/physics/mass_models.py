@@ -29,7 +29,8 @@ import numpy as np
 
 from .hull import unit_hull_moments
 
-__all__ = ['MODELS', 'MassProperties', 'custom', 'laminae', 'mass_properties', 'solid_hull']
+__all__ = ['MODELS', 'MassProperties', 'clear_hull_cache', 'custom', 'laminae', 'mass_properties',
+           'solid_hull']
 
 #: Model names accepted by :func:`mass_properties`.
 MODELS = ('laminae', 'solid', 'custom')
@@ -275,6 +276,11 @@ def _unit_hull(d, rtol):
     first.setflags(write=False)
     second.setflags(write=False)
     return volume, first, second, error
+
+
+def clear_hull_cache():
+    """Forget the quadratures :func:`solid_hull` remembers (to time a first call)."""
+    _unit_hull.cache_clear()
 
 
 def solid_hull(a, b, delta, mass, *, rtol=1e-9):
