@@ -195,3 +195,16 @@ def test_liftoff_refinement_reaches_a_minimum_between_nodes():
     assert got[0] == pytest.approx(math.sqrt(found.fun), rel=1e-12)
     node_only = liftoff_speed_batch(n0[:, :, None], n2[:, :, None], iterations=0)
     assert abs(node_only[0] - got[0]) > 1e-9 * got[0]      # the refinement matters here
+
+
+def test_a_block_that_raises_goes_through_the_scalar_path(monkeypatch):
+    # masks instead of exceptions: a block failing for any reason loses no body
+    def broken(*args):
+        raise FloatingPointError('a numpy error in the block')
+
+    monkeypatch.setattr(batch, '_block', broken)
+    result = batch_quantities([1.0, 1.0], [0.5, 2.0])
+    values, failure = body_quantities(1.0, 0.5)
+    assert result['failure'] == ['', body_quantities(1.0, 2.0)[1]] and failure == ''
+    assert all(result[name][0] == values[name] for name in VARIABLES
+               if not math.isnan(values[name]))

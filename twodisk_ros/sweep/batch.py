@@ -18,8 +18,8 @@ bodies as array operations (docs/sweeps.md, "The batched path"):
    the lift-off speed (nodes, then Newton on the tables' quintic interpolant) and
    μ_required (its 2048 phases are table nodes);
 4. a body whose batched values are not all finite where the scalar path's are (or that has
-   no stable equilibrium although not neutral) is recomputed by the scalar path, which
-   then gives its values or its one-line failure.
+   no stable equilibrium although not neutral), and every body of a block that raised, is
+   recomputed by the scalar path, which then gives its values or its one-line failure.
 
 Every quantity agrees with the scalar path to ≤ 1e-10 relative, except where the scalar
 path itself is less accurate (the oscillation period within ~1e-3 a² of the neutral line
@@ -87,7 +87,7 @@ def _checked_bodies(b_values, delta_values, mass_model, out):
         try:
             body = TwoDiskBody(1.0, b, d)
             props = mass_properties(mass_model, 1.0, b, d, 1.0)
-        except (ValueError, RuntimeError, ArithmeticError):
+        except Exception:  # noqa: BLE001 (the scalar path gives this body's reason)
             continue
         out['theta_max'][k] = body.theta_max
         out['stability_margin'][k] = body.stability_margin
@@ -225,8 +225,14 @@ def batch_quantities(b_values, delta_values, mass_model='laminae', reference_spe
             step = max(1, POINTS // nodes)
             for start in range(0, group.size, step):
                 part = group[start:start + step]
-                values, good = _block(everyone.subset(part), inertia[part], nodes,
-                                      reference_speed, clock)
+                try:
+                    # non-finite values are masks here (checked in _block), not warnings
+                    with np.errstate(divide='ignore', invalid='ignore', over='ignore'):
+                        values, good = _block(everyone.subset(part), inertia[part], nodes,
+                                              reference_speed, clock)
+                except Exception:  # noqa: BLE001 (never lose a chunk: the scalar path)
+                    scalar.extend(chosen[part].tolist())
+                    continue
                 for name, array in values.items():
                     out[name][chosen[part]] = array
                 scalar.extend(chosen[part[~good]].tolist())
