@@ -1,20 +1,25 @@
-"""Bodies per second of ``twodisk-sweep`` on Dask, and projections (not a unit test).
+"""Bodies per second of ``twodisk-sweep`` on Dask, batched against per-body, and projections.
 
-Measured on one representative map, b/a ∈ [0.2, 3], Δ/a ∈ [0.05, 0.95] (no masked point):
+Measured on one representative map, b/a ∈ [0.2, 3], Δ/a ∈ [0.05, 0.95] (no masked point), on
+this machine, side by side in one run (not a unit test):
 
-1. the cost per body split by quantity (stage), serial, in this process (no Dask);
-2. the rate inside a Dask worker against the serial rate, and 2 workers against 1, side by
-   side in one run, before (a bare worker, as Dask's nanny starts it) and after the sweep's
-   worker set-up (:class:`~twodisk_ros.sweep.worker.SweepWorkerSetup`, which ``run_sweep``
-   registers); ``REPEATS`` rounds, each measuring serial, 1 and 2 workers in turn, medians
-   reported. "Inside a worker" is the tasks' own wall time (sum over chunks), so the
-   scheduler is left out; "N workers" is the wall time from the first submission to the last
-   result. CPU/wall below 1 means other jobs took the cores (contention, not Dask): the
-   ratios are also given in CPU time per body, which contention disturbs far less;
+1. the cost per body of the two paths in this process (no Dask), on the same bodies: the
+   per-body path (:func:`~twodisk_ros.sweep.quantities.body_quantities`, one library call
+   per quantity, the sweep's path before the batched one; split by stage) and the batched
+   path (:mod:`twodisk_ros.sweep.batch`, what a sweep's tasks run; split by stage) in chunks
+   of 16 (the current default chunk size) and of :data:`BATCH_CHUNK`: the speed-up per body;
+2. the rate inside a Dask worker against the serial rate, and 2 workers against 1 (batched
+   path, chunks of :data:`RATE_CHUNK`), before (a bare worker, as Dask's nanny starts it)
+   and after the sweep's worker set-up (:class:`~twodisk_ros.sweep.worker.SweepWorkerSetup`,
+   which ``run_sweep`` registers); ``REPEATS`` rounds, medians. "Inside a worker" is the
+   tasks' own wall time (sum over chunks), so the scheduler is left out; "N workers" is the
+   wall time from the first submission to the last result. CPU/wall below 1 means other jobs
+   took the cores (contention, not Dask): the ratios are also given in CPU time per body;
 3. the scheduling overhead per task (empty tasks on a 2-worker LocalCluster) and the client's
    cost per finished chunk (saving it to the resume cache);
-4. an end-to-end ``run_sweep`` (resume cache, NetCDF file) on 2 workers, and the wall time of
-   a 100 × 100 map extrapolated from it;
+4. end to end, ``twodisk-sweep`` itself (a subprocess: start-up, imports, Dask, the NetCDF
+   file) on a 100 × 100 map with 2 local workers and chunks of :data:`BATCH_CHUNK`, against
+   the per-body path's 100 × 100 time extrapolated from its 2-worker rate measured here;
 5. a projection for a 1000 × 1000 map on N workers (model printed with the numbers).
 
 Run: ``python benchmarks/sweep_rate.py`` (PYTHONPATH = the repository). Every cluster
@@ -23,21 +28,29 @@ listens on 127.0.0.1 only and is closed before the script ends.
 
 import math
 import os
+from pathlib import Path
+import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 
+from twodisk_ros.sweep.batch import BATCH_STAGES
 from twodisk_ros.sweep.parts import PartsCache
-from twodisk_ros.sweep.quantities import STAGES, body_quantities, chunk_quantities, timed_chunk
-from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client, run_sweep
+from twodisk_ros.sweep.quantities import STAGES, chunk_quantities, timed_chunk
+from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client
 from twodisk_ros.sweep.worker import SweepWorkerSetup
 
+REPO = Path(__file__).resolve().parents[1]
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
-STAGE_GRID = (16, 12)      # bodies timed serially by stage
-RATE_GRID = (24, 16)       # bodies timed serially and on 1 and 2 workers: 24 chunks of 16,
-                           # so the 2-worker run's tail (one worker idle while the other
-                           # ends its last chunk) stays a few % of its wall time
+SIDE_GRID = (24, 16)       # bodies timed serially by both paths, side by side
+BATCH_CHUNK = 128          # bodies per task of the batched path (docs/sweeps.md, "Cost")
+RATE_GRID = (48, 32)       # bodies timed serially and on 1 and 2 workers (batched path)
+RATE_CHUNK = 64            # 24 chunks: the 2-worker run's tail (one worker idle while the
+                           # other ends its last chunk) stays a few % of its wall time
+SCALAR_GRID = (24, 16)     # the per-body path on 2 workers, chunks of 16 (as it ran)
+MAP = (100, 100)           # the end-to-end map
 EMPTY_TASKS = 400
 REPEATS = 3                # rounds of serial / 1 worker / 2 workers (medians)
 
@@ -47,24 +60,35 @@ def _grid(shape):
 
 
 def _import_physics():
-    import twodisk_ros.sweep.quantities  # noqa: F401  (the workers' one-time imports)
+    import twodisk_ros.sweep.batch  # noqa: F401  (the workers' one-time imports)
 
 
 def _noop(x):
     return x
 
 
-def stage_costs():
-    b, d = _grid(STAGE_GRID)
-    timings = {}
-    start, cpu = time.perf_counter(), time.process_time()
-    for bi in b:
-        for di in d:
-            body_quantities(bi, di, timings=timings)
-    total = time.perf_counter() - start
-    n = b.size * d.size
-    share = (time.process_time() - cpu) / total
-    return n, total / n, share, {stage: timings.get(stage, 0.0) / n for stage in STAGES}
+def _cpu_clock():
+    return time.perf_counter(), time.process_time()
+
+
+def serial_costs(shape=SIDE_GRID):
+    """{path: (wall per body, CPU per body, {stage: wall per body})} (s), same bodies."""
+    spec = SweepSpec(*_grid(shape))
+    b, d = spec.points()
+    chunk_quantities(b[:8], d[:8])                                     # first calls apart
+    found = {}
+    for label, method, chunk in (('per-body', 'scalar', DEFAULT_CHUNK_SIZE),
+                                 (f'batched, chunks of {DEFAULT_CHUNK_SIZE}', 'batch',
+                                  DEFAULT_CHUNK_SIZE),
+                                 (f'batched, chunks of {BATCH_CHUNK}', 'batch', BATCH_CHUNK)):
+        timings = {}
+        wall, cpu = _cpu_clock()
+        for start in range(0, spec.size, chunk):
+            part = slice(start, start + chunk)
+            chunk_quantities(b[part], d[part], timings=timings, method=method)
+        wall, cpu = (x / spec.size for x in np.subtract(_cpu_clock(), (wall, cpu)))
+        found[label] = (wall, cpu, {k: v / spec.size for k, v in timings.items()})
+    return spec.size, found
 
 
 def task_overhead(client):
@@ -75,7 +99,7 @@ def task_overhead(client):
 
 
 def client_cost_per_chunk():
-    result = chunk_quantities([1.0] * DEFAULT_CHUNK_SIZE, [0.5] * DEFAULT_CHUNK_SIZE)
+    result = chunk_quantities([1.0] * BATCH_CHUNK, [0.5] * BATCH_CHUNK)
     with tempfile.TemporaryDirectory() as folder:
         cache = PartsCache(folder + '/x.parts', {'benchmark': 1})
         start = time.perf_counter()
@@ -97,12 +121,12 @@ def _timed_tasks(client, spec):
 
 def serial_rate():
     """(wall, CPU) per body (s) of the chunks of the rate grid, in this process."""
-    spec = SweepSpec(*_grid(RATE_GRID))
+    spec = SweepSpec(*_grid(RATE_GRID), chunk_size=RATE_CHUNK)
     b, d = spec.points()
-    start, cpu = time.perf_counter(), time.process_time()
+    wall, cpu = _cpu_clock()
     for part in spec.chunks():
         chunk_quantities(b[part], d[part])
-    return (time.perf_counter() - start) / spec.size, (time.process_time() - cpu) / spec.size
+    return tuple(x / spec.size for x in np.subtract(_cpu_clock(), (wall, cpu)))
 
 
 def worker_rates(workers):
@@ -111,7 +135,7 @@ def worker_rates(workers):
     One LocalCluster: bare workers first (Dask's defaults), then the same tasks after
     registering the sweep's worker plugin, exactly as ``run_sweep`` does.
     """
-    spec = SweepSpec(*_grid(RATE_GRID))
+    spec = SweepSpec(*_grid(RATE_GRID), chunk_size=RATE_CHUNK)
     found = {}
     with dask_client(workers=workers) as client:
         client.wait_for_workers(workers)
@@ -125,19 +149,40 @@ def worker_rates(workers):
     return found
 
 
-def end_to_end(workers=2):
-    """run_sweep with a NetCDF file on a fresh cluster: (SweepRun, start-up s, overhead s)."""
-    import twodisk_ros.sweep.dataset  # noqa: F401  (xarray's import is not the sweep's work)
-    spec = SweepSpec(*_grid(RATE_GRID))
-    start = time.perf_counter()
-    with dask_client(workers=workers) as client:
-        client.wait_for_workers(workers)
+def scalar_on_two_workers():
+    """Wall per body (s) of the per-body path on 2 workers (chunks of 16, as it ran)."""
+    spec = SweepSpec(*_grid(SCALAR_GRID))
+    b, d = spec.points()
+    with dask_client(workers=2) as client:
+        client.wait_for_workers(2)
+        client.register_plugin(SweepWorkerSetup())
         client.run(_import_physics)
-        startup = time.perf_counter() - start
-        overhead = task_overhead(client)
-        with tempfile.TemporaryDirectory() as folder:
-            run = run_sweep(spec, client, out=folder + '/map.nc', progress=None)
-    return run, startup, overhead
+        start = time.perf_counter()
+        futures = [client.submit(chunk_quantities, b[part], d[part], method='scalar',
+                                 pure=False) for part in spec.chunks()]
+        client.gather(futures)
+        return (time.perf_counter() - start) / spec.size
+
+
+def end_to_end(shape=MAP, workers=2, chunk=BATCH_CHUNK):
+    """``twodisk-sweep`` as a user runs it (a subprocess): (wall s, its last stderr line)."""
+    with tempfile.TemporaryDirectory() as folder:
+        argv = [sys.executable, '-m', 'twodisk_ros.sweep',
+                '--b-over-a', str(B_RANGE[0]), str(B_RANGE[1]), str(shape[0]),
+                '--delta-over-a', str(D_RANGE[0]), str(D_RANGE[1]), str(shape[1]),
+                '--out', str(Path(folder) / 'map.nc'), '--workers', str(workers),
+                '--chunk-size', str(chunk)]
+        env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep
+                   + os.environ.get('PYTHONPATH', ''))
+        env.pop('DASK_SCHEDULER_ADDRESS', None)
+        start = time.perf_counter()
+        done = subprocess.run(argv, env=env, cwd=folder, capture_output=True, text=True,
+                              timeout=3600)
+        wall = time.perf_counter() - start
+    lines = done.stderr.strip().splitlines()
+    if done.returncode != 0:
+        raise RuntimeError(f'twodisk-sweep failed ({done.returncode}): {lines[-1:]}')
+    return wall, lines[-1] if lines else ''
 
 
 def _median(rows, index):
@@ -161,18 +206,19 @@ def rate_table():
         loads.append(os.getloadavg()[0])
     med = {key: tuple(_median(rows, i) for i in range(3)) for key, rows in rounds.items()}
     n = RATE_GRID[0] * RATE_GRID[1]
-    print(f'rates, {n} bodies in chunks of {DEFAULT_CHUNK_SIZE}, medians of {REPEATS} rounds '
-          f'(load average {", ".join(f"{x:.2f}" for x in loads)} over the rounds):')
+    print(f'rates of the batched path, {n} bodies in chunks of {RATE_CHUNK}, medians of '
+          f'{REPEATS} rounds (load average {", ".join(f"{x:.2f}" for x in loads)} over the '
+          f'rounds):')
     serial_wall, _, serial_cpu = med['serial']
-    print(f'  serial (this process, no Dask): {1e3 * serial_wall:.1f} ms/body wall, '
-          f'{1e3 * serial_cpu:.1f} ms/body CPU')
+    print(f'  serial (this process, no Dask): {1e3 * serial_wall:.2f} ms/body wall, '
+          f'{1e3 * serial_cpu:.2f} ms/body CPU')
     for label, text in (('before', 'bare Dask workers (before)'),
                         ('after', 'with SweepWorkerSetup (after)')):
         one, two = med[(1, label)], med[(2, label)]
         print(f'  {text}:')
         for workers, (wall, task, cpu) in ((1, one), (2, two)):
-            print(f'    {workers} worker(s): {1 / wall:6.2f} bodies/s; inside a worker '
-                  f'{1e3 * task:.1f} ms/body wall, {1e3 * cpu:.1f} ms/body CPU '
+            print(f'    {workers} worker(s): {1 / wall:6.1f} bodies/s; inside a worker '
+                  f'{1e3 * task:.2f} ms/body wall, {1e3 * cpu:.2f} ms/body CPU '
                   f'(CPU/wall {cpu / task:.2f})')
         print(f'    rate inside a worker / serial rate: {serial_wall / one[1]:.2f} (wall), '
               f'{serial_cpu / one[2]:.2f} (CPU)   [target >= 0.90]')
@@ -182,43 +228,52 @@ def rate_table():
 
 
 def main():
-    n, per_body, share, stages = stage_costs()
     print(f'load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores')
-    print(f'cost per body, serial, {n} bodies of b/a in {B_RANGE}, delta/a in {D_RANGE}:')
-    print(f'  total {1e3 * per_body:.1f} ms per body (wall; CPU/wall {share:.2f})')
-    for stage, seconds in stages.items():
-        print(f'  {stage:16s} {1e3 * seconds:7.2f} ms  ({100 * seconds / per_body:4.1f} %)')
+    n, costs = serial_costs()
+    print(f'cost per body, serial, the same {n} bodies of b/a in {B_RANGE}, delta/a in '
+          f'{D_RANGE}, side by side:')
+    per_body = costs['per-body'][0]
+    for label, (wall, cpu, stages) in costs.items():
+        print(f'  {label}: {1e3 * wall:.2f} ms/body wall ({1e3 * cpu:.2f} CPU), speed-up per '
+              f'body {per_body / wall:.1f}x')
+        order = STAGES if label == 'per-body' else BATCH_STAGES
+        print('    ' + ', '.join(f'{stage} {1e3 * stages.get(stage, 0.0):.2f}'
+                                 for stage in order if stage in stages) + ' (ms/body)')
     med = rate_table()
     save = client_cost_per_chunk()
-    print(f'client: saving one {DEFAULT_CHUNK_SIZE}-body chunk to the resume cache: '
+    print(f'client: saving one {BATCH_CHUNK}-body chunk to the resume cache: '
           f'{1e3 * save:.2f} ms')
-    run, startup, overhead = end_to_end(2)
-    rate2 = run.dataset['b_over_a'].size * run.dataset['delta_over_a'].size / run.seconds
-    print(f'end to end, run_sweep on 2 workers with the resume cache and the NetCDF file: '
-          f'{rate2:.2f} bodies/s ({run.seconds:.2f} s; median task '
-          f'{np.median(run.chunk_seconds):.2f} s, CPU/wall in the tasks '
-          f'{sum(run.chunk_cpu_seconds) / sum(run.chunk_seconds):.2f}); cluster start-up '
-          f'{startup:.2f} s')
+    scalar_two = scalar_on_two_workers()
+    print(f'per-body path on 2 workers (chunks of {DEFAULT_CHUNK_SIZE}): '
+          f'{1 / scalar_two:.1f} bodies/s')
+    with dask_client(workers=2) as client:
+        client.wait_for_workers(2)
+        overhead = task_overhead(client)
     print(f'scheduler round trip of an empty task (2 workers): {1e3 * overhead:.2f} ms')
-    map_100 = 100 * 100 / rate2
-    print(f'100 x 100 map on 2 workers: ~{map_100:.0f} s ({map_100 / 60:.1f} min), '
-          f'extrapolated from the end-to-end 2-worker rate (+ {startup:.1f} s start-up)')
+    bodies = MAP[0] * MAP[1]
+    wall, last = end_to_end()
+    print(f'end to end, twodisk-sweep {MAP[0]} x {MAP[1]} with 2 local workers, chunks of '
+          f'{BATCH_CHUNK} (start-up, Dask, the NetCDF file): {wall:.1f} s wall '
+          f'({bodies / wall:.0f} bodies/s) [target <= 60 s]')
+    print(f'  its summary: {last}')
+    print(f'  the per-body path, extrapolated from its 2-worker rate: ~{bodies * scalar_two:.0f} '
+          f's for the same map; speed-up end to end {bodies * scalar_two / wall:.1f}x')
     # Projection: each worker spends c per body (the 1-worker wall cost with the worker
     # set-up, which includes the per-task overhead) on B / N bodies; the client handles every
     # chunk serially (save + round trip), which bounds the rate from below whatever N is.
     c = med[(1, 'after')][0]
-    bodies = 1000 * 1000
-    chunks = math.ceil(bodies / DEFAULT_CHUNK_SIZE)
+    big = 1000 * 1000
+    chunks = math.ceil(big / BATCH_CHUNK)
     client_floor = chunks * (save + overhead)
-    print(f'1000 x 1000 map ({bodies} bodies, {chunks} chunks of {DEFAULT_CHUNK_SIZE}); '
-          f'T(N) = max(B c / N, chunks (s + o)) with c = {1e3 * c:.1f} ms/body (1-worker '
+    print(f'1000 x 1000 map ({big} bodies, {chunks} chunks of {BATCH_CHUNK}); '
+          f'T(N) = max(B c / N, chunks (s + o)) with c = {1e3 * c:.2f} ms/body (1-worker '
           f'run), s = {1e3 * save:.2f} ms (save), o = {1e3 * overhead:.2f} ms (round trip); '
           f'N dedicated cores like this one, ideal scaling (divide by the efficiency '
           f'measured on your cluster):')
-    for workers in (1, 2, 8, 32, 128, 512):
-        compute = bodies * c / workers
+    for workers in (1, 2, 8, 32, 64, 128, 512):
+        compute = big * c / workers
         total = max(compute, client_floor)
-        print(f'  N = {workers:4d}: {total / 3600:7.2f} h'
+        print(f'  N = {workers:4d}: {total / 60:8.1f} min'
               + ('   (client-bound)' if client_floor > compute else ''))
     print(f'load average after: {os.getloadavg()[0]:.2f} (other jobs on the machine lower the '
           f'2-worker rate)')

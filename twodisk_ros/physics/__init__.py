@@ -2,7 +2,8 @@
 
 Modules, from geometry to motion (docs/physics.md derives each):
 
-- :mod:`~twodisk_ros.physics.body`: the body and the closed forms, in θ and in the phase u;
+- :mod:`~twodisk_ros.physics.body`: the body and the closed forms, in θ and in the phase u
+  (:mod:`~twodisk_ros.physics.body_batch`: the same closed forms for many bodies at once);
 - :mod:`~twodisk_ros.physics.cycle`: poses and contact traces over whole cycles;
 - :mod:`~twodisk_ros.physics.equilibria`: the eight equilibria and their stability;
 - :mod:`~twodisk_ros.physics.mass_models` (with :mod:`~twodisk_ros.physics.hull`): inertia;

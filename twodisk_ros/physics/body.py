@@ -42,7 +42,7 @@ import numpy as np
 
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 
-__all__ = ['LENGTH_RANGE', 'TwoDiskBody', 'PhaseGeometry']
+__all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
 
 #: Allowed a, b and Δ (m). Every result is scale-invariant (θ_max, z_G / a, S / a, periods
 #: × √(g/a) agree with the unit body's to ≤ 3e-13 from 1e-35 to 1e35 m, tests/
@@ -83,8 +83,231 @@ class PhaseGeometry:
     height: np.ndarray          #: z_G = −r1·n (m), the potential energy per unit M g
     tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
+class TwoDiskForms:
+    """The closed forms of the body in the cycle phase u, for one body or for a batch.
 
-class TwoDiskBody:
+    The methods read the parameters ``a``, ``b``, ``delta`` (m), ``theta_max`` (rad) and the
+    constants derived from them in the constructor of a subclass (``_cos_theta_max``,
+    ``_sin_theta_max``, ``_d_max``, ``_eta_max``, ``_cos_eta_max``, ``_sin_eta_max``,
+    ``_e_max``): floats in :class:`TwoDiskBody` (one body), arrays of shape (B,) in
+    :class:`~twodisk_ros.physics.body_batch.TwoDiskBodies` (B bodies at once; phases of shape
+    (..., B) or (..., 1) then broadcast against them). The formulas are the same for both.
+    """
+
+    @property
+    def stability_margin(self):
+        """b² − 2a² + 2Δ² (m²): > 0 → θ = 0 family stable, < 0 → θ = ±π/2 stable, 0 neutral."""
+        return self.b**2 - 2 * self.a**2 + 2 * self.delta**2
+
+    @property
+    def eta_max(self):
+        """η at the turning point θ = θ_max (rad)."""
+        return self._eta_max
+
+    # -- shared pieces of the closed forms ---------------------------------------------------
+    def _ellipse_terms(self, cos_t, sin_t):
+        """D = √(a² sin²θ + b² cos²θ) (m), the denominator of the polar ellipse ρ = ab/D."""
+        a, b = self.a, self.b
+        return np.sqrt(a * a * sin_t * sin_t + b * b * cos_t * cos_t)
+
+    def _q_cofactor(self, cos_t, d):
+        """L·F2 where Q = (cos θ − cos θ_max)·L·F2 (exact factorisation, see module doc)."""
+        a, b, delta = self.a, self.b, self.delta
+        big_l = b * (2 * delta + a) - a * (a * a - b * b) * (self._cos_theta_max + cos_t) / (
+            d + self._d_max)
+        f2 = a * d + b * cos_t * (2 * delta - a)
+        return big_l * f2
+
+    def _geometry(self, theta, cos_t, sin_t, sq):
+        """Closed forms from θ and σ√Q (works for complex arguments)."""
+        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq)
+        return tuple(np.stack(v, axis=-1) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
+
+    def _geometry_components(self, cos_t, sin_t, sq):
+        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components."""
+        a, b, delta = self.a, self.b, self.delta
+        d = self._ellipse_terms(cos_t, sin_t)
+        rho = a * b / d
+        zero = np.zeros_like(rho)
+        r1 = [rho * sin_t, -(delta + rho * cos_t), zero]
+        e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
+        r2 = [zero, delta - a * a * b * cos_t / e, -b * sq / e]
+        n, t1, planar, norm_n = self._frame(cos_t, sin_t, sq)
+        height = b * (a * d + delta * b * cos_t) / norm_n
+        return r1, r2, n, t1 + [zero / planar], height, planar, norm_n
+
+    def _frame(self, cos_t, sin_t, sq):
+        """The components of n (three) and of t1 (the first two; the third is 0), the planar
+        norm and |N|, from θ and σ√Q (complex-safe)."""
+        a, b = self.a, self.b
+        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        norm_n = np.sqrt(planar2 + sq * sq)
+        n = [-a * a * sin_t / norm_n, b * b * cos_t / norm_n, sq / norm_n]
+        planar = np.sqrt(planar2)
+        return n, [b * b * cos_t / planar, a * a * sin_t / planar], planar, norm_n
+
+    def _theta_array(self, theta):
+        theta = np.asarray(theta, dtype=float)
+        if np.any(~np.isfinite(theta)) or np.any(np.abs(theta) > self.theta_max * (1 + 1e-15)):
+            raise ValueError(f'theta must be finite with |theta| <= theta_max = '
+                             f'{self.theta_max!r} rad')
+        return np.clip(theta, -self.theta_max, self.theta_max)
+
+    def height_second_derivative(self, theta):
+        """d²z_G/dθ² (m/rad²), by complex step of the paper's V′ (exact to rounding)."""
+        theta = self._theta_array(theta)
+        a, b, delta = self.a, self.b, self.delta
+
+        def first(t):
+            s, c = np.sin(t), np.cos(t)
+            d = np.sqrt(a * a * s * s + b * b * c * c)
+            norm2 = (2 * a**4 * s * s + b**4 * c * c + 4 * a * b * delta * c * d
+                     + 4 * b * b * delta * delta * c * c)
+            return a**3 * b**3 * s * c * self.stability_margin / (d * norm2**1.5)
+        return complex_step(first, theta)
+
+    # -- the regular cycle parameter u -------------------------------------------------------
+    # u sweeps the eccentric anomaly η of A on disk 1 sinusoidally: η = η_max sin u, with A at
+    # (b sin η, −a cos η) from the centre of disk 1, so tan θ = (b/a) tan η. Sharp features of
+    # thin ellipses (b/a → 0 or ∞) then have width ~min(a, b)/max(a, b) in u, not its square.
+    def phase_angles(self, u):
+        """(θ, cos θ, sin θ, j) at phase u (rad), with cos θ − cos θ_max = j cos²u.
+
+        Analytic in u (complex-step safe); exact near the turning points u = ±π/2.
+        """
+        a, b = self.a, self.b
+        eta_m, tm = self._eta_max, self.theta_max
+        w = np.sin(u)
+        sign_w = np.where(np.real(w) < 0, -1.0, 1.0)
+        abs_w = w * sign_w
+        abs_eta = eta_m * abs_w
+        e = np.sqrt(a * a * np.cos(abs_eta) ** 2 + b * b * np.sin(abs_eta) ** 2)
+        e_m = self._e_max
+        cos_t = a * np.cos(abs_eta) / e
+        sin_abs = b * np.sin(abs_eta) / e
+        # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
+        v_over_c2 = eta_m / (1 + abs_w)
+        v = v_over_c2 * np.cos(u) ** 2
+        x = (a * a * np.cos(abs_eta) * self._cos_eta_max
+             + b * b * np.sin(abs_eta) * self._sin_eta_max)
+        # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
+        denom = e * e_m + x
+        t = a * b * np.sin(v) / denom
+        # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
+        # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
+        near_axis = np.real(abs_eta) < 1.0
+        tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
+        abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
+        j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
+             * a * b * v_over_c2 * sinc(v) / denom)
+        return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
+
+    def phase_theta(self, u):
+        """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
+        return self.phase_angles(u)[0]
+
+    def phase_signed_sqrt_q(self, u):
+        """σ√Q as a smooth function of u: cos u · √(j L F2), with cos θ − cos θ_max = j cos²u.
+
+        Analytic in u (complex-step safe) and exact near the turning points u = ±π/2.
+        """
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        return self._phase_sqrt_q(u, cos_t, sin_t, j)
+
+    def _phase_sqrt_q(self, u, cos_t, sin_t, j):
+        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe)."""
+        cofactor = self._q_cofactor(cos_t, self._ellipse_terms(cos_t, sin_t))
+        return np.cos(u) * np.sqrt(j * cofactor)
+
+    def phase_vectors(self, u):
+        """(r1, r2, n, t1, z_G, planar, |N|, θ, σ√Q) at phase u, body frame (complex-safe).
+
+        r1, r2 (m), the unit ground normal n and the unit tangent t1 of disk 1 at A, the height
+        z_G (m) and the unnormalised lengths of the normal; for complex-step derivatives.
+        """
+        theta, cos_t, sin_t, j = self.phase_angles(u)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
+        return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
+
+    def phase_geometry(self, u):
+        """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
+        u = np.asarray(u, dtype=float)
+        theta, cos_t, sin_t, j = self.phase_angles(u)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
+        branch = np.where(np.cos(u) < 0, -1.0, 1.0)
+        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
+
+    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch):
+        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq)
+        psi = np.arctan2(sq, -self.a**2 * cos_t)
+        tilt = np.arctan2(planar, sq)
+        return PhaseGeometry(phase=u, theta=theta, psi=psi, branch=branch, signed_sqrt_q=sq,
+                             contact_a=r1, contact_b=r2, ground_normal=n, tangent_a=t1,
+                             height=height, tilt=tilt)
+
+    def phase_height(self, u):
+        """z_G(u) (m), analytic in u."""
+        return self.phase_vectors(u)[4]
+
+    def _psi_half_angle(self, u):
+        """ψ(u) = 2 arctan(sin ψ / (1 + cos ψ)), analytic in u (|ψ| < π over the cycle)."""
+        _, cos_t, _, _ = self.phase_angles(u)
+        sq = self.phase_signed_sqrt_q(u)
+        norm = np.sqrt(sq * sq + self.a**4 * cos_t * cos_t)
+        return 2 * np.arctan(sq / (norm - self.a * self.a * cos_t))
+
+    def phase_angles_with_rates(self, u):
+        """(θ, ψ, dθ/du, dψ/du) at phase u (rad and rad per rad), one complex step each."""
+        uc = np.asarray(u, dtype=float) + 1j * COMPLEX_STEP
+        (theta, dtheta), (psi, dpsi) = complex_step_jet(
+            (self.phase_theta(uc), self._psi_half_angle(uc)))
+        return theta, psi, dtheta, dpsi
+
+    def phase_angle_rates(self, u):
+        """(dθ/du, dψ/du) at phase u, by complex step (ψ = 2 arctan(sin ψ / (1 + cos ψ)))."""
+        return self.phase_angles_with_rates(u)[2:]
+
+    def phase_rates(self, u):
+        """Rates per unit u̇ at phase u: returns (ds/du, dα/du) of the trace of A.
+
+        ds/du = (ds/dη)(dη/du) may be negative (A moves back along disk 1); dα/du = K ds/du
+        ≥ 0 (paper eqs. (3)-(6): K = k cos φ, by the chain rule dη/du = η_max cos u).
+        """
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        return self._rates(u, cos_t, sin_t, self._phase_sqrt_q(u, cos_t, sin_t, j))
+
+    def _rates(self, u, cos_t, sin_t, sq):
+        """(ds/du, dα/du) of :meth:`phase_rates` from the angles at u and σ√Q."""
+        a, b = self.a, self.b
+        eta = self._eta_max * np.sin(u)
+        speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
+        ds_du = np.sqrt(speed2) * self._eta_max * np.cos(u)
+        k = a * b / speed2**1.5
+        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        cos_phi = sq / np.sqrt(planar2 + sq * sq)
+        return ds_du, k * cos_phi * ds_du
+
+    def phase_angular_velocity(self, u):
+        """ω_u (rad per unit u, body frame, shape u.shape + (3,)): angular velocity per u̇.
+
+        With the contact frame (t1, n × t1, n) ↦ (c_α, c_α⊥, e_z) in the world,
+        ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
+        """
+        u = np.asarray(u, dtype=float)
+        vec = self.phase_vectors(u + 1j * COMPLEX_STEP)
+        return self._angular_velocity(vec[2], vec[3], self.phase_rates(u)[1])
+
+    @staticmethod
+    def _angular_velocity(n, t1, dalpha):
+        """ω_u from n and t1 at u + ih (complex, :data:`COMPLEX_STEP`) and dα/du at u."""
+        m = np.cross(n, t1)
+        n_re, t1_re, m_re = n.real, t1.real, m.real
+        dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))
+        frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
+        return dalpha[..., None] * n_re - frame_rate
+
+
+class TwoDiskBody(TwoDiskForms):
     """Two identical elliptic disks in perpendicular planes, joined along their axis ``a``.
 
     Parameters
@@ -121,6 +344,11 @@ class TwoDiskBody:
         self.theta_max = math.atan2(2 * b * math.sqrt(delta * (a + delta)), -a * a)
         self._sin_theta_max = math.sin(self.theta_max)
         self._d_max = math.hypot(a * self._sin_theta_max, b * self._cos_theta_max)
+        # η_max, its cosine and sine, and E(η_max) (phase_angles)
+        self._eta_max = math.atan2(a * self._sin_theta_max, b * self._cos_theta_max)
+        self._cos_eta_max = math.cos(self._eta_max)
+        self._sin_eta_max = math.sin(self._eta_max)
+        self._e_max = math.hypot(a * self._cos_eta_max, b * self._sin_eta_max)
 
     def __repr__(self):
         return f'TwoDiskBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
@@ -143,11 +371,6 @@ class TwoDiskBody:
         return self.theta_max
 
     @property
-    def stability_margin(self):
-        """b² − 2a² + 2Δ² (m²): > 0 → θ = 0 family stable, < 0 → θ = ±π/2 stable, 0 neutral."""
-        return self.b**2 - 2 * self.a**2 + 2 * self.delta**2
-
-    @property
     def size(self):
         """A length scale of the body (m): the largest distance of a disk point from G.
 
@@ -158,45 +381,7 @@ class TwoDiskBody:
             return a + d
         return math.sqrt(b * b + d * d + (a * d) ** 2 / (b * b - a * a))
 
-    # -- shared pieces of the closed forms ---------------------------------------------------
-    def _ellipse_terms(self, cos_t, sin_t):
-        """D = √(a² sin²θ + b² cos²θ) (m), the denominator of the polar ellipse ρ = ab/D."""
-        a, b = self.a, self.b
-        return np.sqrt(a * a * sin_t * sin_t + b * b * cos_t * cos_t)
-
-    def _q_cofactor(self, cos_t, d):
-        """L·F2 where Q = (cos θ − cos θ_max)·L·F2 (exact factorisation, see module doc)."""
-        a, b, delta = self.a, self.b, self.delta
-        big_l = b * (2 * delta + a) - a * (a * a - b * b) * (self._cos_theta_max + cos_t) / (
-            d + self._d_max)
-        f2 = a * d + b * cos_t * (2 * delta - a)
-        return big_l * f2
-
-    def _geometry(self, theta, cos_t, sin_t, sq):
-        """Closed forms from θ and σ√Q (works for complex arguments)."""
-        a, b, delta = self.a, self.b, self.delta
-        d = self._ellipse_terms(cos_t, sin_t)
-        rho = a * b / d
-        zero = np.zeros_like(rho)
-        r1 = np.stack([rho * sin_t, -(delta + rho * cos_t), zero], axis=-1)
-        e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
-        r2 = np.stack([zero, delta - a * a * b * cos_t / e, -b * sq / e], axis=-1)
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
-        norm_n = np.sqrt(planar2 + sq * sq)
-        n = np.stack([-a * a * sin_t, b * b * cos_t, sq], axis=-1) / norm_n[..., None]
-        planar = np.sqrt(planar2)
-        t1 = np.stack([b * b * cos_t, a * a * sin_t, zero], axis=-1) / planar[..., None]
-        height = b * (a * d + delta * b * cos_t) / norm_n
-        return r1, r2, n, t1, height, planar, norm_n
-
     # -- the paper's θ form ------------------------------------------------------------------
-    def _theta_array(self, theta):
-        theta = np.asarray(theta, dtype=float)
-        if np.any(~np.isfinite(theta)) or np.any(np.abs(theta) > self.theta_max * (1 + 1e-15)):
-            raise ValueError(f'theta must be finite with |theta| <= theta_max = '
-                             f'{self.theta_max!r} rad')
-        return np.clip(theta, -self.theta_max, self.theta_max)
-
     @staticmethod
     def _branch_array(branch):
         branch = np.asarray(branch)
@@ -288,59 +473,6 @@ class TwoDiskBody:
                  + 4 * b * b * delta * delta * c * c)
         return a**3 * b**3 * s * c * self.stability_margin / (d * norm2**1.5)
 
-    def height_second_derivative(self, theta):
-        """d²z_G/dθ² (m/rad²), by complex step of the paper's V′ (exact to rounding)."""
-        theta = self._theta_array(theta)
-        a, b, delta = self.a, self.b, self.delta
-
-        def first(t):
-            s, c = np.sin(t), np.cos(t)
-            d = np.sqrt(a * a * s * s + b * b * c * c)
-            norm2 = (2 * a**4 * s * s + b**4 * c * c + 4 * a * b * delta * c * d
-                     + 4 * b * b * delta * delta * c * c)
-            return a**3 * b**3 * s * c * self.stability_margin / (d * norm2**1.5)
-        return complex_step(first, theta)
-
-    # -- the regular cycle parameter u -------------------------------------------------------
-    # u sweeps the eccentric anomaly η of A on disk 1 sinusoidally: η = η_max sin u, with A at
-    # (b sin η, −a cos η) from the centre of disk 1, so tan θ = (b/a) tan η. Sharp features of
-    # thin ellipses (b/a → 0 or ∞) then have width ~min(a, b)/max(a, b) in u, not its square.
-    @property
-    def eta_max(self):
-        """η at the turning point θ = θ_max (rad)."""
-        return math.atan2(self.a * self._sin_theta_max, self.b * self._cos_theta_max)
-
-    def phase_angles(self, u):
-        """(θ, cos θ, sin θ, j) at phase u (rad), with cos θ − cos θ_max = j cos²u.
-
-        Analytic in u (complex-step safe); exact near the turning points u = ±π/2.
-        """
-        a, b = self.a, self.b
-        eta_m, tm = self.eta_max, self.theta_max
-        w = np.sin(u)
-        sign_w = np.where(np.real(w) < 0, -1.0, 1.0)
-        abs_w = w * sign_w
-        abs_eta = eta_m * abs_w
-        e = np.sqrt(a * a * np.cos(abs_eta) ** 2 + b * b * np.sin(abs_eta) ** 2)
-        e_m = math.hypot(a * math.cos(eta_m), b * math.sin(eta_m))
-        cos_t = a * np.cos(abs_eta) / e
-        sin_abs = b * np.sin(abs_eta) / e
-        # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
-        v_over_c2 = eta_m / (1 + abs_w)
-        v = v_over_c2 * np.cos(u) ** 2
-        x = a * a * np.cos(abs_eta) * math.cos(eta_m) + b * b * np.sin(abs_eta) * math.sin(eta_m)
-        # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
-        denom = e * e_m + x
-        t = a * b * np.sin(v) / denom
-        # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
-        # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
-        near_axis = np.real(abs_eta) < 1.0
-        tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
-        abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
-        j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
-             * a * b * v_over_c2 * sinc(v) / denom)
-        return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
-
     def phase_from_theta(self, theta, branch=1):
         """The phase u ∈ [−π/2, 3π/2) of contact angle θ on a branch (inverse of θ(u)).
 
@@ -357,102 +489,3 @@ class TwoDiskBody:
         base = np.pi / 2 - 2 * np.arcsin(np.sqrt(np.clip(v / (2 * self.eta_max), 0.0, 0.5)))
         base = np.where(theta < 0, -base, base)
         return np.where(branch > 0, base, np.pi - base)
-
-    def phase_theta(self, u):
-        """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
-        return self.phase_angles(u)[0]
-
-    def phase_signed_sqrt_q(self, u):
-        """σ√Q as a smooth function of u: cos u · √(j L F2), with cos θ − cos θ_max = j cos²u.
-
-        Analytic in u (complex-step safe) and exact near the turning points u = ±π/2.
-        """
-        _, cos_t, sin_t, j = self.phase_angles(u)
-        return self._phase_sqrt_q(u, cos_t, sin_t, j)
-
-    def _phase_sqrt_q(self, u, cos_t, sin_t, j):
-        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe)."""
-        cofactor = self._q_cofactor(cos_t, self._ellipse_terms(cos_t, sin_t))
-        return np.cos(u) * np.sqrt(j * cofactor)
-
-    def phase_vectors(self, u):
-        """(r1, r2, n, t1, z_G, planar, |N|, θ, σ√Q) at phase u, body frame (complex-safe).
-
-        r1, r2 (m), the unit ground normal n and the unit tangent t1 of disk 1 at A, the height
-        z_G (m) and the unnormalised lengths of the normal; for complex-step derivatives.
-        """
-        theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
-        return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
-
-    def phase_geometry(self, u):
-        """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
-        u = np.asarray(u, dtype=float)
-        theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
-        branch = np.where(np.cos(u) < 0, -1.0, 1.0)
-        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
-
-    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch):
-        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq)
-        psi = np.arctan2(sq, -self.a**2 * cos_t)
-        tilt = np.arctan2(planar, sq)
-        return PhaseGeometry(phase=u, theta=theta, psi=psi, branch=branch, signed_sqrt_q=sq,
-                             contact_a=r1, contact_b=r2, ground_normal=n, tangent_a=t1,
-                             height=height, tilt=tilt)
-
-    def phase_height(self, u):
-        """z_G(u) (m), analytic in u."""
-        return self.phase_vectors(u)[4]
-
-    def _psi_half_angle(self, u):
-        """ψ(u) = 2 arctan(sin ψ / (1 + cos ψ)), analytic in u (|ψ| < π over the cycle)."""
-        _, cos_t, _, _ = self.phase_angles(u)
-        sq = self.phase_signed_sqrt_q(u)
-        norm = np.sqrt(sq * sq + self.a**4 * cos_t * cos_t)
-        return 2 * np.arctan(sq / (norm - self.a * self.a * cos_t))
-
-    def phase_angles_with_rates(self, u):
-        """(θ, ψ, dθ/du, dψ/du) at phase u (rad and rad per rad), one complex step each."""
-        uc = np.asarray(u, dtype=float) + 1j * COMPLEX_STEP
-        (theta, dtheta), (psi, dpsi) = complex_step_jet(
-            (self.phase_theta(uc), self._psi_half_angle(uc)))
-        return theta, psi, dtheta, dpsi
-
-    def phase_angle_rates(self, u):
-        """(dθ/du, dψ/du) at phase u, by complex step (ψ = 2 arctan(sin ψ / (1 + cos ψ)))."""
-        return self.phase_angles_with_rates(u)[2:]
-
-    def phase_rates(self, u):
-        """Rates per unit u̇ at phase u: returns (ds/du, dα/du) of the trace of A.
-
-        ds/du = (ds/dη)(dη/du) may be negative (A moves back along disk 1); dα/du = K ds/du
-        ≥ 0 (paper eqs. (3)-(6): K = k cos φ, by the chain rule dη/du = η_max cos u).
-        """
-        a, b = self.a, self.b
-        eta = self.eta_max * np.sin(u)
-        speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
-        ds_du = np.sqrt(speed2) * self.eta_max * np.cos(u)
-        k = a * b / speed2**1.5
-        _, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
-        cos_phi = sq / np.sqrt(planar2 + sq * sq)
-        return ds_du, k * cos_phi * ds_du
-
-    def phase_angular_velocity(self, u):
-        """ω_u (rad per unit u, body frame, shape u.shape + (3,)): angular velocity per u̇.
-
-        With the contact frame (t1, n × t1, n) ↦ (c_α, c_α⊥, e_z) in the world,
-        ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
-        """
-        u = np.asarray(u, dtype=float)
-        uc = u + 1j * COMPLEX_STEP
-        vec = self.phase_vectors(uc)
-        n, t1 = vec[2], vec[3]
-        m = np.cross(n, t1)
-        n_re, t1_re, m_re = n.real, t1.real, m.real
-        dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))
-        frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
-        _, dalpha = self.phase_rates(u)
-        return dalpha[..., None] * n_re - frame_rate

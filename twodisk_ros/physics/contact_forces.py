@@ -29,12 +29,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .analytic import complex_step
+from .body_batch import cross, dot
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
-from .spectral import spectral_derivative, spectral_tail
+from .spectral import real_spectral_derivative, spectral_derivative, spectral_tail
 from .tables import HermiteTable
 
-__all__ = ['ContactForceModel', 'ContactForces', 'squeeze_split', 'QUANTITIES']
+__all__ = ['ContactForceModel', 'ContactForces', 'squeeze_split', 'kinematic_coefficients',
+           'QUANTITIES']
 
 #: the determinate scalar outputs (N, N, N, N, N, N m), in the order of the tables' columns
 QUANTITIES = ('normal_a', 'normal_b', 'tangential_a', 'tangential_b', 'along_ab',
@@ -100,6 +102,66 @@ def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
     ratio_a = np.where(n_a > 0, np.sqrt(ta2 + x * x) * inv_a, np.inf)
     ratio_b = np.where(n_b > 0, np.sqrt(tb2 + y * y) * inv_b, np.inf)
     return x, ratio_a, ratio_b, np.maximum(ratio_a, ratio_b)
+
+
+def kinematic_coefficients(samples, inertia, mass, gravity):
+    """The kinematic columns of :class:`ContactForceModel` at one cycle's nodes, for a batch.
+
+    The same construction as the model's tables (Newton-Euler per unit u, moments about A,
+    spectral u-derivatives of dG/du, ω_u and |ω_u|), for B bodies at once and component by
+    component, without the heading and the drive torque, which the lift-off speed and
+    μ_required do not need.
+
+    Parameters
+    ----------
+    samples : CycleSamples
+        The bodies' closed forms at u_j = 2πj/N (:meth:`TwoDiskBodies.cycle_samples
+        <twodisk_ros.physics.body_batch.TwoDiskBodies.cycle_samples>`): vectors (3, N, B).
+    inertia : ndarray, shape (B, 3, 3)
+        Inertia about G (kg m², body frame).
+    mass, gravity : float or ndarray of shape (B,)
+        M (kg) and g (m/s²).
+
+    Returns
+    -------
+    q0, q2 : ndarray, shape (5, N, B)
+        N_A, N_B, T_A, T_B, S (N, the first five :data:`QUANTITIES`) when a drive holds
+        |ω| = Ω: Q = Q0 + Ω² Q2 (the model's ``'kinematic'`` coefficients at the nodes).
+    """
+    r1, r2, normal = samples.contact_a, samples.contact_b, samples.ground_normal
+    w = samples.angular_velocity
+    inertia = np.asarray(inertia, dtype=float)
+
+    def times_inertia(x):                                   # (x^T I)_j, x (3, N, B)
+        out = np.empty(x.shape)
+        for j in range(3):
+            np.multiply(x[0], inertia[:, 0, j], out=out[j])
+            out[j] += x[1] * inertia[:, 1, j]
+            out[j] += x[2] * inertia[:, 2, j]
+        return out
+
+    c = -cross(w, r1)                                       # dG/du, body frame
+    dc, dw = np.split(real_spectral_derivative(np.concatenate([c, w]), axis=1), 2)
+    k = cross(w, c) + dc                                    # a_G per u̇² (body frame)
+    iw = times_inertia(w)
+    d = r2 - r1
+    length2 = dot(d, d)
+    e = d / np.sqrt(length2)
+    p = cross(normal, e)
+    force = (mass * gravity * normal, mass * k, mass * c)
+    moment = (None, times_inertia(dw) + cross(w, iw), iw)
+    coef = np.empty((3, 5) + length2.shape)
+    for out, f, m in zip(coef, force, moment):
+        moment_a = cross(r1, f)
+        moment_a = np.negative(moment_a, out=moment_a) if m is None else m - moment_a
+        f_b = cross(moment_a, d)
+        f_b /= length2
+        out[1], out[3], out[4] = dot(f_b, normal), dot(f_b, p), dot(f, e)
+        np.subtract(dot(f, normal), out[1], out=out[0])
+        np.subtract(dot(f, p), out[3], out=out[2])
+    speed = np.sqrt(dot(w, w))
+    kin2 = -real_spectral_derivative(speed) / speed**3
+    return coef[0], coef[1] / speed**2 + kin2 * coef[2]
 
 
 @dataclass

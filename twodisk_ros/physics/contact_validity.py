@@ -14,10 +14,13 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from .cycle import TWO_PI
-from .contact_forces import QUANTITIES
+from .contact_forces import QUANTITIES, squeeze_split
+from .spectral import real_spectral_derivative
+from .tables import hermite_jet
 
 __all__ = ['ValidityReport', 'check_validity', 'motion_validity', 'liftoff_speed',
-           'mu_required_kinematic', 'mu_required_dynamic']
+           'liftoff_speed_batch', 'mu_required_kinematic', 'mu_required_kinematic_batch',
+           'mu_required_dynamic']
 
 _STRIDE = len(QUANTITIES) + 1   # kinematic columns: Q0 (6 + ü) then Q2 (6 + ü)
 
@@ -125,6 +128,68 @@ def liftoff_speed(model):
     return best
 
 
+def liftoff_speed_batch(n0, n2, iterations=6):
+    """:func:`liftoff_speed` of B bodies from their kinematic normal forces at the nodes.
+
+    Parameters
+    ----------
+    n0, n2 : ndarray, shape (2, N, B)
+        N_A, N_B = N0 + Ω² N2 at u_j = 2πj/N (:func:`~twodisk_ros.physics.contact_forces.
+        kinematic_coefficients`, the model's table nodes).
+    iterations : int
+        Newton steps of the refinement.
+
+    Returns
+    -------
+    ndarray, shape (B,)
+        Ω_c (rad/s): 0 where N0 ≤ 0 at a node (a contact already lifts at rest), inf where
+        N2 < 0 nowhere, else √(min −N0/N2) over the cycle and both contacts.
+
+    Notes
+    -----
+    As :func:`liftoff_speed`: the smallest ratio −N0/N2 on the nodes, refined on the
+    quintic Hermite interpolant of the tables (spectral f′ and f″ at the nodes) within one
+    node spacing of it. The refinement is Newton's method on the interpolant (exact slope and
+    curvature of the quintic, steps kept inside the two intervals), the best value found
+    kept; this reaches the interpolant's minimum to rounding where the scalar path's bounded
+    Brent stops at 1e-12 rad.
+    """
+    n, bodies = n0.shape[1:]
+    columns = np.concatenate([n0, n2])                          # (4, N, B)
+    step = TWO_PI / n
+    first = real_spectral_derivative(columns, axis=1) * step
+    second = real_spectral_derivative(first, axis=1) * step
+    with np.errstate(divide='ignore', invalid='ignore'):
+        ratio = np.where(n2 < 0, -n0 / np.where(n2 < 0, n2, -1.0), np.inf)
+    best = np.full(bodies, np.inf)
+    index = np.arange(bodies)
+    for j in range(2):
+        i = np.argmin(ratio[j], axis=0)
+        value = ratio[j, i, index]
+        some = np.isfinite(value)                # N2 < 0 at some node (else never lifts)
+        x = np.zeros(bodies)                     # offset from node i, in node spacings
+        for _ in range(iterations):
+            left = x < 0
+            node = np.where(left, i - 1, i) % n
+            t = np.where(left, x + 1.0, x)
+            jets = [hermite_jet(t, [a[col, node, index] for a in (columns, first, second)],
+                                [a[col, (node + 1) % n, index] for a in (columns, first,
+                                                                        second)])
+                    for col in (j, 2 + j)]
+            (f0, d0, s0), (f2, d2, s2) = jets
+            with np.errstate(divide='ignore', invalid='ignore'):
+                q = -f0 / f2                     # N2 q = −N0, differentiated twice
+                dq = (-d0 - q * d2) / f2
+                ddq = (-s0 - 2 * dq * d2 - q * s2) / f2
+                value = np.where(some & (f2 < 0) & (q < value), q, value)
+                move = np.where(ddq > 0, -dq / ddq, 0.0)
+            x = np.clip(x + np.where(np.isfinite(move), move, 0.0), -1.0, 1.0)
+        best = np.minimum(best, value)
+    lifted = np.any(n0 <= 0, axis=(0, 1))
+    with np.errstate(invalid='ignore'):         # a negative ratio: N0 < 0, lifted
+        return np.where(lifted, 0.0, np.sqrt(best))
+
+
 def mu_required_kinematic(model, omega, samples=2048):
     """max over one cycle of μ_required at each kinematic speed Ω (rad/s, array_like).
 
@@ -161,3 +226,28 @@ def mu_required_dynamic(model, energy, u0=None, samples=2048):
     mu = np.where(reached, model.dynamic(u, np.sqrt(np.maximum(rate2, 0.0))).mu_required,
                   np.nan)
     return (float(np.nanmax(mu)) if np.any(reached) else math.nan), u, mu
+
+
+def mu_required_kinematic_batch(q0, q2, omega, samples=2048):
+    """:func:`mu_required_kinematic` of B bodies at one speed Ω (rad/s), from the nodes.
+
+    Parameters
+    ----------
+    q0, q2 : ndarray, shape (5, N, B)
+        N_A, N_B, T_A, T_B, S = Q0 + Ω² Q2 at u_j = 2πj/N
+        (:func:`~twodisk_ros.physics.contact_forces.kinematic_coefficients`); N must be a
+        multiple of ``samples``, whose phases 2πj/samples are then nodes.
+    omega : float
+        Ω (rad/s).
+
+    Returns
+    -------
+    ndarray, shape (B,)
+        max over the ``samples`` phases of μ_required (inf at and above the lift-off speed).
+    """
+    n = q0.shape[1]
+    if n % samples:
+        raise ValueError(f'the nodes ({n}) must be a multiple of samples ({samples})')
+    stride = n // samples
+    values = q0[:, ::stride] + float(omega) ** 2 * q2[:, ::stride]
+    return squeeze_split(*values)[3].max(axis=0)

@@ -23,11 +23,12 @@ from scipy.integrate import solve_ivp
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
 from .body import TwoDiskBody
 from .orientation import contact_quaternion_samples
-from .spectral import refine_grid, spectral_antiderivative, spectral_derivative, spectral_tail
+from .spectral import (TAIL_TOLERANCE, node_sum, refine_grid, spectral_antiderivative,
+                       spectral_derivative, spectral_tail, spectral_tails)
 from .tables import HermiteTable
 
 __all__ = ['RollingCycle', 'RollingState', 'RollingPoses', 'CycleDisplacement',
-           'integrate_contact_trace']
+           'integrate_contact_trace', 'required_resolutions', 'displacement_from_rates']
 
 TWO_PI = 2.0 * math.pi
 
@@ -108,6 +109,76 @@ def _cycle_tails(body, n):
     ds, dalpha = body.phase_rates(u)
     _, alpha_p = spectral_antiderivative(dalpha)
     return max(spectral_tail(dalpha), spectral_tail(ds * np.exp(1j * alpha_p)))
+
+
+def required_resolutions(bodies, points=2**16):
+    """:meth:`RollingCycle.required_resolution` of every body of a batch, at once.
+
+    The same test as the scalar construction (doubling from 512 nodes until the spectral
+    tails of dα/du and of the trace's rate are below ``TAIL_TOLERANCE``, at most
+    :attr:`RollingCycle.MAX_RESOLUTION`), on arrays of bodies.
+
+    Parameters
+    ----------
+    bodies : TwoDiskBodies
+    points : int
+        Nodes × bodies evaluated at once (bounds the memory: ~100 B per point).
+
+    Returns
+    -------
+    ndarray of int, shape (B,)
+    """
+    resolution = np.zeros(len(bodies), dtype=int)
+    active = np.arange(len(bodies))
+    n = 512
+    while active.size:
+        u = (TWO_PI * np.arange(n) / n)[:, None]
+        done = np.zeros(active.size, dtype=bool)
+        step = max(1, points // n)
+        for start in range(0, active.size, step):
+            part = slice(start, start + step)
+            ds, dalpha = bodies.subset(active[part]).phase_rates(u)
+            _, alpha_p = spectral_antiderivative(dalpha)
+            tails = np.maximum(spectral_tails(dalpha), spectral_tails(ds * np.exp(1j * alpha_p)))
+            done[part] = (tails < TAIL_TOLERANCE) | (n >= RollingCycle.MAX_RESOLUTION)
+        resolution[active[done]] = n
+        active = active[~done]
+        n *= 2
+    return resolution
+
+
+def displacement_from_rates(arc_rate, turn_rate):
+    """The displacement of one cycle from ds/du and dα/du at the nodes u_j = 2πj/N.
+
+    The spectral integration of :class:`RollingCycle` (Z_A(2π) = ∫₀^{2π} ds/du e^{iα} du,
+    exact to rounding once the rates are resolved), for one body or for a batch.
+
+    Parameters
+    ----------
+    arc_rate, turn_rate : ndarray, shape (N, ...)
+        ds/du (m/rad) and dα/du (rad/rad) of the trace of A; axis 0 is u, any further axes
+        are bodies.
+
+    Returns
+    -------
+    turn : ndarray, shape (...)
+        Heading change of one cycle (rad).
+    shift : ndarray of complex, shape (...)
+        Translation of one cycle, x + i y (m).
+    """
+    n = arc_rate.shape[0]
+    slope, alpha_p = spectral_antiderivative(turn_rate)
+    h_hat = np.fft.fft(arc_rate * np.exp(1j * alpha_p), axis=0) / n
+    k = np.fft.fftfreq(n, d=1.0 / n).reshape((n,) + (1,) * (arc_rate.ndim - 1))
+    mu = k + slope
+    k0 = np.argmin(np.abs(mu), axis=0)
+    mu0 = np.take_along_axis(mu, k0[None], axis=0)[0]
+    h0 = np.take_along_axis(h_hat, k0[None], axis=0)[0]
+    first = np.arange(n).reshape(k.shape) == k0
+    coef = np.where(first, 0.0, h_hat / (1j * np.where(mu == 0, 1.0, mu)))
+    shift = (np.exp(1j * slope * TWO_PI) - 1.0) * node_sum(coef) + h0 * _exp_integral(mu0,
+                                                                                        TWO_PI)
+    return slope * TWO_PI, shift
 
 
 class RollingCycle:

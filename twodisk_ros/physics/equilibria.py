@@ -13,9 +13,10 @@ import math
 import numpy as np
 
 from .analytic import complex_step
-from .spectral import refine_grid, spectral_derivative_at, spectral_tail
+from .spectral import node_sum, refine_grid, spectral_derivative_at, spectral_tail
 
-__all__ = ['Equilibrium', 'equilibria', 'stability_map', 'STABLE', 'UNSTABLE', 'NEUTRAL']
+__all__ = ['Equilibrium', 'EquilibriumArrays', 'equilibria', 'equilibria_batch', 'stability_map',
+           'STABLE', 'UNSTABLE', 'NEUTRAL']
 
 STABLE, UNSTABLE, NEUTRAL = 'stable', 'unstable', 'neutral'
 
@@ -54,12 +55,26 @@ def _height_phase_curvatures(body, phases):
     return spectral_derivative_at(slope, phases)
 
 
-def _psi_rate(body, u):
-    """dψ/du near ψ = 0, where ψ = arctan(σ√Q / (−a² cos θ)) is analytic."""
+def _psi_rates(body, u):
+    """dψ/du near ψ = 0, where ψ = arctan(σ√Q / (−a² cos θ)) is analytic (arrays)."""
     def psi_near_zero(x):
         _, cos_t, _, _ = body.phase_angles(x)
         return np.arctan(body.phase_signed_sqrt_q(x) / (-body.a**2 * cos_t))
-    return float(complex_step(psi_near_zero, u))
+    return complex_step(psi_near_zero, u)
+
+
+def _psi_rate(body, u):
+    """dψ/du at one phase u (float)."""
+    return float(_psi_rates(body, u))
+
+
+def _entry_phases(eta_max):
+    """The phases of the eight equilibria in order (θ = 0, +π/2, θ_max, +π/2, 0, −π/2, −θ_max,
+    −π/2), from η_max (array) as in :func:`equilibria`; also u at θ = π/2."""
+    u_half_pi = np.arcsin(np.minimum(1.0, (np.pi / 2) / eta_max))
+    zero = np.zeros_like(u_half_pi)
+    return [zero, u_half_pi, zero + np.pi / 2, np.pi - u_half_pi, zero + np.pi,
+            np.pi + u_half_pi, zero + 1.5 * np.pi, 2 * np.pi - u_half_pi], u_half_pi
 
 
 def _classify(curvature, margin_is_zero):
@@ -109,6 +124,76 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE):
             curvature=curvature, phase_curvature=phase_curv,
             stability=_classify(curvature, neutral)))
     return found
+
+
+@dataclass(frozen=True)
+class EquilibriumArrays:
+    """The eight equilibria of B bodies (:func:`equilibria_batch`); rows in the order of
+    :func:`equilibria`, columns the bodies."""
+
+    phase: np.ndarray             #: u (rad), (8, B)
+    theta: np.ndarray             #: θ (rad), (8, B)
+    height: np.ndarray            #: z_G (m), (8, B)
+    curvature: np.ndarray         #: d²z_G/dθ² (rows θ) or d²z_G/dψ² (turning points), (8, B)
+    phase_curvature: np.ndarray   #: d²z_G/du² (m/rad²), (8, B)
+    stable: np.ndarray            #: bool (8, B): the equilibrium is stable
+    neutral: np.ndarray           #: bool (B,): the body is neutral (every entry 'neutral')
+
+
+def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
+    """:func:`equilibria` of a batch of bodies at once (arrays instead of a list).
+
+    Parameters
+    ----------
+    bodies : TwoDiskBodies
+        B bodies (:mod:`~twodisk_ros.physics.body_batch`).
+    slope : ndarray, shape (N, B)
+        dz_G/du (m/rad) at u_j = 2πj/N, N a multiple of 4, resolved (e.g.
+        :attr:`~twodisk_ros.physics.body_batch.CycleSamples.height_slope` on a cycle's
+        table nodes): d²z_G/du² at the turning points is its spectral derivative, as in
+        :func:`equilibria`.
+    neutral_tolerance : float
+        As in :func:`equilibria`.
+
+    Returns
+    -------
+    EquilibriumArrays
+
+    Notes
+    -----
+    At the six equilibria θ = 0, ±π/2, where dz_G/dθ = 0, d²z_G/du² = (d²z_G/dθ²)(dθ/du)²
+    with both factors by complex step of closed forms (the paper's V′ carries the factor
+    b² − 2a² + 2Δ²): exact to rounding, also near the neutral line. :func:`equilibria` takes
+    the spectral derivative of dz_G/du there too; both agree to ~1e-13 relative when
+    |b² − 2a² + 2Δ²| ≳ 1e-2 a², but within ~1e-3 a² of the neutral line the rounding noise of
+    the samples (~1e-16 a) dominates its spectrum and the spectral value loses digits
+    (1e-9 relative at 1e-4 a², 1e-4 at 1e-8 a²).
+    """
+    n = slope.shape[0]
+    neutral = np.abs(bodies.stability_margin) <= neutral_tolerance * np.maximum(
+        bodies.a, bodies.b) ** 2
+    phases, _ = _entry_phases(bodies.eta_max)
+    phase = np.stack(phases)
+    geo = bodies.phase_geometry(phase)
+    curvature = np.empty(phase.shape)
+    phase_curvature = np.empty(phase.shape)
+    rows, turning = [0, 1, 3, 4, 5, 7], [2, 6]
+    curvature[rows] = bodies.height_second_derivative(geo.theta[rows])
+    theta_rate = bodies.phase_angles_with_rates(phase[rows])[2]
+    phase_curvature[rows] = curvature[rows] * theta_rate**2
+    # turning points u = π/2, 3π/2 (nodes): Re Σ i k c_k e^{iku}, e^{ikπ/2} = i^k (N % 4 == 0)
+    k = np.fft.fftfreq(n, d=1.0 / n)[:, None]
+    coeffs = np.fft.fft(slope, axis=0) / n
+    coeffs[n // 2] = 0.0
+    quarter = (1j ** (np.arange(n) % 4))[:, None]
+    weighted = 1j * k * coeffs
+    phase_curvature[turning] = [np.real(node_sum(weighted * quarter)),
+                                np.real(node_sum(weighted * quarter.conj()))]
+    curvature[turning] = phase_curvature[turning] / _psi_rates(bodies, phase[turning]) ** 2
+    stable = ~neutral & (curvature > 0)
+    return EquilibriumArrays(phase=phase, theta=geo.theta, height=geo.height,
+                             curvature=curvature, phase_curvature=phase_curvature,
+                             stable=stable, neutral=neutral)
 
 
 def stability_map(b_over_a, delta_over_a, neutral_tolerance=NEUTRAL_TOLERANCE):

@@ -21,14 +21,16 @@ Three models are offered:
 The solid hull is computed in :mod:`twodisk_ros.physics.hull`; docs/physics.md#mass-models.
 """
 
-import math
 from dataclasses import dataclass, fields
+from functools import lru_cache
+import math
 
 import numpy as np
 
 from .hull import unit_hull_moments
 
-__all__ = ['MODELS', 'MassProperties', 'custom', 'laminae', 'mass_properties', 'solid_hull']
+__all__ = ['MODELS', 'MassProperties', 'clear_hull_cache', 'custom', 'laminae', 'mass_properties',
+           'solid_hull']
 
 #: Model names accepted by :func:`mass_properties`.
 MODELS = ('laminae', 'solid', 'custom')
@@ -265,6 +267,22 @@ def _moments(principal_moments):
     return moments
 
 
+@lru_cache(maxsize=4096)
+def _unit_hull(d, rtol):
+    """:func:`~twodisk_ros.physics.hull.unit_hull_moments` remembered per (Δ/a, rtol): the
+    quadrature depends on Δ/a only, so a sweep over b/a pays it once per Δ/a (arrays
+    read-only, results identical to a fresh call)."""
+    volume, first, second, error = unit_hull_moments(d, rtol)
+    first.setflags(write=False)
+    second.setflags(write=False)
+    return volume, first, second, error
+
+
+def clear_hull_cache():
+    """Forget the quadratures :func:`solid_hull` remembers (to time a first call)."""
+    _unit_hull.cache_clear()
+
+
 def solid_hull(a, b, delta, mass, *, rtol=1e-9):
     """Uniform solid convex hull of the two disks (the real oloid toy).
 
@@ -296,12 +314,14 @@ def solid_hull(a, b, delta, mass, *, rtol=1e-9):
     Notes
     -----
     See the module docstring for the method. The cost depends on ``delta / a`` only: about
-    1 ms for the Oloid and 5 ms for ``delta / a = 1e-3`` at ``rtol = 1e-9``.
+    1 ms for the Oloid and 5 ms for ``delta / a = 1e-3`` at ``rtol = 1e-9``; the quadrature of
+    each (``delta / a``, ``rtol``) is remembered (4096 of them), so the same ratio costs only
+    the scaling after its first call.
     """
     a, b, d = _geometry(a, b, delta)
     m = _positive('mass', mass, 'kg')
     tol = _rtol(rtol)
-    vol, first, second, err = unit_hull_moments(d / a, tol)
+    vol, first, second, err = _unit_hull(d / a, tol)
     # Map the normalised body (a = b = 1) by diag(b, a, b); the Jacobian is a b**2.
     scale = np.array([b, a, b])
     jac = a * b * b

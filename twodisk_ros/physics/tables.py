@@ -9,7 +9,7 @@ table contributes one gather of its node data and one small matrix product per s
 
 import numpy as np
 
-__all__ = ['HermiteTable']
+__all__ = ['HermiteTable', 'hermite_jet']
 
 
 class HermiteTable:
@@ -124,3 +124,36 @@ class HermiteTable:
         """
         closed = [np.concatenate([x, x[:1]]) for x in (values, first, second)]
         return cls(0.0, 2.0 * np.pi / len(values), *closed)
+
+
+def hermite_jet(t, start, end):
+    """The quintic Hermite interpolant of :class:`HermiteTable` on one interval, and its slope
+    and curvature, at t ∈ [0, 1] (arrays broadcast together).
+
+    Parameters
+    ----------
+    t : array_like
+        Position in the interval, (x − x_i)/h.
+    start, end : sequence of three arrays
+        (f, h f′, h² f″) at the interval's two nodes (the table's scaled node data).
+
+    Returns
+    -------
+    f, df, d2f : ndarray
+        The interpolant and its first and second derivatives in t (divide by h and h² for
+        derivatives in x).
+    """
+    (y0, d0, s0), (y1, d1, s1) = start, end
+    t = np.asarray(t, dtype=float)
+    t2 = t * t
+    t3 = t2 * t
+    value = ((1 + t3 * (-10 + t * (15 - 6 * t))) * y0 + (t + t3 * (-6 + t * (8 - 3 * t))) * d0
+             + 0.5 * (t2 + t3 * (-3 + t * (3 - t))) * s0 + 0.5 * t3 * (1 + t * (-2 + t)) * s1
+             + t3 * (-4 + t * (7 - 3 * t)) * d1 + t3 * (10 + t * (-15 + 6 * t)) * y1)
+    slope = (t2 * (-30 + t * (60 - 30 * t)) * (y0 - y1) + (1 + t2 * (-18 + t * (32 - 15 * t))) * d0
+             + (t + t2 * (-4.5 + t * (6 - 2.5 * t))) * s0 + t2 * (1.5 + t * (-4 + 2.5 * t)) * s1
+             + t2 * (-12 + t * (28 - 15 * t)) * d1)
+    curvature = (t * (-60 + t * (180 - 120 * t)) * (y0 - y1) + t * (-36 + t * (96 - 60 * t)) * d0
+                 + (1 + t * (-9 + t * (18 - 10 * t))) * s0 + t * (3 + t * (-12 + 10 * t)) * s1
+                 + t * (-24 + t * (84 - 60 * t)) * d1)
+    return value, slope, curvature

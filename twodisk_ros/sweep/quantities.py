@@ -2,9 +2,11 @@
 
 Every body of the sweep has a = 1 and is named by its ratios (b/a, Δ/a); lengths are in units
 of a, times in units of √(a/g), angular speeds in units of √(g/a) (a = 1 m, g = 1 m/s²,
-M = 1 kg in the library calls). Each quantity is one call of the physics library
-(:mod:`twodisk_ros.physics`), so a sweep point agrees bitwise with the same call made directly
-(docs/sweeps.md lists the variables and their definitions).
+M = 1 kg in the library calls). In :func:`body_quantities` each quantity is one call of the
+physics library (:mod:`twodisk_ros.physics`): the scalar reference path, which agrees bitwise
+with the same call made directly (docs/sweeps.md lists the variables and their definitions).
+A sweep's tasks (:func:`chunk_quantities`) compute the same quantities for a whole chunk at
+once as arrays (:mod:`~twodisk_ros.sweep.batch`), to ≤ 1e-10 relative of the scalar path.
 
 A body that cannot be built or whose computation fails is not an error of the sweep: its
 quantities from the failing stage on are NaN and ``failure`` says why, in one line.
@@ -212,8 +214,16 @@ def _equilibria_stage(state, values, mass_model, b, d):
 
 
 def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
-                     timings=None):
+                     timings=None, method='batch'):
     """:func:`body_quantities` over paired 1-D arrays of b/a and Δ/a (one task of a sweep).
+
+    Parameters
+    ----------
+    method : str
+        'batch' (default): all bodies at once as arrays (:mod:`~twodisk_ros.sweep.batch`,
+        ≤ 1e-10 relative from the scalar path, docs/sweeps.md); 'scalar':
+        :func:`body_quantities` body by body (the reference). ``timings`` gets the stages of
+        the chosen path (:data:`~twodisk_ros.sweep.batch.BATCH_STAGES` or :data:`STAGES`).
 
     Returns
     -------
@@ -221,6 +231,11 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
         name → float64 array for every name of :data:`VARIABLES`, and ``failure`` → list of
         str, all of the length of the inputs.
     """
+    if method == 'batch':
+        from .batch import batch_quantities     # batch builds on this module (its fallback)
+        return batch_quantities(b_values, delta_values, mass_model, reference_speed, timings)
+    if method != 'scalar':
+        raise ValueError(f"method must be 'batch' or 'scalar', got {method!r}")
     b_values = np.asarray(b_values, dtype=float).ravel()
     delta_values = np.asarray(delta_values, dtype=float).ravel()
     out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}

@@ -35,9 +35,11 @@ __all__ = ['SweepError', 'linspace_grid', 'grid_range', 'estimate', 'check_size'
            'BYTES_PER_BODY', 'BYTES_PER_BODY_ZARR', 'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE',
            'CORE_SECONDS_PER_BODY', 'STORE_MANIFEST', 'STORE_STATE']
 
-#: Bodies per task of a NetCDF sweep (the default of the library too): ~1 s of work on one
-#: core (benchmarks/sweep_rate.py), so the scheduler's ~1 ms per task stays below 1 %.
-DEFAULT_CHUNK_SIZE = 16
+#: Bodies per task of a NetCDF sweep (the default of the library too): ~0.4 s of work on one
+#: core with the batched path (~3 ms a body, benchmarks/sweep_rate.py), so the scheduler's
+#: ~1 ms per task stays below 1 % (16-body tasks spent ~5 % on it: 100 x 100 in 16.8 s, not
+#: 13.6 s).
+DEFAULT_CHUNK_SIZE = 128
 #: Bodies per task of a Zarr sweep: one chunk of every variable, 17 files of a few kB; far
 #: fewer files, tasks and client reads (~0.3 ms per chunk) than 16-body chunks on the large
 #: maps Zarr is for (docs/sweeps.md "Scaling"; benchmarks/sweep_scaling.py).
@@ -49,7 +51,7 @@ MIN_CHUNKS = 16
 FORMATS = {'.nc': 'netcdf', '.zarr': 'zarr'}
 #: Attributes of a sweep's Zarr store: the manifest (JSON) and 'complete' / 'incomplete'.
 STORE_MANIFEST, STORE_STATE = 'sweep_manifest', 'sweep_state'
-#: At most this many bodies in one sweep (~220 core-hours at CORE_SECONDS_PER_BODY).
+#: At most this many bodies in one sweep (~10 core-hours at CORE_SECONDS_PER_BODY).
 MAX_BODIES = 10_000_000
 #: Client memory per body (B): result arrays, Dataset, NetCDF encoding (see the docstring).
 BYTES_PER_BODY = 2048
@@ -59,8 +61,9 @@ BYTES_PER_BODY_ZARR = 64
 BYTES_PER_TASK = 20 * 1024
 #: Memory per grid value of the resume cache's manifest (float.hex strings) (B).
 BYTES_PER_AXIS_VALUE = 256
-#: Work per body in a Dask worker (core-seconds; docs/sweeps.md "Cost").
-CORE_SECONDS_PER_BODY = 0.08
+#: Work per body in a Dask worker (core-seconds; docs/sweeps.md "Cost"): the batched path
+#: measured ~3 ms on the benchmark's map; thin bodies need finer tables, hence the margin.
+CORE_SECONDS_PER_BODY = 0.004
 
 
 class SweepError(Exception):

@@ -13,12 +13,13 @@ Dask task on a worker. Where the results go depends on the output's suffix:
   numbers; the client carries no data. The store's completion flags are the resume state.
   Workers and client must share the file system.
 
-The default chunk holds 16 bodies for NetCDF, ~0.5-1 s of work on one core, and 1024 for Zarr
+The default chunk holds 128 bodies for NetCDF, ~0.4 s of work on one core with the batched
+path (:mod:`~twodisk_ros.sweep.batch`), and 1024 for Zarr
 (far fewer tasks, files and reads on large maps), against ~1 ms of scheduler CPU and a few ms
 of client CPU per task (benchmarks/sweep_scaling.py; docs/sweeps.md "Scaling"). Every
 worker gets the plugin :class:`~twodisk_ros.sweep.worker.SweepWorkerSetup` first, which
-undoes the allocator setting of Dask's nanny that made a body 1.7× as costly on a worker as
-in a plain process.
+undoes the allocator setting of Dask's nanny that made a body 1.7× (per-body path) to 2.6×
+(batched path, larger arrays) as costly on a worker as in a plain process.
 
 Clusters (:func:`dask_client`): by default a ``LocalCluster`` of worker processes on every
 core, listening on 127.0.0.1 only, without dashboard; or any running scheduler given by its

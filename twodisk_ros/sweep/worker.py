@@ -6,7 +6,8 @@ OS at once). In glibc, setting that variable also switches off the dynamic mmap 
 every numpy array above 128 KiB is a fresh ``mmap``/``munmap`` with its pages faulted in
 again, and the heap is trimmed whenever 64 KiB lie free at its top. A sweep body allocates
 many short-lived arrays of that size (cycle and contact-force tables), so inside a worker it
-cost 1.7× the CPU time of the same body in a plain process (benchmarks/sweep_rate.py; numbers
+cost 1.7× the CPU time of the same body in a plain process, and a batched block 2.6×
+(benchmarks/sweep_rate.py; numbers
 in docs/sweeps.md). BLAS threads are not the cause: the nanny already sets
 ``OPENBLAS_NUM_THREADS=OMP_NUM_THREADS=1``.
 
