@@ -25,7 +25,8 @@ tf2_msgs = pytest.importorskip('tf2_msgs.msg')
 from geometry_msgs.msg import (Quaternion, Transform, TransformStamped,  # noqa: E402
                                Vector3)
 from builtin_interfaces.msg import Time  # noqa: E402
-from rclpy.qos import QoSProfile  # noqa: E402
+from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: E402
+from rclpy.serialization import deserialize_message  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
 from test_inspect import OLOID, run_main, simulate_run, write_run  # noqa: E402
@@ -49,12 +50,25 @@ def _class(type_name):
     return getattr(importlib.import_module(f'{package}.msg'), name)
 
 
+def _static(body_frame, stamp):
+    """The node's /tf_static at ``stamp`` (ns): the disk frames, parent ``body_frame``."""
+    sec, nanosec = divmod(int(stamp), 10**9)
+    return TFMessage(transforms=[TransformStamped(
+        header=Header(stamp=Time(sec=sec, nanosec=nanosec), frame_id=body_frame),
+        child_frame_id=f'{body_frame}{suffix}', transform=Transform(
+            translation=Vector3(x=sign * 0.5), rotation=Quaternion(w=1.0)))
+        for suffix, sign in (('_disk_a', -1.0), ('_disk_b', 1.0))])
+
+
 def with_tf(old, path, *, params=PARAMS, edit=None, drop=(), parent='world',
-            child='twodisk_body', encoder=False):
+            child='twodisk_body', encoder=False, frames=None, statics=None):
     """``old`` rewritten with a /tf message after each pose, the pose's numbers in it.
 
     ``edit(i, values)`` may change the 7 values (x, y, z, qx, qy, qz, qw) of sample i;
-    samples in ``drop`` get no transform.
+    samples in ``drop`` get no transform. ``frames(i)`` gives (the pose's frame_id, the /tf
+    parent, the /tf child) of sample i instead of ('world', ``parent``, ``child``);
+    ``statics`` maps sample indices to the body frame of a /tf_static message written, as
+    the node writes it, at that sample's stamp before its messages.
     """
     raw = read_recording(old, decode=lambda topic: False)
     poses = [m.msg for m in read_recording(old).messages if m.topic.endswith('/pose')]
@@ -64,12 +78,25 @@ def with_tf(old, path, *, params=PARAMS, edit=None, drop=(), parent='world',
         for name, info in raw.topics.items():
             rec.add_topic(name, _class(info.type_name))
         rec.add_topic('/tf', TFMessage, QoSProfile(depth=100))
+        if statics:
+            rec.add_topic('/tf_static', TFMessage, QoSProfile(
+                depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL))
         i = 0
         for message in raw.messages:
-            rec.write_serialized(message.topic, message.msg, message.log_time_ns)
             if not message.topic.endswith('/pose'):
+                rec.write_serialized(message.topic, message.msg, message.log_time_ns)
                 continue
             pose = poses[i]
+            if statics and i in statics:
+                rec.write('/tf_static', _static(statics[i], message.log_time_ns),
+                          message.log_time_ns)
+            if frames is None:
+                rec.write_serialized(message.topic, message.msg, message.log_time_ns)
+            else:
+                msg = deserialize_message(message.msg, _class(raw.topics[message.topic]
+                                                               .type_name))
+                msg.header.frame_id, parent, child = frames(i)
+                rec.write(message.topic, msg, message.log_time_ns)
             p, q = pose.pose.position, pose.pose.orientation
             values = [p.x, p.y, p.z, q.x, q.y, q.z, q.w]
             if edit is not None:
@@ -180,3 +207,44 @@ def test_cut_recording_with_tf_is_incomplete_not_fail(tmp_path, old_file):
         assert inspection.verdict == 'INCOMPLETE', [c for c in inspection.checks
                                                     if not c.passed]
         assert checks['tf'].passed
+
+
+# -- frame_id and body_frame changed at run time (the node accepts both) ---------------------
+CHANGE = 150     # the first sample after the change: /tf_static is sent again at its stamp
+RENAMED = dict(PARAMS, frame_id='odom', body_frame='oloid')   # the metadata: the last values
+
+
+def _renamed(i):
+    return ('world', 'world', 'twodisk_body') if i < CHANGE else ('odom', 'odom', 'oloid')
+
+
+def test_frames_changed_at_run_time_pass(capsys, tmp_path, old_file):
+    """The parent is each pose's own frame_id, the child the body frame of the latest
+    /tf_static: a rename of both at sample 150 PASSes (the metadata only holds the last)."""
+    path = with_tf(old_file, tmp_path / 'renamed.mcap', params=RENAMED, frames=_renamed,
+                   statics={0: 'twodisk_body', CHANGE: 'oloid'})
+    inspection, checks = verdict(path)
+    assert inspection.verdict == 'PASS', [c for c in inspection.checks if not c.passed]
+    summary = inspection.summary['tf']
+    assert checks['tf'].value == 0 and summary['transforms'] == 301
+    assert (summary['parents'], summary['children']) == (['world', 'odom'],
+                                                         ['twodisk_body', 'oloid'])
+    assert (summary['parent'], summary['child']) == ('odom', 'oloid')
+    status, out, _ = run_main(capsys, path)
+    assert status == 0 and 'world then odom → twodisk_body then oloid' in out
+
+
+@pytest.mark.parametrize('fault, frames, counted', [
+    ('/tf keeps the old child', lambda i: _renamed(i)[:2] + ('twodisk_body',), 'missing'),
+    ('/tf keeps the old parent', lambda i: _renamed(i)[:1] + ('world',) + _renamed(i)[2:],
+     'wrong_parent'),
+])
+def test_old_frame_after_the_change_fails(tmp_path, old_file, fault, frames, counted):
+    path = with_tf(old_file, tmp_path / 'stale.mcap', params=RENAMED, frames=frames,
+                   statics={0: 'twodisk_body', CHANGE: 'oloid'})
+    inspection, checks = verdict(path)
+    assert inspection.verdict == 'FAIL', fault
+    assert [c.name for c in inspection.checks if not c.passed] == ['tf'], fault
+    # every sample from the change on (301 - 150), and only those
+    assert inspection.summary['tf'][counted] == checks['tf'].value == 301 - CHANGE, fault
+    assert f't = {CHANGE / 100:.9g} s' in ' '.join(checks['tf'].detail), checks['tf'].detail

@@ -222,8 +222,13 @@ def assert_urdf(text, body_frame, static=None, mass=1.0):
     links = {link.name: link for link in robot.links}
     assert set(links) == {body_frame, body_frame + '_disk_a', body_frame + '_disk_b'}
     assert links[body_frame].inertial.mass == mass
-    meshes = [visual.geometry.mesh.filename for visual in links[body_frame].visuals]
-    assert meshes and all(Path(unquote(urlparse(uri).path)).is_file() for uri in meshes)
+    meshes = [Path(unquote(urlparse(visual.geometry.mesh.filename).path))
+              for visual in links[body_frame].visuals]
+    assert meshes and all(path.is_file() for path in meshes)
+    # in the suite's temporary cache (conftest), never the user's ~/.cache
+    cache = Path(os.environ['XDG_CACHE_HOME']).resolve()
+    assert all(path.resolve().is_relative_to(cache) for path in meshes), meshes
+    assert not cache.is_relative_to(Path.home().resolve() / '.cache')
     joints = {j.child: j for j in robot.joints}
     for suffix in ('_disk_a', '_disk_b'):
         joint = joints[body_frame + suffix]

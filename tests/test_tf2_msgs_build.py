@@ -4,13 +4,14 @@
 references (the type hash that rosbags' Jazzy type store computes from its own definitions,
 the CDR bytes of rosbags' serialiser), and the build's set-up behaviour on a temporary prefix:
 a second run does nothing, a missing compiler is one line and leaves the prefix untouched, an
-install that fails half-way leaves no tf2_msgs file behind. ROS domain 30, localhost.
+install that fails half-way leaves no tf2_msgs file behind. ROS domain 30 (given to
+``rclpy.init``, not set in ``os.environ``: that would leak into the worker's later modules),
+localhost.
 """
 
 import os
 
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-os.environ['ROS_DOMAIN_ID'] = '30'
 
 import importlib.util  # noqa: E402
 import json  # noqa: E402
@@ -26,6 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 SCRIPT = REPO / 'tools' / 'build_interfaces.py'
 PACKAGE_DIR = REPO / 'interfaces' / 'tf2_msgs'
 VENV_BIN = Path(sys.executable).parent
+DOMAIN = 30
 TYPE = 'tf2_msgs/msg/TFMessage'
 #: the hash of Jazzy's own tf2_msgs/msg/TFMessage, as the ROS 2 Jazzy type support reports it
 #: (ros2 topic info -v on a Jazzy /tf); rosbags computes it from its own definitions below
@@ -83,7 +85,7 @@ def test_type_hash_equals_jazzys():
     import rclpy
     from tf2_msgs.msg import TFMessage
     context = rclpy.Context()
-    rclpy.init(context=context)
+    rclpy.init(context=context, domain_id=DOMAIN)
     try:
         node = rclpy.create_node('tf2_msgs_hash', context=context)
         node.create_publisher(TFMessage, '/tf_hash_check', 1)
@@ -337,3 +339,15 @@ def test_bad_argument_exits_2(tmp_path):
     assert result.returncode == 2 and '--jobs' in result.stderr
     assert len(result.stderr.splitlines()) == 1 and result.stdout == ''
     assert list(tmp_path.iterdir()) == []
+
+
+def test_importing_the_module_leaves_ros_domain_id_alone():
+    """Module-level settings stay in the module: the worker's later modules keep their own."""
+    code = ('import os, sys; os.environ.pop("ROS_DOMAIN_ID", None); '
+            f'sys.path.insert(0, {str(REPO / "tests")!r}); import test_tf2_msgs_build; '
+            'print(os.environ.get("ROS_DOMAIN_ID"))')
+    done = subprocess.run([sys.executable, '-c', code], cwd=REPO, capture_output=True,
+                          text=True, timeout=120, stdin=subprocess.DEVNULL,
+                          env=dict(os.environ, PYTHONPATH=str(REPO)))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == 'None'

@@ -27,7 +27,7 @@ from .model import build_model
 from .results import Check, Inspection, json_ready
 from .series import (METADATA_NAME, TOPIC_TYPES, WRENCHES, extract_series, join_samples,
                      select_topics, topic_role)
-from .tf_check import is_tf_topic, tf_check
+from .tf_check import reads_topic, tf_check
 
 __all__ = ['inspect_recording']
 
@@ -123,7 +123,7 @@ def inspect_recording(path):
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
     """
     recording = read_recording(
-        path, decode=lambda topic: topic_role(topic) in _DECODED or is_tf_topic(topic))
+        path, decode=lambda topic: topic_role(topic) in _DECODED or reads_topic(topic))
     if recording.empty:
         raise RecordingError(f'cannot read recording {recording.path}: '
                              f'{_nothing_recovered(recording)}')

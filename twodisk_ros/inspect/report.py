@@ -139,7 +139,9 @@ def _tf_lines(info):
         return ['tf: not recorded, check not applicable (a recording made before /tf)']
     if 'transforms' not in info:
         return [f'tf: recorded on {info["topic"]} (not evaluated, see the checks)']
-    return [f'tf: {info["transforms"]} transforms {info["parent"]} → {info["child"]} on '
+    parents = ' then '.join(info.get('parents') or [info['parent']])
+    children = ' then '.join(info.get('children') or [info['child']])
+    return [f'tf: {info["transforms"]} transforms {parents} → {children} on '
             f'{info["topic"]}, {info["pose_stamps"]} pose stamps']
 
 
