@@ -136,6 +136,18 @@ def test_near_the_neutral_line_the_period_is_the_papers():
                       PAPER_RTOL), margins[k]
 
 
+def test_near_the_neutral_line_the_scalar_period_is_the_papers_too():
+    # the per-body path (equilibria(): V″(u*) = V″_θ (dθ/du)² at θ = 0, ±π/2) is exact there
+    # too; its spectral derivative of dz_G/du was 2e-5 off at |b² − 2a² + 2Δ²| = 1e-6 a²
+    d = 0.3
+    for margin in (1e-4, 1e-6, -1e-6, -1e-4):
+        b = math.sqrt(2.0 - 2.0 * d * d + margin)
+        values, failure = body_quantities(b, d)
+        assert failure == ''
+        assert _agree(values['oscillation_period'], _paper_period(b, d, 'laminae'),
+                      PAPER_RTOL), margin
+
+
 def test_results_do_not_depend_on_the_batch():
     # a body's bits are the same alone, in any chunk, and through chunk_quantities
     b = np.array([0.5, 1.0, 1.5, 2.5, 0.3, 1.2])

@@ -43,6 +43,10 @@ class Equilibrium:
 def _height_phase_curvatures(body, phases):
     """d²z_G/du² at the given phases: spectral derivative of the complex-step dz_G/du.
 
+    Used at the turning points; at θ = 0, ±π/2 :func:`equilibria` takes the exact
+    (d²z_G/dθ²)(dθ/du)² instead, since within ~1e-3 a² of the neutral line the rounding noise
+    of the samples dominates the spectrum (1e-9 relative at 1e-4 a², 1e-4 at 1e-8 a²).
+
     z_G is smooth and 2π-periodic in u; the grid is doubled until the upper half of the
     spectrum of dz_G/du is below 1e-13 of its peak (or dz_G/du vanishes: the neutral case).
     """
@@ -114,10 +118,11 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE):
             coordinate = 'psi'
             curvature = phase_curv / _psi_rate(body, u) ** 2
             branch = 1 if u < math.pi else -1
-        else:
+        else:   # dz_G/dθ = 0: d²z_G/du² = (d²z_G/dθ²)(dθ/du)², exact also near neutral
             coordinate = 'theta'
             theta = float(geo.theta)
             curvature = float(body.height_second_derivative(theta))
+            phase_curv = curvature * float(body.phase_angles_with_rates(u)[2]) ** 2
         found.append(Equilibrium(
             name=f'{label} (branch {branch:+d})', phase=u, theta=float(geo.theta),
             psi=float(geo.psi), branch=branch, height=float(geo.height), coordinate=coordinate,
@@ -163,11 +168,11 @@ def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
     -----
     At the six equilibria θ = 0, ±π/2, where dz_G/dθ = 0, d²z_G/du² = (d²z_G/dθ²)(dθ/du)²
     with both factors by complex step of closed forms (the paper's V′ carries the factor
-    b² − 2a² + 2Δ²): exact to rounding, also near the neutral line. :func:`equilibria` takes
-    the spectral derivative of dz_G/du there too; both agree to ~1e-13 relative when
-    |b² − 2a² + 2Δ²| ≳ 1e-2 a², but within ~1e-3 a² of the neutral line the rounding noise of
-    the samples (~1e-16 a) dominates its spectrum and the spectral value loses digits
-    (1e-9 relative at 1e-4 a², 1e-4 at 1e-8 a²).
+    b² − 2a² + 2Δ²): exact to rounding, also near the neutral line. :func:`equilibria` takes the
+    same product; the spectral derivative of dz_G/du, which both use at the turning points,
+    would lose digits here within ~1e-3 a² of the neutral line (1e-9 relative at 1e-4 a²,
+    1e-4 at 1e-8 a²), where the rounding noise of the samples (~1e-16 a) dominates its
+    spectrum.
     """
     n = slope.shape[0]
     neutral = np.abs(bodies.stability_margin) <= neutral_tolerance * np.maximum(
