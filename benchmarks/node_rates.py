@@ -244,8 +244,11 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True):
             end = time.monotonic() + warmup
             while time.monotonic() < end or not arrivals:
                 executor.spin_once(timeout_sec=0.01)
-                if time.monotonic() > end + 30:
-                    raise RuntimeError('no pose received')
+                if process.poll() is not None:
+                    raise RuntimeError('the node exited before its first pose: ' + ' '.join(
+                        process.communicate()[1].decode(errors='replace').split()[-40:]))
+                if time.monotonic() > end + 60:
+                    raise RuntimeError(f'no pose received in {warmup + 60:g} s')
             first = len(arrivals)
             cpu0, wall0 = _cpu_seconds(process.pid), time.monotonic()
             end = time.monotonic() + seconds
