@@ -140,6 +140,12 @@ def _noop(x):
     return x
 
 
+# The workers cannot import this script (benchmarks/ is not on their path when run_all.py
+# imports it): its functions travel by value, as they do when it runs as __main__.
+import cloudpickle  # noqa: E402
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+
 def _warm_up():
     import twodisk_ros.sweep.store  # noqa: F401  (zarr, xarray, the physics: once per worker)
 
