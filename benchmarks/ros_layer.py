@@ -5,7 +5,8 @@
   measured side by side in one run (``node_rates.py``);
 - real time at 100 Hz, 1 kHz and 10 kHz (``node_rates.py``);
 - contact forces per second, and the cost of the solid mass model;
-- parameter sweeps on Dask (``sweep_rate.py``).
+- parameter sweeps on Dask (``sweep_rate.py``);
+- the set-up's extra seconds for building tf2_msgs/TFMessage (``setup_cost.py``).
 """
 
 import contextlib
@@ -16,6 +17,7 @@ import time
 import numpy as np
 
 from node_rates import batch_rate, realtime_rate
+import setup_cost
 from targets import poses_throughput
 
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
@@ -79,13 +81,16 @@ def measure(builds, quick=False, log=print):
     with contextlib.redirect_stdout(text):
         sweep_rate.main()
     out['sweep'] = text.getvalue()
+    log('   set-up: building tf2_msgs/TFMessage (benchmarks/setup_cost.py)')
+    out['setup'] = setup_cost.build_cost(repeats=1 if quick else 2)
+    log(f'   tf2_msgs build: {out["setup"]["wall"]:.1f} s')
     return out
 
 
 def as_dict(out):
     return {'poses': [asdict(p) for p in out['poses']], 'batch': out['batch'].as_dict(),
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
-            'solid': out['solid'], 'sweep': out['sweep']}
+            'solid': out['solid'], 'sweep': out['sweep'], 'setup': out['setup']}
 
 
 def _status(ok):
@@ -160,4 +165,5 @@ def report_lines(out):
       'split by quantity, bodies per second with 1 and 2 workers, the 100 × 100 map and the '
       'projection to 1000 × 1000 with the model it uses):\n')
     w('```\n' + out['sweep'].strip() + '\n```\n')
+    lines.extend(setup_cost.report_lines(out['setup']))
     return lines
