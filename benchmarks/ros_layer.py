@@ -9,6 +9,7 @@
 - contact forces per second, and the cost of the solid mass model;
 - parameter sweeps on Dask (``sweep_rate.py``);
 - the live view without ROS, ``twodisk-view``, at 100 Hz and 1 kHz (``view_rate.py``).
+- the set-up's extra seconds for building tf2_msgs/TFMessage (``setup_cost.py``).
 """
 
 import contextlib
@@ -19,6 +20,7 @@ import time
 import numpy as np
 
 from node_rates import batch_rate, batch_tf_cost, realtime_rate
+import setup_cost
 from targets import poses_throughput
 import view_rate
 
@@ -99,6 +101,9 @@ def measure(builds, quick=False, log=print):
     for r in out['view']:
         log(f'   twodisk-view {r.rate_hz:g} Hz: {r.per_second:.0f} transforms/s, lag p50 '
             f'{r.lag_p50_ms:.2f} ms, server CPU {r.server_cpu:.0%}, skipped {r.skipped}')
+    log('   set-up: building tf2_msgs/TFMessage (benchmarks/setup_cost.py)')
+    out['setup'] = setup_cost.build_cost(repeats=1 if quick else 2)
+    log(f'   tf2_msgs build: {out["setup"]["wall"]:.1f} s')
     return out
 
 
@@ -107,7 +112,7 @@ def as_dict(out):
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
             'tf_cost': {'batch': out['tf_cost']['batch'],
                         'realtime': [r.as_dict() for r in out['tf_cost']['realtime']]},
-            'solid': out['solid'], 'sweep': out['sweep'],
+            'solid': out['solid'], 'sweep': out['sweep'], 'setup': out['setup'],
             'view': [r.as_dict() for r in out['view']]}
 
 
@@ -209,4 +214,5 @@ def report_lines(out):
       'projection to 1000 × 1000 with the model it uses):\n')
     w('```\n' + out['sweep'].strip() + '\n```\n')
     lines.extend(view_rate.report_lines(out['view']))
+    lines.extend(setup_cost.report_lines(out['setup']))
     return lines

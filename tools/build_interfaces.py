@@ -155,11 +155,16 @@ def is_up_to_date(stamp, digest, prefix):
         and all((prefix / f).is_file() for f in files)
 
 
-def _run_logged(command, log, env, cwd):
+def _run_logged(name, command, log, env, cwd):
+    """Run one step with its output in the log, and its wall time (``# step NAME: S s``)."""
     log.write(f'\n$ {" ".join(map(str, command))}\n')
     log.flush()
-    return subprocess.run([str(c) for c in command], stdout=log, stderr=subprocess.STDOUT,
-                          stdin=subprocess.DEVNULL, env=env, cwd=cwd).returncode
+    start = time.monotonic()
+    status = subprocess.run([str(c) for c in command], stdout=log, stderr=subprocess.STDOUT,
+                            stdin=subprocess.DEVNULL, env=env, cwd=cwd).returncode
+    log.write(f'# step {name}: {time.monotonic() - start:.2f} s, exit status {status}\n')
+    log.flush()
+    return status
 
 
 def build_environment():
@@ -193,7 +198,7 @@ def build(package_dir, prefix, work, log, compilers, jobs):
     )
     for name, command in steps:
         step_env = dict(env, DESTDIR=str(stage)) if name == 'install' else env
-        status = _run_logged(command, log, step_env, work)
+        status = _run_logged(name, command, log, step_env, work)
         if status != 0:
             raise Failure(f'the {name} step failed (exit status {status})')
     staged = stage / prefix.relative_to(prefix.anchor)
@@ -212,7 +217,8 @@ def smoke_test(staged, log):
     env['LD_LIBRARY_PATH'] = os.pathsep.join(
         [str(staged / 'lib'), str(_tool_prefix() / 'lib')]
         + [p for p in os.environ.get('LD_LIBRARY_PATH', '').split(os.pathsep) if p])
-    status = _run_logged([sys.executable, '-c', SMOKE_TEST, purelib], log, env, staged)
+    status = _run_logged('smoke test', [sys.executable, '-c', SMOKE_TEST, purelib], log, env,
+                         staged)
     if status != 0:
         raise Failure('the built package does not import or serialise a TFMessage')
     for cache in [p for p in staged.rglob('__pycache__') if p.is_dir()]:
