@@ -51,8 +51,11 @@ CLUSTER = (64, 512)        # workers of the extrapolation
 MAP = (1000, 1000)         # the map of the extrapolation
 ONE_OFF_CHUNKS = (1000, 100)   # bodies per chunk of the MAP stores timed for the one-offs
 DASK = str(Path(sys.executable).with_name('dask'))
+# the repository and this folder: the scheduler and the workers unpickle this module's task
+# functions by reference when make bench (run_all.py) has imported it as ``sweep_scaling``
 ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(
-    [str(Path(__file__).resolve().parents[1]), os.environ.get('PYTHONPATH', '')]))
+    [str(Path(__file__).resolve().parents[1]), str(Path(__file__).resolve().parent),
+     os.environ.get('PYTHONPATH', '')]))
 ENV.pop('DASK_SCHEDULER_ADDRESS', None)
 
 
@@ -138,12 +141,6 @@ def dask_cluster(workers, folder):
 
 def _noop(x):
     return x
-
-
-# The workers cannot import this script (benchmarks/ is not on their path when run_all.py
-# imports it): its functions travel by value, as they do when it runs as __main__.
-import cloudpickle  # noqa: E402
-cloudpickle.register_pickle_by_value(sys.modules[__name__])
 
 
 def _warm_up():

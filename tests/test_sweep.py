@@ -16,6 +16,7 @@ import time
 import numpy as np
 import pytest
 
+from dask_helpers import free_port, stop
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.contact_forces import ContactForceModel
 from twodisk_ros.physics.contact_validity import liftoff_speed, mu_required_kinematic
@@ -215,25 +216,6 @@ def test_sweep_workers_reuse_freed_memory_like_a_plain_process(client, local):
     assert all(count < 50 * 512 / 4 for count in faults.values()), faults
 
 
-def _free_port():
-    import socket
-    with socket.socket() as s:
-        s.bind(('127.0.0.1', 0))
-        return s.getsockname()[1]
-
-
-def _stop(procs):
-    for proc in procs:
-        if proc.poll() is None:
-            proc.terminate()
-    for proc in procs:
-        try:
-            proc.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)   # the group this test started with the proc
-            proc.wait(timeout=5)
-
-
 def _listening_hosts(procs):
     """The addresses every started process (and its children) listens on."""
     import psutil
@@ -254,7 +236,7 @@ def _wait_for_workers(address, count, timeout=60):
 
 @pytest.mark.slow
 def test_distributed_cli_equals_local(local, tmp_path):
-    port = _free_port()
+    port = free_port()
     address = f'tcp://127.0.0.1:{port}'
     procs = []
     logs = []
@@ -294,7 +276,7 @@ def test_distributed_cli_equals_local(local, tmp_path):
         assert 'Traceback' not in result.stderr
         remote = read_netcdf(out)
     finally:
-        _stop(procs)
+        stop(procs)
         for log in logs:
             log.close()
     assert all(p.returncode is not None for p in procs)
@@ -374,7 +356,7 @@ def test_bad_input_one_line_exit_2(override, words, capsys, tmp_path):
 
 @pytest.mark.slow
 def test_unreachable_scheduler_exit_2_fast(tmp_path):
-    port = _free_port()   # nothing listens there
+    port = free_port()   # nothing listens there
     start = time.monotonic()
     result = subprocess.run(
         [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', '1', '1', '1',
