@@ -120,7 +120,8 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     phrase = (f'recovered {count} of 2 001 samples of the run ({share}), '
               f't = 0 … {(samples - 1) / RATE:.6g} s of 2 s')
     result = [line for line in out.splitlines() if line.startswith('result: ')]
-    assert len(result) == 1 and result[0].startswith('result: INCOMPLETE (all 13 checks '
+    # 14 checks: the node records /tf, so the tf check (/tf against the poses) is one of them
+    assert len(result) == 1 and result[0].startswith('result: INCOMPLETE (all 14 checks '
                                                      'passed on the recovered part'), result
     assert phrase in result[0] and 'the file is cut' in result[0]
     assert 'PASS (' not in out and 'FAIL' not in out
@@ -130,6 +131,7 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     assert status == 4
     assert document['verdict'] == 'INCOMPLETE' and document['exit_status'] == 4
     assert document['passed'] is False and document['checks_passed'] is True
+    assert len(document['checks']) == 14 and 'tf' in {c['name'] for c in document['checks']}
     run = document['summary']['run']
     assert run['recovered_samples'] == samples and run['expected_samples'] == EXPECTED
     assert run['share'] == samples / EXPECTED
