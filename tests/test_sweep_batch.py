@@ -34,10 +34,6 @@ EDGE_RTOL = {'liftoff_speed': 1e-8, 'mu_required': 1e-8}
 #: Oscillation period against the paper's V″ (T = 2π √(m(u*) / (V″_θ (dθ/du)²))): measured
 #: ≤ 2e-15 everywhere, also within 1e-8 a² of the neutral line.
 PAPER_RTOL = 1e-13
-#: |b² − 2a² + 2Δ²| (a = 1) above which the scalar path's period is compared at RTOL: nearer
-#: the neutral line its spectral V″ loses digits to rounding noise (1e-9 relative at 1e-4,
-#: 1e-4 at 1e-8; docs/sweeps.md), and at the extreme shapes it is off by up to 1.5e-10.
-SCALAR_PERIOD_MARGIN = 1e-2
 
 EDGES = [(0.01, 1e-3), (0.01, 1 - 1e-6), (100.0, 1e-3), (100.0, 1 - 1e-6)]
 #: The edges for the solid model: the scalar path costs 1-6 s per edge body, so two of them
@@ -93,8 +89,8 @@ def _check(result, b, d, mass_model, edge=False):
             if name == 'oscillation_period' and not failure and math.isfinite(want):
                 # claim: the batch's V″(u*) is exact to rounding (paper's closed form)
                 assert _agree(got, _paper_period(bk, dk, mass_model), PAPER_RTOL), where
-                if edge or abs(bk * bk - 2.0 + 2.0 * dk * dk) < SCALAR_PERIOD_MARGIN:
-                    continue
+                # and so is the per-body path's since equilibria() takes V″_θ (dθ/du)² too:
+                # compared at RTOL also on the neutral line and at the edges
             rtol = EDGE_RTOL.get(name, RTOL) if edge else RTOL
             assert _agree(got, want, rtol), (where, name, got, want)
 
