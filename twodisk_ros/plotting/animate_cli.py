@@ -27,6 +27,7 @@ import sys
 
 from ..limits import LimitError, check_memory, describe_bytes
 from ..outputs import OutputError, check_output, replacing
+from ..io.errors import one_line
 
 __all__ = ['main', 'estimate_memory', 'MAX_FRAMES', 'MAX_SIMULATED_SECONDS']
 
@@ -187,12 +188,8 @@ def _run_of(args):
     return library_run(settings, stop=stop, forces=args.forces)
 
 
-def _one_line(error):
-    return ' '.join(str(error).split())
-
-
 def _refuse(error):
-    print(f'{PROG}: {_one_line(error)}', file=sys.stderr)
+    print(f'{PROG}: {one_line(error)}', file=sys.stderr)
     return 2
 
 
@@ -221,7 +218,7 @@ def main(argv=None):
     except Exception as error:  # noqa: BLE001 - one line, not a traceback
         if os.environ.get('TWODISK_DEBUG'):
             raise
-        print(f'{PROG}: internal error: {type(error).__name__}: {_one_line(error)}',
+        print(f'{PROG}: internal error: {type(error).__name__}: {one_line(error)}',
               file=sys.stderr)
         return 1
     if args.forces and run.force_a is None:

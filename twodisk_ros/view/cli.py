@@ -21,6 +21,8 @@ import signal
 import sys
 import threading
 
+from ..io.errors import one_line
+
 __all__ = ['DEFAULT_PORT', 'EPILOG', 'MAX_RATE', 'MAX_SPEED', 'main']
 
 PROG = 'twodisk-view'
@@ -154,12 +156,8 @@ class _Signals:
             raise _Stopped()
 
 
-def _one_line(error):
-    return ' '.join(str(error).split())
-
-
 def _refuse(error):
-    print(f'{PROG}: {_one_line(error)}', file=sys.stderr)
+    print(f'{PROG}: {one_line(error)}', file=sys.stderr)
     return 2
 
 
@@ -226,7 +224,7 @@ def main(argv=None):
     except Exception as error:  # noqa: BLE001 - one line, not a traceback
         if os.environ.get('TWODISK_DEBUG'):
             raise
-        print(f'{PROG}: internal error: {type(error).__name__}: {_one_line(error)}',
+        print(f'{PROG}: internal error: {type(error).__name__}: {one_line(error)}',
               file=sys.stderr)
         return 1
 
