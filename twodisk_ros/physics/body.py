@@ -41,6 +41,8 @@ import math
 import numpy as np
 
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
+from .lamina import Ellipse
+from .rolling_body import RollingBody
 
 __all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
 
@@ -307,7 +309,7 @@ class TwoDiskForms:
         return dalpha[..., None] * n_re - frame_rate
 
 
-class TwoDiskBody(TwoDiskForms):
+class TwoDiskBody(TwoDiskForms, RollingBody):
     """Two identical elliptic disks in perpendicular planes, joined along their axis ``a``.
 
     Parameters
@@ -365,6 +367,19 @@ class TwoDiskBody(TwoDiskForms):
         return cls(radius, radius, radius / math.sqrt(2))
 
     # -- scalar properties -------------------------------------------------------------------
+    #: The ellipse body has the disk-swap symmetry; 'parallel' and 'swapped' are the same body.
+    arrangement = 'parallel'
+
+    @property
+    def lamina(self):
+        """The :class:`~twodisk_ros.physics.lamina.Ellipse` (a along e2, b along e1)."""
+        return Ellipse(self.a, self.b)
+
+    @property
+    def feature_width(self):
+        """min(1, b/a, a/b, 2√(Δ/a)): the width in u of the sharpest feature (module doc)."""
+        return min(1.0, self.b / self.a, self.a / self.b, 2 * math.sqrt(self.delta / self.a))
+
     @property
     def psi_max(self):
         """Largest |ψ| (rad); equal to θ_max (paper, after eq. (2))."""
