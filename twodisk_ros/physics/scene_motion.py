@@ -1,0 +1,345 @@
+"""Motion in a scene: the general integrator over the phase u (docs/physics.md#scenes).
+
+The configuration is still a function of u (rolling is exact on any plane), so every scene
+is the 1-DOF equation of motion (SI units, Q the generalised forces, J/rad):
+
+    m(u) ü + ½ m′(u) u̇² + V′(u) = Q_drive + Q_damping + Q_rolling,
+
+* V(u) = M g (h cos β − s sin β) on a slope (:mod:`~twodisk_ros.physics.scene_terms`);
+* torque drive: a moment τ ê about the axis AB, Q = τ (ω_u·ê) = τ |ω_u| (ω_u ∥ ê, ω_u·ê > 0);
+* damping, a moment −c ω: Q = −c |ω_u|² u̇;
+* rolling resistance, a moment μ_r N ρ about AB opposing the rotation (N = N_A + N_B, ρ the
+  distance of G from AB, so ρ |ω_u| = |dG/du| =: k): Q = −μ_r k N sgn(u̇). N depends on ü
+  (N = N_g + N_2 u̇² + N_ü ü), so ü solves a linear equation;
+* speed drive: the signed rolling speed Ω = |ω_u| u̇ follows the command by the first-order
+  lag Ω(t) = Ω_cmd + (Ω₀ − Ω_cmd) e^{−t/T}; then u̇ = Ω/|ω_u| and the drive supplies
+  Q_drive = m ü + ½ m′ u̇² + V′ − Q_damping − Q_rolling, i.e. the torque Q_drive/|ω_u| about AB
+  and the power Q_drive u̇.
+
+The state carries the dissipated work W (J, ≥ 0) and the drive's work W_d (J), so that
+E(t) + W(t) − W_d(t) = E₀ is the energy balance. DOP853 (scipy, dense output) integrates
+(u, u̇, W, W_d) (speed drive: (u, W, W_d)); rolling resistance switches sign with u̇, so each
+stretch between two stops (u̇ = 0) is integrated on its own, and at a stop the body stays at
+rest if |V′ − Q_drive| ≤ μ_r k N (it sticks: the time to rest is exact). Where the flat fast
+paths hold (:func:`scene_stream`) today's :class:`~twodisk_ros.physics.motion.MotionStream` is
+used unchanged.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .contact_validity import check_validity
+from .motion import MotionStream
+from .scene_terms import C2, CN, CU, DM, DW, K_G, KIM, KRE, M, SceneTerms, W
+
+__all__ = ['SceneStream', 'SceneSamples', 'scene_stream', 'simulate_scene', 'settle',
+           'first_failure']
+
+
+@dataclass
+class SceneSamples:
+    """A scene's motion at sample times (arrays over ``t``; SI units)."""
+
+    t: np.ndarray                   #: s
+    phase: np.ndarray               #: u (rad)
+    phase_rate: np.ndarray          #: u̇ (rad/s)
+    phase_acceleration: np.ndarray  #: ü (rad/s²)
+    energy: np.ndarray              #: E = T + V (J), V along gravity (0 at A's start height)
+    dissipated: np.ndarray          #: W (J): work done by damping and rolling resistance
+    drive_work: np.ndarray          #: W_d (J): work done by the drive
+    drive_torque: np.ndarray        #: τ about AB (N m) (0 without drive)
+    power: np.ndarray               #: drive power τ ê·ω (W)
+    rolling_speed: np.ndarray       #: Ω = |ω_u| u̇ (rad/s), signed
+
+    @property
+    def balance(self):
+        """E + W − W_d (J): constant (= E₀) along any motion."""
+        return self.energy + self.dissipated - self.drive_work
+
+
+class _Piece:
+    """One stretch [start, end] of the motion: dense output of the state, or rest."""
+
+    def __init__(self, start, end, sol=None, rest=None):
+        self.start, self.end, self.sol, self.rest = start, end, sol, rest
+
+    def __call__(self, t):
+        if self.sol is None:
+            return np.repeat(np.asarray(self.rest, dtype=float)[:, None], len(t), axis=1)
+        return self.sol(t)
+
+
+class SceneStream:
+    """Samples of a scene's motion at increasing times (DOP853, lazily in segments).
+
+    Parameters
+    ----------
+    terms : SceneTerms
+    u0, u_dot0 : float
+        Initial phase (rad) and phase rate (rad/s).
+    tolerance : float
+        rtol of DOP853 (atol = tolerance × the state's scale).
+    chunk, lookahead : float
+        As :class:`~twodisk_ros.physics.motion.MotionStream`: segments of at most ``chunk``
+        s, reaching ``lookahead`` s beyond the times asked.
+    """
+
+    def __init__(self, terms, u0, u_dot0, *, tolerance=1e-10, chunk=10.0, lookahead=0.5):
+        if not isinstance(terms, SceneTerms):
+            raise TypeError(f'terms must be a SceneTerms, got {type(terms).__name__}')
+        self.terms, self.scene, self.tolerance = terms, terms.scene, float(tolerance)
+        self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
+        u0, u_dot0 = float(u0), float(u_dot0)
+        self.speed_drive = self.scene.drive == 'speed'
+        self.initial_speed = u_dot0 * float(terms.rows(u0)[W])
+        self.initial_energy = float(terms.energy(u0, u_dot0))
+        self.rest_time = math.nan                   #: time the body stuck at rest (s)
+        self.nfev = 0
+        scale = terms.dynamics.energy_scale
+        state = [u0, 0.0, 0.0] if self.speed_drive else [u0, u_dot0, 0.0, 0.0]
+        self._atol = self.tolerance * np.array(
+            [1.0, scale, scale] if self.speed_drive else [1.0, max(abs(u_dot0), 1.0),
+                                                          scale, scale])
+        self._pieces = [_Piece(0.0, 0.0, rest=state)]
+        self._sigma = self._direction(u0, u_dot0)
+
+    @property
+    def solver(self):
+        """'DOP853' (or 'rest' once stuck)."""
+        return 'rest' if math.isfinite(self.rest_time) else 'DOP853'
+
+    # -- the equation of motion ---------------------------------------------------------------
+    def _terms(self, u, row):
+        t = self.terms
+        n_g = float(np.sum(t.quantities_from(u, row, 0.0, 0.0)[:2]))
+        return (float(row[M]), float(row[DM]), float(row[W]), float(row[DW]),
+                float(t.potential_slope_from(u, row)), float(row[K_G]), n_g,
+                float(row[C2] + row[C2 + 1]), float(row[CU] + row[CU + 1]))
+
+    def speed(self, t):
+        """The speed drive's Ω(t) (rad/s), t from the stream's start (s)."""
+        cmd = self.scene.command
+        return cmd + (self.initial_speed - cmd) * np.exp(-np.asarray(t, dtype=float)
+                                                          / self.scene.lag)
+
+    def _free(self, u, u_dot, sigma):
+        """(ü, Q_drive, dW/dt) for the free or torque-driven equation."""
+        s = self.scene
+        m, dm, w, _, dv, k, n_g, n_2, n_u = self._terms(u, self.terms.rows(u))
+        q_drive = s.command * w if s.drive == 'torque' else 0.0
+        q_damp = -s.damping * w * w * u_dot
+        rr = s.rolling_resistance * sigma * k
+        u_ddot = (-0.5 * dm * u_dot**2 - dv + q_drive + q_damp - rr * (n_g + n_2 * u_dot**2)) \
+            / (m + rr * n_u)
+        q_roll = -rr * (n_g + n_2 * u_dot**2 + n_u * u_ddot)
+        return u_ddot, q_drive, -(q_damp + q_roll) * u_dot
+
+    def _driven(self, t, u):
+        """(u̇, ü, Q_drive, dW/dt) under the speed drive."""
+        s = self.scene
+        m, dm, w, dw, dv, k, n_g, n_2, n_u = self._terms(u, self.terms.rows(u))
+        omega = float(self.speed(t))
+        u_dot = omega / w
+        u_ddot = ((s.command - omega) / s.lag - dw * u_dot**2) / w
+        q_damp = -s.damping * w * w * u_dot
+        q_roll = -s.rolling_resistance * math.copysign(1.0, u_dot) * k * (
+            n_g + n_2 * u_dot**2 + n_u * u_ddot) if u_dot else 0.0
+        q_drive = m * u_ddot + 0.5 * dm * u_dot**2 + dv - q_damp - q_roll
+        return u_dot, u_ddot, q_drive, -(q_damp + q_roll) * u_dot
+
+    def _direction(self, u, u_dot):
+        """sgn(u̇), or at u̇ = 0 the way the body starts to move (0: it stays at rest)."""
+        if u_dot != 0 or self.speed_drive:
+            return math.copysign(1.0, u_dot)
+        s = self.scene
+        m, dm, w, _, dv, k, n_g, _, _ = self._terms(u, self.terms.rows(u))
+        push = (s.command * w if s.drive == 'torque' else 0.0) - dv
+        if s.rolling_resistance > 0 and abs(push) <= s.rolling_resistance * k * n_g:
+            return 0.0
+        return math.copysign(1.0, push) if push else 0.0
+
+    # -- integration ----------------------------------------------------------------------
+    def _advance(self, t0, t1, y0):
+        """Pieces covering [t0, t1] from state y0 (stops split them)."""
+        pieces = []
+        while t0 < t1:
+            if self._sigma == 0.0 and not self.speed_drive:
+                self.rest_time = t0 if math.isnan(self.rest_time) else self.rest_time
+                pieces.append(_Piece(t0, math.inf, rest=[y0[0], 0.0, y0[2], y0[3]]))
+                return pieces
+            if self.speed_drive:
+                def rhs(t, y):
+                    u_dot, _, q_drive, dw = self._driven(t, y[0])
+                    return [u_dot, dw, q_drive * u_dot]
+                events = None
+            else:
+                sigma = self._sigma
+
+                def rhs(t, y):
+                    u_ddot, q_drive, dw = self._free(y[0], y[1], sigma)
+                    return [y[1], u_ddot, dw, q_drive * y[1]]
+
+                def stop(t, y):
+                    return y[1]
+                stop.terminal, stop.direction = True, -sigma
+                events = [stop] if self.scene.rolling_resistance > 0 else None
+            result = solve_ivp(rhs, (t0, t1), y0, method='DOP853', rtol=self.tolerance,
+                               atol=self._atol, dense_output=True, events=events)
+            if not result.success:
+                raise RuntimeError(f'scene integration failed: {result.message}')
+            self.nfev += result.nfev
+            end = float(result.t[-1])
+            pieces.append(_Piece(t0, end, sol=result.sol))
+            y0 = [float(x) for x in result.y[:, -1]]
+            if result.status == 1:                  # stopped: u̇ = 0
+                y0[1] = 0.0
+                self._sigma = self._direction(y0[0], 0.0)
+            t0 = end
+        return pieces
+
+    def _states(self, t):
+        """The state at times t (s, increasing, not before earlier calls): array (ny, len)."""
+        t = np.asarray(t, dtype=float)
+        out = np.empty((3 if self.speed_drive else 4, t.size))
+        done = 0
+        while done < t.size:
+            last = self._pieces[-1]
+            for piece in self._pieces:
+                inside = (t[done:] >= piece.start) & (t[done:] <= piece.end)
+                count = int(np.sum(inside))
+                if count:
+                    out[:, done:done + count] = piece(t[done:done + count])
+                    done += count
+            if done == t.size:
+                break
+            end = last.end
+            y0 = [float(x) for x in last(np.array([end]))[:, 0]]
+            span = min(self._chunk, max(float(t[-1]) - end, self._lookahead))
+            self._pieces = self._advance(end, end + span, y0)
+        return out
+
+    def sample(self, t):
+        """(u, u̇) at times t (s, increasing, not before earlier calls)."""
+        s = self.samples(t)
+        return s.phase, s.phase_rate
+
+    def samples(self, t):
+        """:class:`SceneSamples` at times t (s, increasing, not before earlier calls)."""
+        t = np.asarray(t, dtype=float)
+        y = self._states(t)
+        u = y[0]
+        n = t.size
+        u_dot, u_ddot, q_drive = np.empty(n), np.empty(n), np.empty(n)
+        for i in range(n):
+            if self.speed_drive:
+                u_dot[i], u_ddot[i], q_drive[i], _ = self._driven(t[i], u[i])
+            else:
+                sigma = self._sigma_at(t[i], y[1, i])
+                u_dot[i] = y[1, i]
+                u_ddot[i], q_drive[i], _ = self._free(u[i], u_dot[i], sigma)
+                if sigma == 0.0:
+                    u_ddot[i] = 0.0
+        w = self.terms.rows(u)[..., W]
+        torque = q_drive / w
+        return SceneSamples(t=t, phase=u, phase_rate=u_dot, phase_acceleration=u_ddot,
+                            energy=self.terms.energy(u, u_dot), dissipated=y[-2],
+                            drive_work=y[-1], drive_torque=torque, power=q_drive * u_dot,
+                            rolling_speed=w * u_dot)
+
+    def _sigma_at(self, t, u_dot):
+        if math.isfinite(self.rest_time) and t >= self.rest_time:
+            return 0.0
+        if u_dot != 0:
+            return math.copysign(1.0, u_dot)
+        return self._sigma
+
+
+def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10, terms=None,
+                 chunk=10.0, lookahead=0.5):
+    """The motion of a scene from (u0 (rad), u̇0 (rad/s)): a MotionStream where it holds.
+
+    * flat, free, conservative (``Scene()``): today's dynamic MotionStream, bit for bit;
+    * speed drive whose command equals the initial speed (Ω₀ = |ω_u(u0)| u̇0, to 1e-12): the
+      motion is today's kinematic MotionStream on any slope and with any dissipation (u(t)
+      is then kinematic; only the drive torque depends on the scene);
+    * otherwise a :class:`SceneStream` (``terms`` reused if given).
+    """
+    kwargs = dict(method=method, tolerance=tolerance, chunk=chunk, lookahead=lookahead)
+    if scene.flat_free:
+        return MotionStream(dynamics, u0, u_dot0, mode='dynamic', **kwargs)
+    if scene.drive == 'speed':
+        omega0 = float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
+        if abs(omega0 - scene.command) <= 1e-12 * max(abs(omega0), abs(scene.command)) \
+                and omega0 != 0:
+            return MotionStream(dynamics, u0, u_dot0, mode='kinematic', **kwargs)
+    if terms is None:
+        terms = SceneTerms(dynamics, scene)
+    return SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=chunk,
+                       lookahead=lookahead)
+
+
+def simulate_scene(terms, t_eval, u0, u_dot0, *, tolerance=1e-10):
+    """:class:`SceneSamples` of the general integrator at times ``t_eval`` (s, increasing, ≥ 0)."""
+    t_eval = np.asarray(t_eval, dtype=float)
+    stream = SceneStream(terms, u0, u_dot0, tolerance=tolerance,
+                         chunk=max(float(t_eval[-1]), 1e-3))
+    return stream.samples(t_eval)
+
+
+def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolerance=1e-10):
+    """When a dissipative free body comes to rest: (time (s), u (rad), SceneEquilibrium).
+
+    At rest: stuck by rolling resistance (exact), or within ``rest_energy`` × M g L of the
+    bottom of the well it oscillates in (damping alone approaches it exponentially), the
+    first such time bracketed on a grid of ``step`` s and refined on a grid of step/1024.
+    (nan, nan, None) if not at rest by ``t_max`` s (e.g. it rolls down the slope).
+    """
+    stable = [eq for eq in terms.equilibria() if eq.stable]
+    stream = SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=10 * step)
+    threshold = rest_energy * terms.dynamics.energy_scale
+
+    def excess(samples):
+        """E − V(u*) for the equilibrium nearest each sample (J), and that equilibrium."""
+        best = np.full(samples.t.shape, math.inf), [None] * samples.t.size
+        for eq in stable:
+            centre = eq.phase + 2 * math.pi * np.round((samples.phase - eq.phase) / (2 * math.pi))
+            gap = samples.energy - terms.potential(centre)
+            closer = np.abs(samples.phase - centre) < math.pi / 4
+            for i in np.flatnonzero(closer & (gap < best[0])):
+                best[0][i], best[1][i] = gap[i], (eq, centre[i])
+        return best
+    t = 0.0
+    while t < t_max:
+        grid = np.linspace(t, t + step, 9)
+        samples = stream.samples(grid)
+        gap, which = excess(samples)
+        if math.isfinite(stream.rest_time) and stream.rest_time <= grid[-1]:
+            i = int(np.searchsorted(grid, stream.rest_time))
+            eq = which[min(i, grid.size - 1)]
+            return stream.rest_time, float(samples.phase[-1]), eq[0] if eq else None
+        below = np.flatnonzero(gap < threshold)
+        if below.size:
+            i = int(below[0])
+            if i == 0:
+                return float(grid[0]), float(samples.phase[0]), which[0][0]
+            fine = np.linspace(grid[i - 1], grid[i], 1025)
+            probe = SceneStream(terms, u0, u_dot0, tolerance=tolerance,
+                                chunk=10 * step).samples(np.concatenate([[0.0], fine]))
+            j = int(np.flatnonzero(excess(probe)[0][1:] < threshold)[0])
+            return float(fine[j]), float(probe.phase[j + 1]), which[i][0]
+        t = grid[-1]
+    return math.nan, math.nan, None
+
+
+def first_failure(terms, samples):
+    """Where the rolling model first fails along sampled motion: lift-off or slip.
+
+    Returns a :class:`~twodisk_ros.physics.contact_validity.ValidityReport`: the first
+    sample at which N_A < 0, N_B < 0 or μ_required > the scene's friction (the time
+    resolution is the sampling), forces with the tilted gravity.
+    """
+    forces = terms.forces(samples.phase, samples.phase_rate, samples.phase_acceleration)
+    return check_validity(samples.t, forces, terms.scene.friction)
