@@ -37,6 +37,7 @@ from .tables import HermiteTable
 __all__ = ['SceneTerms', 'SceneForces', 'SceneEquilibrium']
 
 # columns of the table
+# m, m′, |ω_u|, |ω_u|′, h, h′, p (Re, Im), k = |dG/du|
 M, DM, W, DW, H, DH, P, K_G = 0, 1, 2, 3, 4, 5, 6, 8
 CN, KRE, KIM, C2, CU, EDGE = 9, 15, 21, 27, 33, 39
 WIDTH = 41
@@ -133,7 +134,8 @@ class SceneTerms:
         edge = rot[:, 0] * (np.sum(e * t1, -1) + 1j * np.sum(e * m_axis, -1))
         columns = np.column_stack([
             m_u, spectral_derivative(m_u), speed, spectral_derivative(speed), height,
-            spectral_derivative(height), p.real, p.imag, np.abs(p), unit_force(normal),
+            spectral_derivative(height), p.real, p.imag, np.linalg.norm(c, axis=-1),
+            unit_force(normal),
             k.real, k.imag, general[:, 6:12], general[:, 12:18], edge.real, edge.imag])
         first = spectral_derivative(columns)
         self._table = HermiteTable.periodic(columns, first, spectral_derivative(first))
