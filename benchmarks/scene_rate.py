@@ -9,6 +9,7 @@ built beforehand and reported separately), best of ``REPEAT``.
 Run: ``python benchmarks/scene_rate.py``.
 """
 
+import argparse
 import math
 import time
 
@@ -60,4 +61,5 @@ def main():
 
 
 if __name__ == '__main__':
+    argparse.ArgumentParser(description=__doc__.split('\n')[0]).parse_args()
     main()
