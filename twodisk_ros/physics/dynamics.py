@@ -18,10 +18,10 @@ import math
 import numpy as np
 
 from .analytic import complex_step
-from .body import TwoDiskBody
 from .cycle import RollingCycle, TWO_PI
 from .equilibria import equilibria, NEUTRAL, STABLE
 from .mass_models import MassProperties
+from .rolling_body import check_rolling_body
 from .spectral import spectral_derivative
 from .tables import HermiteTable
 from .wells import LocalWell, TabulatedWell
@@ -36,7 +36,7 @@ class RollingDynamics:
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : RollingBody
     mass_properties : MassProperties
         Mass (kg) and inertia about G (kg m², body frame); the centre of mass must be G.
     gravity : float
@@ -46,8 +46,7 @@ class RollingDynamics:
     """
 
     def __init__(self, body, mass_properties, gravity=9.81, cycle=None):
-        if not isinstance(body, TwoDiskBody):
-            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
+        check_rolling_body(body)
         if not isinstance(mass_properties, MassProperties):
             raise TypeError('mass_properties must be a MassProperties')
         gravity = float(gravity)
@@ -59,8 +58,7 @@ class RollingDynamics:
         self.mass = mass_properties
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
-        self._feature_width = min(1.0, body.b / body.a, body.a / body.b,
-                                  2 * math.sqrt(body.delta / body.a))
+        self._feature_width = body.feature_width
         self._build_tables(4 * self.cycle.resolution)
         self._equilibria = None
         self._local_wells = {}
