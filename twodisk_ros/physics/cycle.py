@@ -21,8 +21,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
-from .body import TwoDiskBody
 from .orientation import contact_quaternion_samples
+from .rolling_body import check_rolling_body
 from .spectral import (TAIL_TOLERANCE, node_sum, refine_grid, spectral_antiderivative,
                        spectral_derivative, spectral_tail, spectral_tails)
 from .tables import HermiteTable
@@ -217,9 +217,7 @@ class RollingCycle:
     BLOCK = 16384
 
     def __init__(self, body, resolution=None, oversampling=4):
-        if not isinstance(body, TwoDiskBody):
-            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
-        self.body = body
+        self.body = check_rolling_body(body)
         if resolution is None:
             resolution, tail = self._refine(body)
         else:
