@@ -310,11 +310,17 @@ def general_hull_moments(lamina, delta, arrangement='parallel', rtol=1e-9):
     """
     arcs = _Arcs(lamina, delta, arrangement)
     n = N_START
-    coarse = arcs.integrals(n)
+    with np.errstate(all='ignore'):
+        coarse = arcs.integrals(n)
     previous = math.inf
     while True:
         n *= 2
-        fine = arcs.integrals(n)
+        with np.errstate(all='ignore'):
+            fine = arcs.integrals(n)
+        if not np.all(np.isfinite(fine)):
+            raise RuntimeError(f'solid hull quadrature failed for {lamina!r}, delta = {delta!r}: '
+                               'the pose where both rims are at their flat side vertices is '
+                               'not resolved in floating point (exponent too large)')
         error = relative_change(coarse, fine)
         if error <= rtol:
             second = np.empty((3, 3))
