@@ -91,6 +91,7 @@ class ContactGeometry:
     height: np.ndarray          #: z_G = n·(G − A) (m), G's height above the ground
     support_height: np.ndarray  #: h1(m) = h2(m) = max of m·P over the body, P from O (m)
     tilt: np.ndarray            #: angle between the plane of disk 1 and the ground (rad)
+    parameter_b: np.ndarray = None  #: B's lamina parameter on disk 2 (rad, in (−π, π])
 
 
 class GeneralTwoDiskBody:
@@ -202,7 +203,8 @@ class GeneralTwoDiskBody:
             parameter_a=np.asarray(s, dtype=float) + zero, elevation=tau,
             contact_a=a_body - self.centroid, contact_b=b_body - self.centroid,
             ground_normal=n, tangent_a=tangent, height=height1 - m @ self.centroid,
-            support_height=height1, tilt=np.arctan2(np.hypot(n[..., 0], n[..., 1]), n[..., 2]))
+            support_height=height1, tilt=np.arctan2(np.hypot(n[..., 0], n[..., 1]), n[..., 2]),
+            parameter_b=support2.parameter + zero)
 
     @staticmethod
     def _branch_array(branch, shape):
@@ -315,6 +317,49 @@ class GeneralTwoDiskBody:
         s = _bisect(residual, np.full_like(tau_abs, self.steepest[0]),
                     np.full_like(tau_abs, self.s_max))
         return self._pose(side * s, tau_abs, branch)
+
+    # -- the charts of the regular phase (lamina_phase.py) ------------------------------------
+    @property
+    def far_tip(self):
+        """Disk 2's lamina parameter (0 or π) of the tip B touches at the turning points."""
+        _, nu, _ = self._frame_a(np.asarray(self.s_max))
+        return 0.0 if self.sigma * float(nu[..., 1]) < 0 else math.pi
+
+    def elevation_of_parameter(self, s):
+        """|τ| (≥ 0) of the resting pose whose contact A has lamina parameter s (rad)."""
+        _, nu, big_l = self._frame_a(np.asarray(s, dtype=float))
+        return self._elevation(nu, big_l)
+
+    def geometry_at_parameter(self, s, tau_abs, branch=1):
+        """:class:`ContactGeometry` from A's lamina parameter s (rad, its sign is θ's) and
+        the elevation |τ| (from either chart), on a branch (±1)."""
+        s = np.asarray(s, dtype=float)
+        return self._pose(s, np.asarray(tau_abs, dtype=float),
+                          self._branch_array(branch, s.shape))
+
+    def chart_from_b(self, s_b):
+        """(s, |τ|): A's lamina parameter (≥ 0, the side θ ≥ 0) and the elevation of the
+        resting pose whose contact B on disk 2 has lamina parameter ``s_b`` (rad).
+
+        The mirror of :meth:`geometry` with the disks' roles swapped: the in-plane part of
+        the downward normal m is B's outward lamina normal ν_B, so m ∝ (μ, σν_By, ν_Bx) with
+        μ ≥ 0 the elevation out of disk 2's plane, the root of the convex equation
+        h(μ, σν_By) = 2Δσν_By + B·ν_B (bisection); A is disk 1's support point in direction
+        (μ, σν_By). Well conditioned where A is away from disk 1's far tip (μ > 0), i.e. near
+        the turning points, where :meth:`geometry`'s ψ(θ) is not.
+        """
+        lam, sigma = self.lamina, self.sigma
+        s_b = np.asarray(s_b, dtype=float)
+        point = lam.point(s_b)
+        nu = lam.normal(s_b)
+        c = sigma * nu[..., 1]
+        big_l = 2 * self.delta * c + np.sum(point * nu, axis=-1)
+        reach = max(-self.y_min, self.y_max)
+        hi = np.maximum((big_l + np.abs(c) * reach) / self.x_max, 0.0) * (1 + 1e-12) + 1e-300
+        mu = _bisect(lambda t: self._h2(t, c) - big_l, np.zeros_like(hi), hi)
+        mu = np.where(big_l <= self._h_axis(c), 0.0, mu)
+        s_a = lam.support(np.stack([mu, c], axis=-1)).parameter
+        return np.abs(s_a), np.abs(nu[..., 0]) / np.hypot(mu, c)
 
     # -- scale -------------------------------------------------------------------------------
     @property
