@@ -37,7 +37,7 @@ MAX_NODES = 1 << 14
 OVERSAMPLING = 8
 MIN_TABLE = 4096
 #: A body whose samples are not resolved to this at MAX_NODES is refused (one line).
-RESOLVED_TAIL = 1e-9
+RESOLVED_TAIL = 1e-4
 _NOISE_FLOOR = 1e-13
 _STALL = 0.5
 # column indices of the table: COLUMNS, then ds/du and dα/du
