@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 from numpy.testing import assert_allclose
-from scipy.optimize import minimize_scalar
+from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from twodisk_ros.physics.body import TwoDiskBody
@@ -356,6 +356,24 @@ def test_phase_landmarks(name):
     # away from the turning points the inverse is well conditioned: measured ≤ 4.6e-14 rad
     assert_allclose(body.phase_from_theta(theta, 1), u, rtol=0, atol=1e-12)
     assert_allclose(body.phase_from_theta(theta, -1), math.pi - u, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize('name', ['superellipse-4', 'superellipse-7.5'])
+def test_body_does_not_turn_where_contacts_cross_flat_vertices(name):
+    """Where a contact sits on a flat vertex its normal is stationary, so is the ground's:
+    ω_u = 0 at u = 0, π (A on disk 1's tip), ±π/2 (B on disk 2's far tip while A turns
+    back) and where A and B cross their side vertices together (t1·e1 = 0). An ellipse
+    turns everywhere. Measured: ≤ 5e-13 of |ω|max at the landmarks, ≤ 3e-11 at the side
+    vertices (located by root finding on t1·e1)."""
+    body = _body(name)
+    scale = np.linalg.norm(body.phase_angular_velocity(np.linspace(0, TWO_PI, 999)), axis=-1)
+    landmarks = np.arange(4) * math.pi / 2
+    assert np.all(np.linalg.norm(body.phase_angular_velocity(landmarks), axis=-1)
+                  < 1e-11 * scale.max())
+    side = brentq(lambda v: body.phase_vectors(v)[3][0], 0.05, math.pi / 2 - 0.05)
+    assert np.linalg.norm(body.phase_angular_velocity(side)) < 1e-9 * scale.max()
+    ellipse, _ = _ellipse_pair(ELLIPSES[0])
+    assert np.min(np.linalg.norm(ellipse.phase_angular_velocity(landmarks), axis=-1)) > 0.5
 
 
 # -- bad input and random shapes -------------------------------------------------------------
