@@ -40,7 +40,7 @@ turning points: there the tilt chart is the regular one.
 from dataclasses import dataclass
 import math
 import numpy as np
-from scipy.optimize import elementwise, minimize_scalar
+from scipy.optimize import minimize_scalar
 
 from .lamina import Lamina, check_length
 
@@ -52,6 +52,9 @@ ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
 #: would mean a family in several pieces, which is refused).
 _CHECK_NODES = 2049
 _MAX_BISECTIONS = 2200
+#: Newton steps of the convex elevation equation at most (5 to 8 needed; bisection steps of
+#: the guard, if any, are among them).
+_NEWTON_STEPS = 200
 
 
 def _bisect(func, lo, hi):
@@ -73,20 +76,6 @@ def _bisect(func, lo, hi):
         hi = np.where(above, mid, hi)
     take_hi = np.abs(func(hi)) < np.abs(func(lo))
     return np.where(take_hi, hi, lo)
-
-
-_ROOT_TOLERANCES = {'xatol': 1e-300, 'xrtol': 4 * np.finfo(float).eps, 'fatol': 0.0,
-                    'frtol': 0.0}
-
-
-def _root(func, lo, hi, *args):
-    """:func:`_bisect`'s root by scipy's elementwise Chandrupatla (superlinear, bracketing:
-    ~10 evaluations instead of ~60); ``args`` are arrays of lo's shape passed to func."""
-    lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
-    if lo.size == 0:
-        return lo.copy()
-    found = elementwise.find_root(func, (lo, hi), args=args, tolerances=_ROOT_TOLERANCES)
-    return np.where(np.isfinite(found.x), found.x, lo)
 
 
 @dataclass(frozen=True)
@@ -188,7 +177,7 @@ class GeneralTwoDiskBody:
     def _elevation(self, nu, big_l, fast=False):
         """|τ| ≥ 0 with h(|τ|, σν_y) = L (0 where L ≤ h(0, σν_y): the turning point).
 
-        By bisection, or with ``fast`` by :func:`_root` (the same root to the last bits).
+        By bisection, or with ``fast`` by :meth:`_convex_newton` (the same root).
         """
         return self._convex_root(self.sigma * nu[..., 1], big_l, fast)
 
@@ -202,11 +191,31 @@ class GeneralTwoDiskBody:
             tau = _bisect(lambda t: self._h2(t, c) - big_l, np.zeros_like(hi), hi)
             return np.where(inside, tau, 0.0)
         tau = np.zeros(np.shape(hi))
-        def residual(t, c, big_l):
-            with np.errstate(divide='ignore', invalid='ignore'):   # (0, 0) at t = 0, c = 0
-                return np.where(t > 0, self._h2(t, c), self._h_axis(c)) - big_l
-        tau[inside] = _root(residual, 0.0, hi[inside], c[inside], big_l[inside])
+        tau[inside] = self._convex_newton(c[inside], big_l[inside], hi[inside])
         return tau
+
+    def _convex_newton(self, c, big_l, hi):
+        """The root t > 0 of f(t) = h(t, c) − L, f(0) < 0 < f(hi), by Newton's method from hi
+        with f′(t) = x of the support point (h's gradient): monotone for a convex f, guarded
+        by the bracket (bisection where a step would leave it); stops when a step changes t
+        by less than 4 ulp, or stalls at the rounding of f (a step no shorter than half the
+        previous one, below 1e-8 t)."""
+        lo, x = np.zeros_like(hi), hi.copy()
+        previous = np.full_like(hi, np.inf)
+        for _ in range(_NEWTON_STEPS):
+            found = self.lamina.support(np.stack([x, c], axis=-1))
+            f = found.height - big_l
+            lo, hi = np.where(f <= 0, x, lo), np.where(f > 0, x, hi)
+            with np.errstate(divide='ignore', invalid='ignore'):
+                new = x - f / found.point[..., 0]
+            new = np.where((new >= lo) & (new <= hi), new, lo + 0.5 * (hi - lo))
+            step = np.abs(new - x)
+            done = (step <= 4 * np.finfo(float).eps * x) | ((step >= 0.5 * previous)
+                                                             & (step <= 1e-8 * x))
+            x, previous = new, step
+            if np.all(done):
+                break
+        return x
 
     # -- assembling a pose -------------------------------------------------------------------
     def _pose(self, s, tau_abs, branch):
