@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .analytic import COMPLEX_STEP
 from .body import PhaseGeometry
 from .general_body import ARRANGEMENTS, GeneralTwoDiskBody
 from .lamina_phase import COLUMNS, PhaseSolver, unfold
@@ -38,7 +39,9 @@ OVERSAMPLING = 8
 MIN_TABLE = 4096
 #: A body whose samples are not resolved to this at MAX_NODES is refused (one line).
 RESOLVED_TAIL = 1e-4
-_NOISE_FLOOR = 1e-13
+#: Stop doubling once the tail is below this and a doubling shrank it by less than half: the
+#: samples' rounding noise (a converging spectrum shrinks far faster; spectral.refine_grid).
+_NOISE_FLOOR = 1e-12
 _STALL = 0.5
 # column indices of the table: COLUMNS, then ds/du and dα/du
 _R1, _R2, _N, _T1 = (0, 1), (2, 3), (4, 5, 6), (7, 8)
@@ -171,9 +174,9 @@ class LaminaBody(RollingBody):
         (t1, n × t1, n), derivatives from the table."""
         u = np.asarray(u, dtype=float)
         f, df = self._values(u), self._table(np.mod(u, TWO_PI), 1)
-        _, _, n, t1, _ = self._vectors(f + 1j * 1e-30 * df)
+        _, _, n, t1, _ = self._vectors(f + 1j * COMPLEX_STEP * df)
         m = np.cross(n, t1)
-        frame = 0.5 * sum(np.cross(x.real, x.imag / 1e-30) for x in (n, t1, m))
+        frame = 0.5 * sum(np.cross(x.real, x.imag / COMPLEX_STEP) for x in (n, t1, m))
         return f[..., _DALPHA][..., None] * n.real - frame
 
     def phase_angles_with_rates(self, u):
