@@ -1,7 +1,8 @@
 """Two congruent laminae of any shape as a :class:`~twodisk_ros.physics.rolling_body.RollingBody`.
 
-docs/physics.md#the-phase-of-a-general-body. The resting poses are solved exactly (bisection
-on the support function, :mod:`~twodisk_ros.physics.general_body`) at N equispaced phases of
+docs/physics.md#the-phase-of-a-general-body. The resting poses are solved to rounding from
+the support function (:mod:`~twodisk_ros.physics.general_body`: guarded Newton on the convex
+elevation equations, a bracketing root finder on the phase ray) at N equispaced phases of
 the regular phase u (:mod:`~twodisk_ros.physics.lamina_phase`), N a power of two doubled
 until the spectral tail of every sampled function is below
 :data:`~twodisk_ros.physics.spectral.TAIL_TOLERANCE`. The samples are refined spectrally to
