@@ -22,7 +22,7 @@ from ..physics.dynamics import RollingDynamics
 from ..physics.motion import MotionStream
 from . import shape as shapes
 
-__all__ = ['RunDescription']
+__all__ = ['RunDescription', 'clear_caches']
 
 
 @lru_cache(maxsize=4)
@@ -40,6 +40,13 @@ def _general_mass(body, model, mass, moments):
                            'twodisk_ros.physics.mass_models.mass_properties_of, which this '
                            'installation lacks') from None
     return mass_properties_of(model, body, mass, moments)
+
+
+def clear_caches():
+    """Forget the cached bodies and mass models (and the laminae and their cycles' limits)."""
+    _lamina_body.cache_clear()
+    _general_mass.cache_clear()
+    shapes.clear_caches()
 
 
 class RunDescription:

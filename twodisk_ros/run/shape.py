@@ -32,9 +32,10 @@ from ..physics.general_body import GeneralTwoDiskBody
 from ..physics.lamina import Egg, Ellipse, Superellipse
 from ..physics.lamina_fit import Outline, read_outline
 
-__all__ = ['EGG_ASYMMETRY', 'MAX_SHAPE_FILE_BYTES', 'OUTLINE_KEYS', 'SHAPES', 'axes_of',
-           'describe_shape', 'lamina_of', 'outline_from_metadata', 'outline_metadata',
-           'read_shape_file', 'shape_key', 'theta_max_of']
+__all__ = ['ARRANGEMENT_NAMES', 'EGG_ASYMMETRY', 'MAX_SHAPE_FILE_BYTES', 'OUTLINE_KEYS',
+           'SHAPES', 'axes_of', 'clear_caches', 'describe_shape', 'lamina_of',
+           'outline_from_metadata', 'outline_metadata', 'read_shape_file', 'shape_key',
+           'theta_max_of']
 
 SHAPES = ('ellipse', 'superellipse', 'egg', 'points')
 ARRANGEMENT_NAMES = ('parallel', 'swapped')
@@ -161,6 +162,12 @@ def axes_of(lamina):
 @lru_cache(maxsize=32)
 def _general(lamina, delta, arrangement):
     return GeneralTwoDiskBody(lamina, delta, arrangement)
+
+
+def clear_caches():
+    """Forget the cached laminae (files are read again) and general bodies."""
+    _lamina.cache_clear()
+    _general.cache_clear()
 
 
 def theta_max_of(lamina, delta, arrangement):
