@@ -19,6 +19,7 @@ from functools import cached_property, lru_cache
 from ..node.parameters import parse_recorded
 from ..physics.body import TwoDiskBody
 from ..physics.dynamics import RollingDynamics
+from ..physics.mass_models import custom
 from ..physics.motion import MotionStream
 from . import shape as shapes
 
@@ -110,8 +111,9 @@ class RunDescription:
         s = self.settings
         if s.shape == 'ellipse':
             return s.mass_properties()
-        moments = tuple(s.principal_moments) if s.mass_model == 'custom' else None
-        return _general_mass(self.body, s.mass_model, s.mass, moments)
+        if s.mass_model == 'custom':      # the given moments about G, whatever the shape
+            return custom(s.mass, s.principal_moments)
+        return _general_mass(self.body, s.mass_model, s.mass, None)
 
     @cached_property
     def dynamics(self):
