@@ -53,6 +53,13 @@ def test_shape_parameters_are_in_the_contract_and_restart_the_motion():
     assert BY_NAME['shape'].choices == ('ellipse', 'superellipse', 'egg', 'points')
     assert DEFAULTS.shape == 'ellipse' and DEFAULTS.arrangement == 'parallel'
     assert DEFAULTS.with_values(shape='egg').physics_differs(DEFAULTS)
+    # what the shape does not read does not restart the motion
+    assert not DEFAULTS.with_values(exponent=6.0, shape_file='x.csv').physics_differs(DEFAULTS)
+    superellipse = DEFAULTS.with_values(shape='superellipse')
+    assert superellipse.with_values(exponent=6.0).physics_differs(superellipse)
+    points = DEFAULTS.with_values(shape='points', shape_file='x.csv')
+    assert not points.with_values(a=0.3, b=0.2, exponent=3.0).physics_differs(points)
+    assert points.with_values(delta=0.02).physics_differs(points)
 
 
 def test_the_default_ellipse_run_is_todays_bit_for_bit():

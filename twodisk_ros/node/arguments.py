@@ -18,7 +18,7 @@ given counts, as in rcl.
 import difflib
 import re
 
-from .parameters import BY_NAME, ROS_OWN
+from .parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
 from .usage import split_ros_args
 from .params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
 
@@ -155,10 +155,6 @@ def check_arguments(argv):
             raise ArgumentError(f'{where}: {problem}')
     return (warnings + _unknown_warnings([name for _, name, _ in given])
             + _unused_warnings({name: value.value for _, name, value in given}))
-
-
-#: Parameters that only one shape reads.
-SHAPE_ONLY = {'exponent': 'superellipse', 'egg_asymmetry': 'egg', 'shape_file': 'points'}
 
 
 def _unused_warnings(last):

@@ -22,7 +22,7 @@ from ..physics.mass_models import MODELS, custom, mass_properties
 from ..physics.motion import METHODS, MODES
 from ..run import shape as shapes
 
-__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings',
+__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
            'markdown_table', 'parse_recorded']
 
 B_OVER_A = (0.01, 100.0)             # allowed b/a
@@ -138,6 +138,8 @@ PARAMETERS = (
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
+#: Parameters that only one shape reads: {name: shape}.
+SHAPE_ONLY = {'exponent': 'superellipse', 'egg_asymmetry': 'egg', 'shape_file': 'points'}
 #: Names the node accepts that belong to rclpy itself (no warning for them).
 ROS_OWN = ('use_sim_time', 'start_type_description_service')
 
@@ -280,9 +282,17 @@ class _SettingsMethods:
                          else str(getattr(self, p.name))) for p in PARAMETERS}
 
     def physics_differs(self, other):
-        """True if a parameter that shapes the motion differs (the motion restarts)."""
+        """True if a parameter that shapes the motion differs (the motion restarts).
+
+        A parameter that only another shape reads (:data:`SHAPE_ONLY`: ``exponent`` of an
+        ellipse run) does not count; ``a`` and ``b`` of two ``points`` runs do not either.
+        """
+        unread = {name for name, shape in SHAPE_ONLY.items()
+                  if self.shape != shape and other.shape != shape}
+        if self.shape == other.shape == 'points':
+            unread |= {'a', 'b'}
         return any(getattr(self, p.name) != getattr(other, p.name)
-                   for p in PARAMETERS if p.physics)
+                   for p in PARAMETERS if p.physics and p.name not in unread)
 
 
 #: Settings of the node (SI units): a frozen dataclass with one field per parameter.
