@@ -80,7 +80,7 @@ def test_recording_gif_cli(recording, tmp_path):
     assert np.allclose(run.contact_a[:, 2], 0.0, atol=1e-12)
     out = tmp_path / 'rec.gif'
     result = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.plotting.animation', str(recording), '-o',
+        [sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', str(recording), '-o',
          str(out), '--stop', '0.9', '--fps', '5', '--size', '160x120', '--view', 'top'],
         cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
     assert result.returncode == 0, result.stderr
