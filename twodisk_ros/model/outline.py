@@ -121,10 +121,12 @@ class BodyShape:
 
 
 def general_body(body):
-    """``body`` itself if it is a GeneralTwoDiskBody, else the GeneralTwoDiskBody of its
-    lamina, Δ and arrangement (the exact contact geometry of any lamina)."""
-    if isinstance(body, GeneralTwoDiskBody):
-        return body
+    """``body`` itself if it is a GeneralTwoDiskBody, else the one it holds as ``general``
+    (LaminaBody), else the GeneralTwoDiskBody of its lamina, Δ and arrangement (the exact
+    contact geometry of any lamina)."""
+    for candidate in (body, getattr(body, 'general', None)):
+        if isinstance(candidate, GeneralTwoDiskBody):
+            return candidate
     return GeneralTwoDiskBody(body.lamina, body.delta, getattr(body, 'arrangement', 'parallel'))
 
 
