@@ -65,6 +65,19 @@ def test_outline_misses_the_support_function_by_at_most_its_tolerance(lamina, to
     assert np.array_equal(points[1:n // 2][::-1] * [-1, 1], points[n // 2 + 1:])
 
 
+def test_outline_of_a_fitted_outline():
+    # a lamina fitted from points (lamina_fit.Outline: a support-function lamina whose
+    # parameter is the normal angle) is drawn to the same guarantee
+    from twodisk_ros.physics.lamina_fit import Outline
+    given = Egg(1.0, 0.7, 0.05).point(np.linspace(0, 2 * np.pi, 200, endpoint=False))
+    lamina = Outline.from_points(given)
+    points = lamina_outline(lamina, 1e-4)
+    h = lamina.support(DIRECTIONS).height
+    reach = (DIRECTIONS @ points.T).max(axis=1)
+    assert np.max(reach - h) <= 1e-15 * lamina.size
+    assert 1e-5 * lamina.size <= np.max(h - reach) <= 1e-4 * lamina.size
+
+
 @pytest.mark.parametrize('lamina', [Superellipse(1.0, 1.0, 6), Superellipse(1.0, 0.5, 100),
                                     Superellipse(0.3, 0.8, 2.5)], ids=repr)
 def test_superellipse_outline_vertices_satisfy_its_equation(lamina):
