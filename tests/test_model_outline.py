@@ -33,7 +33,8 @@ LAMINAE = [Ellipse(1.0, 0.3), Ellipse(0.5, 0.5), Superellipse(1.0, 1.0, 6),
            Egg(0.2, 0.16, -0.012)]
 # (lamina, Δ, arrangement): symmetric and asymmetric laminae, both arrangements
 BODIES = [(Superellipse(1.0, 1.0, 6), 0.5, 'parallel'),
-          (Superellipse(1.0, 0.5, 100), 0.3, 'parallel'), (Egg(1.0, 0.8, 0.06), 0.4, 'parallel'), (Egg(1.0, 0.8, 0.06), 0.4, 'swapped'),
+          (Superellipse(1.0, 0.5, 100), 0.3, 'parallel'), (Egg(1.0, 0.8, 0.06), 0.4, 'parallel'),
+          (Egg(1.0, 0.8, 0.06), 0.4, 'swapped'),
           (Ellipse(1.0, 1.0), 0.5, 'parallel')]
 DIRECTIONS = np.stack([np.cos(np.linspace(0, 2 * np.pi, 20001)),
                        np.sin(np.linspace(0, 2 * np.pi, 20001))], axis=-1)

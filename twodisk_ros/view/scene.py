@@ -6,8 +6,9 @@ parameters: the world frame ``frame_id`` (Z up, the ground z = 0), the body fram
 ``{body_frame}_disk_a`` / ``_disk_b`` of :func:`twodisk_ros.model.frames.disk_frames`
 (centre of the disk, z normal to its plane, x along the common axis towards its far tip).
 Quaternions are (x, y, z, w), rotating child-frame components into parent-frame ones, as in
-ROS and in ``foxglove.FrameTransform``. Colours come from :mod:`twodisk_ros.plotting.palette` (plain
-hex strings, no matplotlib): disk 1 and A blue, disk 2 and B orange, AB green.
+ROS and in ``foxglove.FrameTransform``. Colours come from
+:mod:`twodisk_ros.plotting.palette` (plain hex strings, no matplotlib): disk 1 and A blue,
+disk 2 and B orange, AB green.
 """
 
 import math
