@@ -36,9 +36,10 @@ from twodisk_ros.physics.general_body import ARRANGEMENTS, GeneralTwoDiskBody
 __all__ = ['BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
            'frame_rims', 'general_body', 'lamina_outline', 'resolution_tolerance']
 
-#: Default polygon error of a drawn outline, as a fraction of the lamina's size (a circle
-#: needs 70 vertices for it).
-DEFAULT_TOLERANCE = 1e-3
+#: Default polygon error of a drawn outline, as a fraction of the lamina's size: below a
+#: pixel for a body 500 pixels wide; a circle gets 64 vertices (error 1.2e-3), as the
+#: markers had before.
+DEFAULT_TOLERANCE = 2e-3
 #: Chords of the first polygon on the half outline s ∈ [0, π].
 _FIRST_CHORDS = 8
 #: A split point closer than this share of its chord's parameter interval to an end is moved

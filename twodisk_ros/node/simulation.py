@@ -188,7 +188,7 @@ class Simulation:
 
     def disk_outlines(self, rotation, position_g):
         """World points (m) of both disk outlines for one pose: two closed arrays (N + 1, 3),
-        the real outline of the body's lamina to a polygon error of 1e-3 of its size
+        the real outline of the body's lamina to a polygon error of 2e-3 of its size
         (:func:`~twodisk_ros.model.outline.disk_rims`, sampled once per body)."""
         rims = self.__dict__.get('_outline_rims')
         if rims is None:
