@@ -140,7 +140,9 @@ def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickne
         ``'solid'`` gives the convex hull (:func:`hull_mesh`); ``'laminae'`` and ``'custom'``
         the two plates (:func:`laminae_mesh`).
     resolution : int
-        Multiple of 4, ≥ 8: rim vertices per plate, or phase steps per cycle for the hull.
+        Multiple of 4, ≥ 8: for ellipses, rim vertices per plate or phase steps per cycle
+        for the hull; for any other lamina the sampling whose error is that of a regular
+        n-gon (module docstring; the vertex count follows the shape).
     thickness : float, optional
         Plate thickness (m) for the plates; default ``DEFAULT_THICKNESS * body.size``.
         Ignored for the hull.
