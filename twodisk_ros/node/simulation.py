@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.outline import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
 from ..run.description import RunDescription
@@ -186,13 +187,14 @@ class Simulation:
             [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
-    def disk_outlines(self, rotation, position_g, points=64):
-        """World points (m) of both disk outlines for one pose: two arrays (points + 1, 3)."""
-        a, b, d = self.body.a, self.body.b, self.body.delta
-        s = np.linspace(0.0, 2 * np.pi, points + 1)
-        disk1 = np.stack([b * np.sin(s), -d - a * np.cos(s), 0 * s], -1)
-        disk2 = np.stack([0 * s, d + a * np.cos(s), b * np.sin(s)], -1)
-        return disk1 @ rotation.T + position_g, disk2 @ rotation.T + position_g
+    def disk_outlines(self, rotation, position_g):
+        """World points (m) of both disk outlines for one pose: two closed arrays (N + 1, 3),
+        the real outline of the body's lamina to a polygon error of 2e-3 of its size
+        (:func:`~twodisk_ros.model.outline.disk_rims`, sampled once per body)."""
+        rims = self.__dict__.get('_outline_rims')
+        if rims is None:
+            rims = self.__dict__['_outline_rims'] = disk_rims(self.body)
+        return tuple(rim @ rotation.T + position_g for rim in rims)
 
     def hull_rims(self, rotation, position_g, points=64):
         """World end points A, B of the hull's rulings over one cycle: two arrays (points + 1, 3).
