@@ -401,19 +401,22 @@ class GeneralTwoDiskBody:
         """Largest distance (m) of a disk point from G (relative errors are quoted to it)."""
         cached = self.__dict__.get('_size')
         if cached is None:
-            g = float(self.centroid[1])
-            best = 0.0
-            # disk 1: |(x, y − Δ − g)|; disk 2: |(x, σy + Δ − g)| = |(x, y + σ(Δ − g))|
-            for offset in (-self.delta - g, self.sigma * (self.delta - g)):
-                def dist(s, offset=offset):
-                    p = self.lamina.point(s)
-                    return np.hypot(p[..., 0], p[..., 1] + offset)
-                grid = np.linspace(0.0, np.pi, 2049)
-                values = dist(grid)
-                j = int(np.argmax(values))
-                found = minimize_scalar(lambda s: -float(dist(s)),
-                                        bounds=(grid[max(j - 1, 0)], grid[min(j + 1, 2048)]),
-                                        method='bounded', options={'xatol': 1e-12})
-                best = max(best, float(values[j]), -float(found.fun))
-            cached = self.__dict__['_size'] = best
+            cached = self.__dict__['_size'] = self.size_about(float(self.centroid[1]))
         return cached
+
+    def size_about(self, g):
+        """Largest distance (m) of a disk point from the point g e2 (g in m, from O)."""
+        best = 0.0
+        # disk 1: |(x, y − Δ − g)|; disk 2: |(x, σy + Δ − g)| = |(x, y + σ(Δ − g))|
+        for offset in (-self.delta - g, self.sigma * (self.delta - g)):
+            def dist(s, offset=offset):
+                p = self.lamina.point(s)
+                return np.hypot(p[..., 0], p[..., 1] + offset)
+            grid = np.linspace(0.0, np.pi, 2049)
+            values = dist(grid)
+            j = int(np.argmax(values))
+            found = minimize_scalar(lambda s: -float(dist(s)),
+                                    bounds=(grid[max(j - 1, 0)], grid[min(j + 1, 2048)]),
+                                    method='bounded', options={'xatol': 1e-12})
+            best = max(best, float(values[j]), -float(found.fun))
+        return best

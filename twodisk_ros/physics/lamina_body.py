@@ -14,8 +14,14 @@ f′ the interpolant's derivative, so callers' complex steps give the spectral d
 
 Frames as in body.py and general_body.py: body frame with origin G, the centroid of the two
 laminae (GeneralTwoDiskBody.centroid); r1 = GA, r2 = GB (m); n the upward ground normal.
+:meth:`LaminaBody.about` moves the origin (the reference point P) along e2, sharing the
+tables: then r1 = PA, r2 = PB and the height is P's, z_P = z_G + n·(P − G). That is how a
+solid whose centre of mass lies off G (an egg in the parallel arrangement) gets a body whose
+origin is its centre of mass, as RollingDynamics needs (mass_models.centred_on_mass).
 """
 
+import copy
+import dataclasses
 import math
 
 import numpy as np
@@ -23,12 +29,12 @@ import numpy as np
 from .analytic import COMPLEX_STEP
 from .body import PhaseGeometry
 from .general_body import ARRANGEMENTS, GeneralTwoDiskBody
-from .lamina_phase import COLUMNS, PhaseSolver, unfold
+from .lamina_phase import BRANCH_FLIP, COLUMNS, PhaseSolver, THETA_FLIP, unfold
 from .rolling_body import RollingBody
 from .spectral import TAIL_TOLERANCE, real_spectral_derivative, spectral_tails, upsample
 from .tables import HermiteTable
 
-__all__ = ['LaminaBody', 'MIN_NODES', 'MAX_NODES', 'OVERSAMPLING', 'RESOLVED_TAIL']
+__all__ = ['LaminaBody', 'MIN_NODES', 'MAX_NODES', 'OVERSAMPLING', 'RESOLVED_TAIL', 'symmetrise']
 
 TWO_PI = 2.0 * math.pi
 #: First and largest number of exactly solved phases per cycle (powers of two).
@@ -47,6 +53,28 @@ _STALL = 0.5
 # column indices of the table: COLUMNS, then ds/du and dα/du
 _R1, _R2, _N, _T1 = (0, 1), (2, 3), (4, 5, 6), (7, 8)
 _HEIGHT, _THETA, _PSI, _DS, _DALPHA = 9, 10, 11, 12, 13
+#: Parity of every column under u → −u (the mirror x1 → −x1) and u → π − u (x3 → −x3):
+#: ds/du = t1·dr1/du is odd about π/2 (A turns back there), dα/du even about both.
+_PARITY_ZERO = np.concatenate([THETA_FLIP, [1.0, 1.0]])
+_PARITY_HALF = np.concatenate([BRANCH_FLIP, [-1.0, 1.0]])
+
+
+def symmetrise(values, order):
+    """The k-th derivatives (k = ``order``) of the columns at u_j = 2πj/M (M a multiple of 4,
+    shape (M, 14)) made exactly symmetric under the body's two mirrors.
+
+    f(−u) = P f(u) gives f⁽ᵏ⁾(−u) = (−1)ᵏ P f⁽ᵏ⁾(u), and likewise about π/2: each mirror's
+    average of the node values and their images. The spectral derivatives of the (exactly
+    symmetric) samples break the symmetry only by rounding amplified by the wavenumbers
+    (~5e-15 m/rad in dz/du); averaged, an odd derivative is exactly 0 at the landmarks
+    u = 0, π/2, π, 3π/2, which are then exact critical points of z (at a flat vertex, where
+    z − z* ~ (u − u*)⁴, 5e-15 m/rad moved the root of dz/du by 2e-5 rad).
+    """
+    m = len(values)
+    j = np.arange(m)
+    sign = (-1.0) ** order
+    values = 0.5 * (values + sign * _PARITY_ZERO * values[(-j) % m])
+    return 0.5 * (values + sign * _PARITY_HALF * values[(m // 2 - j) % m])
 
 
 def _rates(samples):
@@ -87,11 +115,43 @@ class LaminaBody(RollingBody):
                              f'got {arrangement!r}')
         self.general = GeneralTwoDiskBody(lamina, delta, arrangement)
         self._solver = PhaseSolver(self.general)
+        self._offset = 0.0
         self._sample()
 
     def __repr__(self):
+        moved = f'.about({self._offset!r})' if self._offset else ''
         return (f'LaminaBody({self.lamina!r}, delta={self.delta!r}, '
-                f'arrangement={self.arrangement!r})')
+                f'arrangement={self.arrangement!r}){moved}')
+
+    def about(self, offset):
+        """The same body with its reference point (the body-frame origin) moved by offset e2.
+
+        Parameters
+        ----------
+        offset : float
+            Along e2 (m, body frame), from the current reference point; finite, |offset| <
+            size. ``about(0.0)`` is the body itself.
+
+        Returns
+        -------
+        LaminaBody
+            Sharing this body's tables and contact geometry: θ, ψ, n, t1, the phase, its
+            rates and ω_u are the same; r1, r2 and the height are those of the new point P
+            (r_i − offset e2, z + offset n·e2); ``offset`` is P's from G, ``origin`` P's from
+            O, ``size`` the largest distance of a disk point from P.
+        """
+        shift = float(offset) if isinstance(offset, (int, float, np.floating,
+                                                     np.integer)) else math.nan
+        if not (math.isfinite(shift) and abs(shift) < self.size) or isinstance(offset, bool):
+            raise ValueError(f'offset must be a finite number of metres with |offset| < size = '
+                             f'{self.size!r}, got {offset!r}')
+        if shift == 0.0:
+            return self
+        moved = copy.copy(self)              # shares the tables and the contact geometry
+        state = vars(moved)
+        state.pop('_size', None)
+        state['_offset'] = self._offset + shift
+        return moved
 
     # -- construction ------------------------------------------------------------------------
     def _sample(self):
@@ -122,7 +182,8 @@ class LaminaBody(RollingBody):
                                 for k in range(samples.shape[1])])
         first = real_spectral_derivative(fine)
         second = real_spectral_derivative(first)
-        self._table = HermiteTable.periodic(fine, first, second)
+        self._table = HermiteTable.periodic(*(symmetrise(f, k) for k, f in
+                                              enumerate((fine, first, second))))
 
     # -- table evaluation --------------------------------------------------------------------
     def _values(self, u):
@@ -139,11 +200,20 @@ class LaminaBody(RollingBody):
 
     def _vectors(self, f):
         zero = np.zeros_like(f[..., 0])
-        r1 = np.stack([f[..., 0], f[..., 1], zero], axis=-1)
-        r2 = np.stack([zero, f[..., 2], f[..., 3]], axis=-1)
+        g = self._offset
+        r1 = np.stack([f[..., 0], f[..., 1] - g, zero], axis=-1)
+        r2 = np.stack([zero, f[..., 2] - g, f[..., 3]], axis=-1)
         n = self._unit(f[..., 4:7])
         t1 = self._unit(np.stack([f[..., 7], f[..., 8], zero], axis=-1))
-        return r1, r2, n, t1, f[..., _HEIGHT]
+        return r1, r2, n, t1, self._height(f, n[..., 1])
+
+    def _height(self, f, n2=None):
+        """The reference point's height: z_G + offset n·e2 (m)."""
+        if not self._offset:
+            return f[..., _HEIGHT]
+        if n2 is None:
+            n2 = self._unit(f[..., 4:7])[..., 1]
+        return f[..., _HEIGHT] + self._offset * n2
 
     # -- RollingBody -------------------------------------------------------------------------
     def phase_vectors(self, u):
@@ -151,8 +221,8 @@ class LaminaBody(RollingBody):
         return self._vectors(self._values(u))
 
     def phase_height(self, u):
-        """z_G(u) (m). Complex-safe."""
-        return self._values(u)[..., _HEIGHT]
+        """z_G(u) (m), the reference point's height. Complex-safe."""
+        return self._height(self._values(u))
 
     def phase_rates(self, u):
         """(ds/du, dα/du) (m/rad, rad/rad) of the trace of A. Complex-safe."""
@@ -208,12 +278,19 @@ class LaminaBody(RollingBody):
 
     # -- the paper's θ chart, exact (general_body.py) ----------------------------------------
     def geometry(self, theta, branch=1):
-        """:class:`~twodisk_ros.physics.general_body.ContactGeometry` at θ on a branch."""
-        return self.general.geometry(theta, branch)
+        """:class:`~twodisk_ros.physics.general_body.ContactGeometry` at θ on a branch
+        (contact vectors and height of the reference point)."""
+        pose = self.general.geometry(theta, branch)
+        if not self._offset:
+            return pose
+        shift = np.array([0.0, self._offset, 0.0])
+        return dataclasses.replace(
+            pose, contact_a=pose.contact_a - shift, contact_b=pose.contact_b - shift,
+            height=pose.height + self._offset * pose.ground_normal[..., 1])
 
     def height(self, theta):
-        """z_G (m) at contact angle θ (rad)."""
-        return self.general.height(theta)
+        """z_G (m) at contact angle θ (rad), the reference point's height."""
+        return self.geometry(theta).height
 
     # -- scalar properties -------------------------------------------------------------------
     @property
@@ -230,8 +307,19 @@ class LaminaBody(RollingBody):
 
     @property
     def centroid(self):
-        """G from the midpoint O of the centres (m, body frame): (1 + σ) ȳ/2 e2."""
+        """G, the laminae's centroid, from the midpoint O of the centres (m, body frame):
+        (1 + σ) ȳ/2 e2 (also for a moved body: see ``origin``)."""
         return self.general.centroid
+
+    @property
+    def offset(self):
+        """The reference point P (the body-frame origin) from G (m, along e2; :meth:`about`)."""
+        return self._offset
+
+    @property
+    def origin(self):
+        """The reference point P from O (m, body frame): G + offset e2."""
+        return self.general.centroid + np.array([0.0, self._offset, 0.0])
 
     @property
     def theta_max(self):
@@ -243,7 +331,13 @@ class LaminaBody(RollingBody):
 
     @property
     def size(self):
-        return self.general.size
+        """Largest distance (m) of a disk point from the reference point."""
+        if not self._offset:
+            return self.general.size
+        cached = self.__dict__.get('_size')
+        if cached is None:
+            cached = self.__dict__['_size'] = self.general.size_about(float(self.origin[1]))
+        return cached
 
     @property
     def feature_width(self):

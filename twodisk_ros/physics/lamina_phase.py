@@ -31,16 +31,16 @@ import math
 import numpy as np
 from scipy.optimize import elementwise
 
-__all__ = ['COLUMNS', 'PhaseSolver', 'unfold']
+__all__ = ['BRANCH_FLIP', 'COLUMNS', 'PhaseSolver', 'THETA_FLIP', 'unfold']
 
 #: The sampled functions of u, in table order (lengths in m, angles in rad): r1 = GA has no
 #: e3 part and r2 = GB no e1 part; t1 lies in disk 1's plane.
 COLUMNS = ('r1_x', 'r1_y', 'r2_y', 'r2_z', 'n_x', 'n_y', 'n_z', 't1_x', 't1_y', 'height',
            'theta', 'psi')
 #: Sign of each column under the mirror x1 → −x1 (u → −u, θ → −θ; t1 → −M1 t1) ...
-_THETA_FLIP = np.array([-1, 1, 1, 1, -1, 1, 1, 1, -1, 1, -1, 1], dtype=float)
+THETA_FLIP = np.array([-1, 1, 1, 1, -1, 1, 1, 1, -1, 1, -1, 1], dtype=float)
 #: ... and under the mirror x3 → −x3 (u → π − u, the other branch).
-_BRANCH_FLIP = np.array([1, 1, 1, -1, 1, 1, -1, 1, 1, 1, 1, -1], dtype=float)
+BRANCH_FLIP = np.array([1, 1, 1, -1, 1, 1, -1, 1, 1, 1, 1, -1], dtype=float)
 _TOLERANCES = {'xatol': 1e-300, 'xrtol': 4 * np.finfo(float).eps, 'fatol': 0.0, 'frtol': 0.0}
 
 
@@ -140,7 +140,7 @@ def unfold(quarter):
     """
     m = quarter.shape[0] - 1
     first = quarter[:m + 1]                                   # [0, π/2]
-    second = (quarter[m - 1::-1] * _BRANCH_FLIP)              # (π/2, π]
-    third = (quarter[1:m + 1] * _BRANCH_FLIP * _THETA_FLIP)   # (π, 3π/2]
-    fourth = (quarter[m - 1:0:-1] * _THETA_FLIP)              # (3π/2, 2π)
+    second = (quarter[m - 1::-1] * BRANCH_FLIP)              # (π/2, π]
+    third = (quarter[1:m + 1] * BRANCH_FLIP * THETA_FLIP)   # (π, 3π/2]
+    fourth = (quarter[m - 1:0:-1] * THETA_FLIP)              # (3π/2, 2π)
     return np.concatenate([first, second, third, fourth])

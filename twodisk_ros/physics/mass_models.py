@@ -29,9 +29,11 @@ the midpoint of the centres, disk 2's at (0, Δ + σ y, x); G, the body-frame or
 laminae's centroid (1 + σ) ȳ/2 e2 (ȳ the lamina's centroid). ``laminae`` takes the lamina's
 area moments (centre of mass G exactly); ``solid`` the convex hull of the two laminae from
 :mod:`twodisk_ros.physics.hull_general`, whose centre of mass is off G along e2 for an
-asymmetric lamina (the egg) in the parallel arrangement.
+asymmetric lamina (the egg) in the parallel arrangement. :func:`centred_on_mass` moves such
+a body's origin to that centre of mass (LaminaBody.about), as the dynamics needs.
 """
 
+import dataclasses
 from functools import lru_cache
 import math
 import weakref
@@ -44,8 +46,9 @@ from .hull_general import general_hull_moments
 from .lamina import Ellipse, Lamina
 from .mass_record import MassProperties, check_rtol, one_line, positive, real_number
 
-__all__ = ['MODELS', 'MassProperties', 'clear_hull_cache', 'custom', 'laminae', 'laminae_of',
-           'mass_properties', 'mass_properties_of', 'solid_hull', 'solid_of']
+__all__ = ['MODELS', 'MassProperties', 'centred_on_mass', 'clear_hull_cache', 'custom',
+           'laminae', 'laminae_of', 'mass_properties', 'mass_properties_of', 'solid_hull',
+           'solid_of']
 
 #: Model names accepted by :func:`mass_properties`.
 MODELS = ('laminae', 'solid', 'custom')
@@ -386,8 +389,45 @@ def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
     -------
     MassProperties
         In the body frame with origin G, the laminae's centroid (the midpoint of the centres
-        for symmetric laminae).
+        for symmetric laminae), or the body's reference point G + offset e2 for a body moved
+        by :meth:`~twodisk_ros.physics.lamina_body.LaminaBody.about` (centre of mass from
+        it; inertia about the centre of mass either way).
     """
+    props = _properties_of(model, body, mass, principal_moments, rtol)
+    offset = float(getattr(body, 'offset', 0.0))
+    if not offset:
+        return props
+    return dataclasses.replace(props, center_of_mass=props.center_of_mass
+                               - np.array([0.0, offset, 0.0]))
+
+
+def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
+    """(body, mass properties) whose body-frame origin is the centre of mass.
+
+    For a :class:`~twodisk_ros.physics.lamina_body.LaminaBody` the body is moved by the
+    centre of mass's e2 coordinate (``body.about``, sharing its tables) and the returned
+    centre of mass is exactly zero (its e1 and e3 parts vanish by the mirror symmetries;
+    more than 1e-12 of the size there is refused). Any other body (the ellipse's
+    TwoDiskBody, centre of mass at G by its symmetries) is returned as it is, with its
+    properties. Arguments as in :func:`mass_properties_of`.
+
+    Returns
+    -------
+    (RollingBody, MassProperties)
+        Ready for :class:`~twodisk_ros.physics.dynamics.RollingDynamics`.
+    """
+    props = mass_properties_of(model, body, mass, principal_moments, rtol)
+    com = props.center_of_mass
+    if not hasattr(body, 'about'):
+        return body, props
+    if max(abs(com[0]), abs(com[2])) > 1e-12 * body.size:
+        raise ValueError(f'the centre of mass {com.tolist()} m is off the common axis e2: '
+                         'the body cannot be moved onto it along e2')
+    return body.about(float(com[1])), dataclasses.replace(props, center_of_mass=np.zeros(3))
+
+
+def _properties_of(model, body, mass, principal_moments, rtol):
+    """:func:`mass_properties_of` about G."""
     if not isinstance(model, str) or model not in MODELS:
         allowed = ', '.join(repr(name) for name in MODELS)
         raise ValueError(f'model must be one of {allowed}, got {one_line(model)}')
