@@ -1,7 +1,8 @@
 """Two congruent laminae of any shape: the contact geometry solved from the support function.
 
-Step 2 of issue 20 (docs/physics.md#the-contact-geometry-of-any-laminae). Nothing else in
-the package uses this module yet; :class:`~twodisk_ros.physics.body.TwoDiskBody` stays the
+docs/physics.md#the-contact-geometry-of-any-laminae. :class:`~twodisk_ros.physics.lamina_body.
+LaminaBody` tabulates these exact solutions over the cycle; the hull (hull_general.py) and the
+drawing (model/) use them directly. :class:`~twodisk_ros.physics.body.TwoDiskBody` stays the
 exact, fast path for ellipses and is the reference the tests hold this one to.
 
 Body frame as in body.py (metres): O, the midpoint of the centres, is the origin; e2 is the
