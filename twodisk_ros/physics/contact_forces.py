@@ -253,16 +253,8 @@ class ContactForceModel:
     def _build(self, n):
         terms = self.terms = ForceTerms(self.body, self.dynamics.mass.inertia, self.mass,
                                         self.dynamics.gravity, n)
-        y = terms.y
-        # world direction of ê: heading α of t1 (paper eqs. (4)-(6)) plus the angle of ê from
-        # t1, stored as a periodic part plus slope·y (the cycle's turn, plus any winding)
-        e, normal, t1 = terms.e, terms.normal, terms.t1
-        gamma = np.unwrap(np.arctan2(_dot(e, np.cross(normal, t1)), _dot(e, t1)))
         self._turn = self.cycle.displacement.turn
-        periodic = self.cycle.heading(terms.u) + gamma - self._turn / TWO_PI * y
-        winding = round((2 * periodic[-1] - periodic[-2] - periodic[0]) / TWO_PI)
-        self._slope = self._turn / TWO_PI + winding
-        heading = periodic - winding * y
+        heading, self._slope = self._heading(terms)
         # Q = A + a C / s (a = Ω² or w²); the 7th quantity is ẇ = γ̈
         j, dj = terms.inertia_line, terms.inertia_slope
         dyn0 = -terms.potential_turn_slope() / j
@@ -270,19 +262,41 @@ class ContactForceModel:
         zero = np.zeros((n, 1))
         rates = np.column_stack([terms.s, terms.s_u, terms.ds_u, heading])
         self._columns = {
-            'general': np.column_stack([terms.q_g, terms.ratio[:, None] * terms.p
-                                        + terms.ds_u[:, None] * terms.q_a,
-                                        terms.s_u[:, None] * terms.q_a, rates[:, 1:]]),
             'dynamic': np.column_stack([terms.q_g + dyn0[:, None] * terms.q_a, dyn0,
                                         terms.p + dyn2[:, None] * terms.q_a, dyn2, rates]),
             'kinematic': np.column_stack([terms.q_g, zero, terms.p, zero, rates])}
-        self.spectral_tail = max(spectral_tail(x) for x in self._columns.values())
+        if terms.regular:
+            self._general_columns(terms, heading)
+        self.spectral_tail = max(spectral_tail(x[:, :-3]) for x in self._columns.values())
         # a singular coefficient below this is taken as zero at a flat-vertex instant
         self._singular_floor = 1e-9 * np.max(np.abs(self._columns['kinematic'][:, 7:14]),
                                              axis=0)
         self._tables = {}
 
+    def _heading(self, terms):
+        """Periodic part of the world heading of ê at the nodes (rad), and its slope per y:
+        the heading α of t1 (paper eqs. (4)-(6)) plus the angle of ê from t1, as a periodic
+        part plus slope·y (the cycle's turn, plus any winding)."""
+        e, normal, t1, y = terms.e, terms.normal, terms.t1, terms.y
+        gamma = np.unwrap(np.arctan2(_dot(e, np.cross(normal, t1)), _dot(e, t1)))
+        periodic = self.cycle.heading(terms.u) + gamma - self._turn / TWO_PI * y
+        winding = round((2 * periodic[-1] - periodic[-2] - periodic[0]) / TWO_PI)
+        return periodic - winding * y, self._turn / TWO_PI + winding
+
+    def _general_columns(self, terms, heading):
+        """(Q_g, Q_u̇², Q_ü) on nodes of u (smooth in u for any body: no division)."""
+        self._columns['general'] = np.column_stack([
+            terms.q_g, terms.ratio[:, None] * terms.p + terms.ds_u[:, None] * terms.q_a,
+            terms.s_u[:, None] * terms.q_a, terms.s_u, terms.ds_u, heading])
+
     def _table(self, kind):
+        if kind == 'general' and kind not in self._columns:
+            phase = ForceTerms(self.body, self.dynamics.mass.inertia, self.mass,
+                               self.dynamics.gravity, self.nodes, phase_only=True)
+            heading, slope = self._heading(phase)
+            if slope != self._slope:
+                raise RuntimeError('the heading of AB winds differently in u and in y')
+            self._general_columns(phase, heading)
         if kind not in self._tables:
             self._tables[kind] = _periodic_table(self._columns[kind])
         return self._tables[kind]
@@ -292,12 +306,13 @@ class ContactForceModel:
 
         ``'kinematic'``: A (7 columns) then C (7) with Q = A + Ω² C / s for each of
         :data:`QUANTITIES` and γ̈ (rad/s²), then s = dγ/dy, dγ/du = |ω_u|, d²γ/du² and the
-        periodic part of the heading of ê (rad); ``'dynamic'``: the same with Q = A + w² C / s
-        along a free motion of angular speed w; ``'general'``: (Q_g, Q_u̇², Q_ü), 6 each, then
-        dγ/du, d²γ/du² and the heading. y is the table coordinate (``terms.coordinate(u)``;
-        u itself for TwoDiskBody and LaminaBody).
+        periodic part of the heading of ê (rad), tabulated in y = ``terms.coordinate(u)``
+        (u itself for TwoDiskBody and LaminaBody); ``'dynamic'``: the same with
+        Q = A + w² C / s along a free motion of angular speed w; ``'general'``:
+        (Q_g, Q_u̇², Q_ü), 6 each, then dγ/du, d²γ/du² and the heading, tabulated in u.
         """
-        y = self.terms.coordinate(np.asarray(u, dtype=float))
+        u = np.asarray(u, dtype=float)
+        y = u if kind == 'general' else self.terms.coordinate(u)
         return self._table(kind)(np.mod(y, TWO_PI))
 
     # -- forces ------------------------------------------------------------------------------
@@ -314,11 +329,12 @@ class ContactForceModel:
         table = self._table(kind)
         for start in range(0, u.size, BLOCK):
             part = slice(start, start + BLOCK)
-            y = self.terms.coordinate(u[part])
+            y = u[part] if kind == 'general' else self.terms.coordinate(u[part])
             cycles = np.floor(y / TWO_PI)
             rest = y - TWO_PI * cycles
             f = table.combine(*table.weights(rest))
             values, singular = self._values(kind, f, a[part], b[0][part] if b else None)
+            out['phase_rate'][part] = u[part]       # (the phases, for _rates)
             self._rates(kind, f, a[part], b[0][part] if b else None, values, out, part)
             for j, name in enumerate(QUANTITIES):
                 out[name][part] = values[:, j]
@@ -377,7 +393,10 @@ class ContactForceModel:
 
     def _rates(self, kind, f, a, b, values, out, part):
         """u̇, ü, w, ẇ of a block (u̇ = inf and ü = nan where the body does not turn in u)."""
-        s_u, ds_u = f[:, -3], f[:, -2]
+        if kind == 'general' or self.terms.regular:
+            s_u, ds_u = f[:, -3], f[:, -2]
+        else:                       # |ω_u| is smooth in u, not in the arc length
+            s_u, ds_u = self.terms.turn_rates(out['phase_rate'][part])
         with np.errstate(divide='ignore', invalid='ignore'):
             if kind == 'general':
                 u_dot = np.sqrt(a)
@@ -432,8 +451,7 @@ class ContactForceModel:
         if (u_dot is None) == (angular_speed is None):
             raise TypeError('give exactly one of u_dot and angular_speed')
         if angular_speed is None:
-            s_u = self.coefficients(u, 'dynamic')[..., 15]
-            angular_speed = s_u * np.asarray(u_dot, dtype=float)
+            angular_speed = self.terms.turn_rates(u)[0] * np.asarray(u_dot, dtype=float)
         forces = self._evaluate('dynamic', u, np.square(angular_speed))
         if u_dot is not None:
             forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
@@ -463,7 +481,7 @@ class ContactForceModel:
         if state is not None:                       # SundmanSolution: (u, w) directly
             speed = state(motion.t)[1]
         else:
-            s_u = self.coefficients(motion.phase, 'dynamic')[..., 15]
+            s_u = self.terms.turn_rates(motion.phase)[0]
             with np.errstate(invalid='ignore'):
                 speed = s_u * motion.phase_rate
             if not np.all(np.isfinite(speed)):      # u̇ = ∞ where the body does not turn

@@ -78,6 +78,8 @@ class ForceTerms:
         M (kg), g (m/s²).
     n : int
         Nodes per cycle (y_k = 2πk/n).
+    phase_only : bool
+        Use y = u whatever the body (for coefficients per u̇², ü, smooth in u).
 
     Attributes (arrays over the nodes)
     ----------------------------------
@@ -90,7 +92,7 @@ class ForceTerms:
     e, t1, normal : ê, disk 1's tangent at A and n (body frame).
     """
 
-    def __init__(self, body, inertia, mass, gravity, n):
+    def __init__(self, body, inertia, mass, gravity, n, phase_only=False):
         u = TWO_PI * np.arange(n) / n
         geo = body.phase_geometry(u)
         w_u = body.phase_angular_velocity(u)
@@ -100,7 +102,7 @@ class ForceTerms:
         s_u = self.sense * along
         drift = real_spectral_derivative(np.concatenate([geo.contact_a, geo.contact_b], -1))
         rate = np.sqrt(s_u**2 + _dot(drift, drift) / body.size**2)
-        self.regular = bool(rate.min() > REGULAR_RATE * rate.max())
+        self.regular = phase_only or bool(rate.min() > REGULAR_RATE * rate.max())
         self.n = n
         # u-table: [x(u) − u, γ(u) − mean·u (periodic), s_u]: the maps u → y, γ and |ω_u|
         mean_rate, x_part = spectral_antiderivative(rate)
@@ -158,6 +160,11 @@ class ForceTerms:
         if self.regular:
             return u
         return u + self._phase_table(np.mod(u, TWO_PI))[..., 0]
+
+    def turn_rates(self, u):
+        """(dγ/du, d²γ/du²) at phase(s) u (rad): |ω_u| and its slope, from the u-table."""
+        u = np.mod(np.asarray(u, dtype=float), TWO_PI)
+        return self._phase_table(u)[..., 2], self._phase_table(u, derivative=1)[..., 2]
 
     def phase_of(self, y):
         """u with y(u) = y (rad), by bisection (y(u) − u is periodic and increasing in u)."""
