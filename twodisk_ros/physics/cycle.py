@@ -186,7 +186,8 @@ class RollingCycle:
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : RollingBody
+        TwoDiskBody or LaminaBody (rolling_body.py).
     resolution : int, optional
         Grid size of the spectral integration (power of two). By default it is doubled from
         512 until the upper half of the spectra of dα/du and of the trace's rate is below
