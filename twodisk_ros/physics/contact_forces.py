@@ -338,8 +338,8 @@ class ContactForceModel:
             self._rates(kind, f, a[part], b[0][part] if b else None, values, out, part)
             for j, name in enumerate(QUANTITIES):
                 out[name][part] = values[:, j]
-            split = list(squeeze_split(*values[:, :5].T))
-            with np.errstate(invalid='ignore'):
+            with np.errstate(invalid='ignore'):       # ±inf at flat-vertex instants
+                split = list(squeeze_split(*values[:, :5].T))
                 along_b = values[:, 4] - split[0]
             if singular is not None:            # flat-vertex instants: the limits
                 limit = squeeze_split(*singular[:, :5].T)
@@ -382,7 +382,7 @@ class ContactForceModel:
         s = f[:, 14]
         stopped = s <= 0.0
         with np.errstate(divide='ignore', invalid='ignore'):
-            values = f[:, :7] + (a / s)[:, None] * f[:, 7:14]
+            values = f[:, :7] + np.where(stopped, 0.0, a / s)[:, None] * f[:, 7:14]
         if not np.any(stopped & (a > 0)):
             return values, None
         part = np.where(np.abs(f[:, 7:14]) > self._singular_floor, f[:, 7:14], 0.0)

@@ -133,6 +133,8 @@ class ForceTerms:
             self.ratio = self.s_u * (1.0 + jet[..., 0])
             e = self._unit(geo.contact_b - geo.contact_a)
             dz = real_spectral_derivative(geo.height)
+        # rounding of a stop (|ω_u| ~ 1e-13) is a stop: s = 0 exactly there
+        self.s = np.where(self.s <= STOPPED * np.max(self.s), 0.0, self.s)
         r1, r2, normal = geo.contact_a, geo.contact_b, geo.ground_normal
         self.e, self.t1, self.normal, self.height = e, geo.tangent_a, normal, geo.height
         axis = self.sense * e                                    # ω̂
