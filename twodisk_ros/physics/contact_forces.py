@@ -4,20 +4,14 @@ Frames and units: world frame with z up (the ground is z = 0); body frame ``G e1
 :mod:`twodisk_ros.body`. Forces in N, moments in N m, speeds in rad/s. The derivation is in
 docs/physics.md, section "Contact forces".
 
-Newton-Euler with both contacts at rest (no slip), in the body frame, per unit of the phase u:
-ω = ω_u u̇, ω̇ = ω_u′ u̇² + ω_u ü, v_G = u̇ c with c = −ω_u × r1, hence
-
-    a_G = u̇² (ω_u × c + c′) + ü c,          (c′ = dc/du: A moves along the boundary)
-    F_A + F_B = M a_G + M g n,                L_G = u̇² (I ω_u′ + ω_u × I ω_u) + ü I ω_u,
-
-n the ground normal, r1 = GA, r2 = GB (paper eq. (2)), d = r2 − r1 = |AB| ê. Moments about A:
+Newton–Euler with both contacts at rest (no slip), moments about A (d = r2 − r1 = |AB| ê):
 d × F_B + τ ê = L_G − r1 × (F_A + F_B) =: L_A, so F_B⊥ = (L_A × d)/|d|² and τ = ê·L_A (the
-drive torque; zero along a free motion, where it is the residual of m ü + ½ m′ u̇² + V′ = 0).
-Only the sum S of the components along ê is determined (the squeeze, resolved by
-:func:`squeeze_split`). Every output is linear in (1, u̇², ü) with coefficients that depend on
-u only: they are tabulated once per cycle (quintic Hermite, spectral derivatives), so 10⁶
-states take ~0.4 s (benchmarks/contact_forces_rate.py). V = M g z_G is the paper's section 4;
-the heading of the trace of A, which orients ê in the world, solves its eqs. (4)-(6).
+drive torque; zero along a free motion). Only the sum S along ê is determined (the squeeze,
+resolved by :func:`squeeze_split`). The coefficients, per unit of the body's turn γ for any
+RollingBody, are built in :mod:`~twodisk_ros.physics.contact_terms` and tabulated once per
+cycle (quintic Hermite, spectral derivatives): 10⁶ states take ~0.4 s
+(benchmarks/contact_forces_rate.py). The heading of the trace of A, which orients ê in the
+world, solves the paper's eqs. (4)-(6).
 
 Public API: :class:`ContactForceModel` (``forces``, ``dynamic``, ``kinematic``, ``along``,
 ``coefficients``), :class:`ContactForces`, :func:`squeeze_split`. Validity checks and
