@@ -101,7 +101,8 @@ def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
 def kinematic_coefficients(samples, inertia, mass, gravity):
     """The kinematic columns of :class:`ContactForceModel` at one cycle's nodes, for a batch.
 
-    The same construction as the model's tables (Newton-Euler per unit u, moments about A,
+    Ellipses only (TwoDiskBodies, which turn at every u: |ω_u| > 0); the same construction
+    as the model's tables in u (Newton-Euler per unit u, moments about A,
     spectral u-derivatives of dG/du, ω_u and |ω_u|), for B bodies at once and component by
     component, without the heading and the drive torque, which the lift-off speed and
     μ_required do not need.
