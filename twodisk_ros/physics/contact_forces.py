@@ -44,12 +44,6 @@ def _dot(x, y):
     return np.sum(x * y, axis=-1)
 
 
-def _periodic_table(values):
-    """Quintic Hermite table over one cycle of columns sampled at u_j = 2πj/N (spectral f′, f″)."""
-    first = spectral_derivative(values)
-    return HermiteTable.periodic(values, first, spectral_derivative(first))
-
-
 def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
     """The split of the total along AB that needs the least friction coefficient.
 
@@ -292,8 +286,10 @@ class ContactForceModel:
             if slope != self._slope:
                 raise RuntimeError('the heading of AB winds differently in u and in y')
             self._general_columns(phase, heading)
-        if kind not in self._tables:
-            self._tables[kind] = _periodic_table(self._columns[kind])
+        if kind not in self._tables:      # quintic Hermite, spectral f′ and f″ at the nodes
+            first = spectral_derivative(self._columns[kind])
+            self._tables[kind] = HermiteTable.periodic(self._columns[kind], first,
+                                                       spectral_derivative(first))
         return self._tables[kind]
 
     def coefficients(self, u, kind='kinematic'):
@@ -311,8 +307,9 @@ class ContactForceModel:
         return self._table(kind)(np.mod(y, TWO_PI))
 
     # -- forces ------------------------------------------------------------------------------
-    def _evaluate(self, kind, u, a, b=None):
-        """States in blocks: u (rad), a = u̇² (general) or Ω², w² (kinematic, dynamic), b = ü."""
+    def _evaluate(self, kind, u, a, b=None, per_phase=False):
+        """States in blocks: u (rad), a = u̇² (general) or Ω², w² (kinematic, dynamic), b = ü;
+        ``per_phase``: a is u̇² of a free motion (w² = |ω_u|² u̇²)."""
         arrays = [np.asarray(x, dtype=float) for x in (u, a) + ((b,) if b is not None else ())]
         shape = np.broadcast_shapes(*(x.shape for x in arrays))
         u, a, *b = (np.broadcast_to(x, shape).ravel() for x in arrays)
@@ -328,9 +325,13 @@ class ContactForceModel:
             cycles = np.floor(y / TWO_PI)
             rest = y - TWO_PI * cycles
             f = table.combine(*table.weights(rest))
-            values, singular = self._values(kind, f, a[part], b[0][part] if b else None)
+            square = a[part]
+            if per_phase:
+                turn = (f[:, 15] if self.terms.regular else self.terms.turn_rates(u[part])[0])
+                square = square * turn * turn
+            values, singular = self._values(kind, f, square, b[0][part] if b else None)
             out['phase_rate'][part] = u[part]       # (the phases, for _rates)
-            self._rates(kind, f, a[part], b[0][part] if b else None, values, out, part)
+            self._rates(kind, f, square, b[0][part] if b else None, values, out, part)
             for j, name in enumerate(QUANTITIES):
                 out[name][part] = values[:, j]
             with np.errstate(invalid='ignore'):       # ±inf at flat-vertex instants
@@ -429,14 +430,10 @@ class ContactForceModel:
 
         Parameters
         ----------
-        u : array_like
-            Phase (rad).
-        u_dot : array_like, optional
-            Its rate (rad/s), e.g. a :class:`~twodisk_ros.dynamics.RollingMotion`'s
-            ``phase_rate``; or
-        angular_speed : array_like, optional
-            the body's angular speed w = |ω_u| u̇ (rad/s), finite also where the body does not
-            turn in u (u̇ infinite there). Broadcast with u.
+        u, u_dot : array_like
+            Phase (rad) and its rate (rad/s, e.g. a RollingMotion's ``phase_rate``); or
+        angular_speed : array_like
+            instead of u̇, the angular speed w = |ω_u| u̇ (rad/s), finite where u̇ is not.
 
         Returns
         -------
@@ -446,8 +443,9 @@ class ContactForceModel:
         if (u_dot is None) == (angular_speed is None):
             raise TypeError('give exactly one of u_dot and angular_speed')
         if angular_speed is None:
-            angular_speed = self.terms.turn_rates(u)[0] * np.asarray(u_dot, dtype=float)
-        forces = self._evaluate('dynamic', u, np.square(angular_speed))
+            forces = self._evaluate('dynamic', u, np.square(u_dot), per_phase=True)
+        else:
+            forces = self._evaluate('dynamic', u, np.square(angular_speed))
         if u_dot is not None:
             forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
                                                 forces.phase.shape).copy()
