@@ -313,8 +313,8 @@ class ContactForceModel:
         arrays = [np.asarray(x, dtype=float) for x in (u, a) + ((b,) if b is not None else ())]
         shape = np.broadcast_shapes(*(x.shape for x in arrays))
         u, a, *b = (np.broadcast_to(x, shape).ravel() for x in arrays)
-        names = QUANTITIES + _SPLIT + ('along_b', 'phase_rate', 'phase_acceleration', 'angular_speed',
-                                       'angular_acceleration')
+        names = QUANTITIES + _SPLIT + ('along_b', 'phase_rate', 'phase_acceleration',
+                                       'angular_speed', 'angular_acceleration')
         out = {name: np.empty(u.size) for name in names}
         for name in ('force_a', 'force_b', 'direction_ab'):
             out[name] = np.empty((u.size, 3))
