@@ -219,6 +219,9 @@ class EquilibriumArrays:
 def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
     """:func:`equilibria` of a batch of bodies at once (arrays instead of a list).
 
+    Ellipses only (TwoDiskBodies: the eight equilibria at the fixed angles); a batch of other
+    bodies takes :func:`equilibria` body by body.
+
     Parameters
     ----------
     bodies : TwoDiskBodies
@@ -274,6 +277,9 @@ def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
 
 def stability_map(b_over_a, delta_over_a, neutral_tolerance=NEUTRAL_TOLERANCE):
     """Which family of equilibria is stable over a grid of shapes (a = 1).
+
+    Ellipses only (the paper's margin b² − 2a² + 2Δ²); for other laminae the symmetric
+    equilibria's stability is :mod:`~twodisk_ros.physics.symmetric_stability`.
 
     Parameters
     ----------
