@@ -315,7 +315,7 @@ class ClosedSceneStream:
         return self._samples_of(t, *self.solution(t))
 
     def _samples_of(self, t, u, u_dot):
-        m, v, dm, dv, w = np.moveaxis(self.terms.energy_jet(u), -1, 0)
+        m, v, dm, dv, w = np.moveaxis(self.terms.energy_jet(u)[..., :5], -1, 0)
         zero = np.zeros(t.shape)
         return SceneSamples(t=t, phase=u, phase_rate=u_dot,
                             phase_acceleration=-(0.5 * dm * u_dot**2 + dv) / m,

@@ -140,13 +140,15 @@ class SceneTerms:
             k.real, k.imag, general[:, 6:12], general[:, 12:18], edge.real, edge.imag])
         first = spectral_derivative(columns)
         self._table = HermiteTable.periodic(columns, first, spectral_derivative(first))
+        self._equilibria = None
         # V = V_p(u) + drift u/2π: the periodic part tabulated once from G's composed
         # positions, the drift of one cycle composed (exact for a turn of 2π per cycle)
         v = self.weight * (self.cos_b * height - self.sin_b * self.downhill(u))
         self.drift = float(self.weight * (self.cos_b * height[0] - self.sin_b * self.downhill(
             TWO_PI)) - v[0])
         jet = np.column_stack([m_u, v - self.drift * u / TWO_PI])
-        jet = np.column_stack([jet, spectral_derivative(jet), speed])
+        slope = spectral_derivative(jet)
+        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope)])
         first = spectral_derivative(jet)
         self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
 
@@ -172,11 +174,13 @@ class SceneTerms:
         return self.weight * (self.cos_b * h - self.sin_b * self.downhill(u))
 
     def energy_jet(self, u, derivative=0):
-        """(m, V, m′, V′, |ω_u|) at u (``derivative=0``) or their derivatives in u (``1``),
-        array u.shape + (5,), from one table of m, of V's periodic part (V = V_p + drift
-        u/2π) and of |ω_u|: the narrow table the closed forms and the samples read."""
+        """(m, V, m′, V′, |ω_u|, m″, V″) at u (``derivative=0``) or their derivatives in u
+        (``1``), array u.shape + (7,), from one table of m, of V's periodic part (V = V_p +
+        drift u/2π) and of |ω_u|: the narrow table the closed forms and the samples read."""
         u = np.asarray(u, dtype=float)
-        jet = self._energy_table(np.mod(u, TWO_PI), derivative)
+        table = self._energy_table
+        jet = table.combine(*table.weights(np.mod(u, TWO_PI))) if derivative == 0 else \
+            table(np.mod(u, TWO_PI), derivative)
         if derivative == 0:
             jet[..., 1] += self.drift * u / TWO_PI
         jet[..., 3 - 2 * derivative] += self.drift / TWO_PI
@@ -252,8 +256,13 @@ class SceneTerms:
 
         Roots bracketed on the table nodes and refined by Brent's method. V′ is periodic
         (λ = 1 to ~1e-11: the heading turns once per cycle); a slope steeper than the
-        tipping limit has none.
+        tipping limit has none. Computed once (a copy of the list is returned).
         """
+        if self._equilibria is None:
+            self._equilibria = self._find_equilibria()
+        return list(self._equilibria)
+
+    def _find_equilibria(self):
         n = self._table.last_index + 1
         u = TWO_PI * np.arange(n + 1) / n
         slope = self.potential_slope(u)
