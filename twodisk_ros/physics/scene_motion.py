@@ -22,7 +22,8 @@ E(t) + W(t) − W_d(t) = E₀ is the energy balance. DOP853 (scipy, dense output
 stretch between two stops (u̇ = 0) is integrated on its own, and at a stop the body stays at
 rest if |V′ − Q_drive| ≤ μ_r k N (it sticks: the time to rest is exact). Where the flat fast
 paths hold (:func:`scene_stream`) today's :class:`~twodisk_ros.physics.motion.MotionStream` is
-used unchanged.
+used unchanged, and a conservative scene on a slope has the closed forms of
+:mod:`~twodisk_ros.physics.scene_closed` (:class:`ClosedSceneStream`).
 """
 
 from dataclasses import dataclass
