@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-__all__ = ['Scene', 'DRIVES', 'SLOPE_LIMIT', 'quaternion_product']
+__all__ = ['Scene', 'DRIVES', 'SLOPE_LIMIT', 'command_error', 'quaternion_product']
 
 DRIVES = ('none', 'speed', 'torque')
 #: |slope| must stay below this (rad): at π/2 the ground is a wall
@@ -77,6 +77,9 @@ class Scene:
         c ≥ 0 (N m s): a viscous torque −c ω.
     friction : float
         μ ≥ 0 of the ground (inf: never slips); used to report slip, not in the motion.
+    speed_limit, torque_limit : float
+        Largest |command| (rad/s, N m; > 0, inf allowed) the speed and torque drives accept
+        (:func:`command_error`).
     """
 
     slope: float = 0.0
@@ -88,6 +91,8 @@ class Scene:
     rolling_resistance: float = 0.0
     damping: float = 0.0
     friction: float = math.inf
+    speed_limit: float = 100.0
+    torque_limit: float = 10.0
 
     def __post_init__(self):
         checks = [
@@ -100,12 +105,25 @@ class Scene:
             ('rolling_resistance', 'finite and >= 0', lambda x: math.isfinite(x) and x >= 0),
             ('damping', 'finite and >= 0 N m s', lambda x: math.isfinite(x) and x >= 0),
             ('friction', '>= 0 (inf allowed)', lambda x: x >= 0),
+            ('speed_limit', '> 0 rad/s (inf allowed)', lambda x: x > 0),
+            ('torque_limit', '> 0 N m (inf allowed)', lambda x: x > 0),
         ]
         for name, rule, allowed in checks:
             object.__setattr__(self, name, _number(name, getattr(self, name), rule, allowed))
         if self.drive not in DRIVES:
             raise ValueError(f'drive must be one of {", ".join(map(repr, DRIVES))}, '
                              f'got {self.drive!r}')
+        if self.drive != 'none':
+            why = self.command_error(self.drive, self.command)
+            if why:
+                raise ValueError('command ' + why.split(' ignored: ', 1)[1])
+
+    def command_error(self, drive, value):
+        """'' if ``value`` is a command the ``drive`` ('speed' or 'torque') accepts, else
+        one line saying what was wrong and what is allowed (the node logs it as a WARN and
+        keeps the previous command)."""
+        limit = {'speed': self.speed_limit, 'torque': self.torque_limit}.get(drive)
+        return command_error(drive, value, limit)
 
     # -- what the scene needs ------------------------------------------------------------
     @property
@@ -163,6 +181,31 @@ class Scene:
         if self.damping:
             parts.append(f'damping {self.damping:g} N m s')
         return ', '.join(parts) if parts else 'flat, free, conservative'
+
+
+def command_error(drive, value, limit):
+    """'' if ``value`` is a valid command for ``drive``, else one line: why it is rejected.
+
+    ``drive`` is 'speed' (rad/s) or 'torque' (N m); a valid command is a finite real number
+    (not a bool or a string) with |value| ≤ ``limit``. NaN, ±inf and values beyond the limit
+    are rejected, never raised: the caller keeps its previous command.
+    """
+    units = {'speed': 'rad/s', 'torque': 'N m'}
+    if drive not in units:
+        return f'cmd_{drive} ignored: no such drive (allowed: speed, torque)'
+    name = f'cmd_{drive}'
+    if isinstance(value, (str, bytes, bool)) or value is None:
+        return f'{name} ignored: must be a number in {units[drive]}, got {value!r}'
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return f'{name} ignored: must be a number in {units[drive]}, got {value!r}'
+    if not math.isfinite(number):
+        return f'{name} ignored: must be finite, got {number!r}'
+    if not abs(number) <= limit:
+        return (f'{name} ignored: |{number:g}| {units[drive]} is beyond the limit '
+                f'{limit:g} {units[drive]}')
+    return ''
 
 
 def quaternion_product(p, q):

@@ -22,7 +22,8 @@ E(t) + W(t) − W_d(t) = E₀ is the energy balance. DOP853 (scipy, dense output
 stretch between two stops (u̇ = 0) is integrated on its own, and at a stop the body stays at
 rest if |V′ − Q_drive| ≤ μ_r k N (it sticks: the time to rest is exact). Where the flat fast
 paths hold (:func:`scene_stream`) today's :class:`~twodisk_ros.physics.motion.MotionStream` is
-used unchanged.
+used unchanged, and a conservative scene on a slope has the closed forms of
+:mod:`~twodisk_ros.physics.scene_closed` (:class:`ClosedSceneStream`).
 """
 
 from dataclasses import dataclass
@@ -30,13 +31,15 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
-from .contact_validity import check_validity
+from .contact_validity import ValidityReport, check_validity
 from .motion import MotionStream
+from .scene_closed import DriftQuadrature, conservative_solution
 from .scene_terms import C2, CN, CU, DM, DW, K_G, KIM, KRE, M, SceneTerms, W
 
-__all__ = ['SceneStream', 'SceneSamples', 'scene_stream', 'simulate_scene', 'settle',
-           'first_failure']
+__all__ = ['ClosedSceneStream', 'SceneStream', 'SceneSamples', 'scene_stream',
+           'simulate_scene', 'settle', 'first_failure']
 
 
 @dataclass
@@ -85,6 +88,10 @@ class SceneStream:
     chunk, lookahead : float
         As :class:`~twodisk_ros.physics.motion.MotionStream`: segments of at most ``chunk``
         s, reaching ``lookahead`` s beyond the times asked.
+
+    The dense output of every segment reaching back to the earliest time of the latest
+    call is kept, so :meth:`evaluate` gives the state at any time of that window (the root
+    finding of :func:`first_failure` and :func:`settle`).
     """
 
     def __init__(self, terms, u0, u_dot0, *, tolerance=1e-10, chunk=10.0, lookahead=0.5):
@@ -105,19 +112,21 @@ class SceneStream:
                                                           scale, scale])
         self._pieces = [_Piece(0.0, 0.0, rest=state)]
         self._sigma = self._direction(u0, u_dot0)
+        self._stops = [(0.0, self._sigma)]          # (time, direction of motion from then)
 
     @property
     def solver(self):
         """'DOP853' (or 'rest' once stuck)."""
         return 'rest' if math.isfinite(self.rest_time) else 'DOP853'
 
-    # -- the equation of motion ---------------------------------------------------------------
-    def _terms(self, u, row):
+    # -- the equation of motion (arrays or scalars) ---------------------------------------
+    def _terms(self, u):
         t = self.terms
-        n_g = float(np.sum(t.quantities_from(u, row, 0.0, 0.0)[:2]))
-        return (float(row[M]), float(row[DM]), float(row[W]), float(row[DW]),
-                float(t.potential_slope_from(u, row)), float(row[K_G]), n_g,
-                float(row[C2] + row[C2 + 1]), float(row[CU] + row[CU + 1]))
+        row = t.rows(u)
+        n_g = np.sum(t.quantities_from(u, row, 0.0, 0.0)[..., :2], axis=-1)
+        return (row[..., M], row[..., DM], row[..., W], row[..., DW],
+                t.potential_slope_from(u, row), row[..., K_G], n_g,
+                row[..., C2] + row[..., C2 + 1], row[..., CU] + row[..., CU + 1])
 
     def speed(self, t):
         """The speed drive's Ω(t) (rad/s), t from the stream's start (s)."""
@@ -126,10 +135,10 @@ class SceneStream:
                                                           / self.scene.lag)
 
     def _free(self, u, u_dot, sigma):
-        """(ü, Q_drive, dW/dt) for the free or torque-driven equation."""
+        """(ü, Q_drive, dW/dt) for the free or torque-driven equation (σ = sgn u̇)."""
         s = self.scene
-        m, dm, w, _, dv, k, n_g, n_2, n_u = self._terms(u, self.terms.rows(u))
-        q_drive = s.command * w if s.drive == 'torque' else 0.0
+        m, dm, w, _, dv, k, n_g, n_2, n_u = self._terms(u)
+        q_drive = s.command * w if s.drive == 'torque' else 0.0 * w
         q_damp = -s.damping * w * w * u_dot
         rr = s.rolling_resistance * sigma * k
         u_ddot = (-0.5 * dm * u_dot**2 - dv + q_drive + q_damp - rr * (n_g + n_2 * u_dot**2)) \
@@ -140,13 +149,13 @@ class SceneStream:
     def _driven(self, t, u):
         """(u̇, ü, Q_drive, dW/dt) under the speed drive."""
         s = self.scene
-        m, dm, w, dw, dv, k, n_g, n_2, n_u = self._terms(u, self.terms.rows(u))
-        omega = float(self.speed(t))
+        m, dm, w, dw, dv, k, n_g, n_2, n_u = self._terms(u)
+        omega = self.speed(t)
         u_dot = omega / w
         u_ddot = ((s.command - omega) / s.lag - dw * u_dot**2) / w
         q_damp = -s.damping * w * w * u_dot
-        q_roll = -s.rolling_resistance * math.copysign(1.0, u_dot) * k * (
-            n_g + n_2 * u_dot**2 + n_u * u_ddot) if u_dot else 0.0
+        q_roll = -s.rolling_resistance * np.sign(u_dot) * k * (
+            n_g + n_2 * u_dot**2 + n_u * u_ddot)
         q_drive = m * u_ddot + 0.5 * dm * u_dot**2 + dv - q_damp - q_roll
         return u_dot, u_ddot, q_drive, -(q_damp + q_roll) * u_dot
 
@@ -155,7 +164,7 @@ class SceneStream:
         if u_dot != 0 or self.speed_drive:
             return math.copysign(1.0, u_dot)
         s = self.scene
-        m, dm, w, _, dv, k, n_g, _, _ = self._terms(u, self.terms.rows(u))
+        m, dm, w, _, dv, k, n_g, _, _ = (float(x) for x in self._terms(u))
         push = (s.command * w if s.drive == 'torque' else 0.0) - dv
         if s.rolling_resistance > 0 and abs(push) <= s.rolling_resistance * k * n_g:
             return 0.0
@@ -197,28 +206,39 @@ class SceneStream:
             if result.status == 1:                  # stopped: u̇ = 0
                 y0[1] = 0.0
                 self._sigma = self._direction(y0[0], 0.0)
+                self._stops.append((end, self._sigma))
             t0 = end
         return pieces
 
     def _states(self, t):
-        """The state at times t (s, increasing, not before earlier calls): array (ny, len)."""
+        """The state at times t (s, increasing, not before the window): array (ny, len)."""
         t = np.asarray(t, dtype=float)
-        out = np.empty((3 if self.speed_drive else 4, t.size))
-        done = 0
-        while done < t.size:
+        if t.size and t[0] < self._pieces[0].start:
+            raise ValueError(f'time {t[0]!r} s is before the stream\'s window (from '
+                             f'{self._pieces[0].start!r} s)')
+        if t.size:      # keep only the pieces from the one holding t[0]
+            first = max(i for i, p in enumerate(self._pieces) if p.start <= t[0])
+            self._pieces = self._pieces[first:]
+        while t.size and self._pieces[-1].end < t[-1]:
             last = self._pieces[-1]
-            for piece in self._pieces:
-                inside = (t[done:] >= piece.start) & (t[done:] <= piece.end)
-                count = int(np.sum(inside))
-                if count:
-                    out[:, done:done + count] = piece(t[done:done + count])
-                    done += count
-            if done == t.size:
-                break
             end = last.end
             y0 = [float(x) for x in last(np.array([end]))[:, 0]]
             span = min(self._chunk, max(float(t[-1]) - end, self._lookahead))
-            self._pieces = self._advance(end, end + span, y0)
+            self._pieces.extend(self._advance(end, end + span, y0))
+        return self.evaluate(t)
+
+    def evaluate(self, t):
+        """The state (u, u̇, W, W_d) (speed drive: (u, W, W_d)) at times t (s) inside the
+        window already integrated: from the earliest time of the latest call to its end."""
+        t = np.asarray(t, dtype=float)
+        out = np.empty((3 if self.speed_drive else 4, t.size))
+        starts = np.array([p.start for p in self._pieces])
+        if t.size and not (t.min() >= starts[0] and t.max() <= self._pieces[-1].end):
+            raise ValueError('times outside the integrated window')
+        which = np.clip(np.searchsorted(starts, t, side='right') - 1, 0, len(starts) - 1)
+        for i in np.unique(which):
+            inside = which == i
+            out[:, inside] = self._pieces[i](t[inside])
         return out
 
     def sample(self, t):
@@ -229,43 +249,95 @@ class SceneStream:
     def samples(self, t):
         """:class:`SceneSamples` at times t (s, increasing, not before earlier calls)."""
         t = np.asarray(t, dtype=float)
-        y = self._states(t)
+        return self._samples_of(t, self._states(t))
+
+    def samples_at(self, t):
+        """:class:`SceneSamples` at times t (s) inside the window (:meth:`evaluate`)."""
+        t = np.asarray(t, dtype=float)
+        return self._samples_of(t, self.evaluate(t))
+
+    def _samples_of(self, t, y):
+        """The samples from the states y at times t, vectorised over the samples."""
         u = y[0]
-        n = t.size
-        u_dot, u_ddot, q_drive = np.empty(n), np.empty(n), np.empty(n)
-        for i in range(n):
-            if self.speed_drive:
-                u_dot[i], u_ddot[i], q_drive[i], _ = self._driven(t[i], u[i])
-            else:
-                sigma = self._sigma_at(t[i], y[1, i])
-                u_dot[i] = y[1, i]
-                u_ddot[i], q_drive[i], _ = self._free(u[i], u_dot[i], sigma)
-                if sigma == 0.0:
-                    u_ddot[i] = 0.0
+        if self.speed_drive:
+            u_dot, u_ddot, q_drive, _ = self._driven(t, u)
+        else:
+            u_dot = y[1]
+            sigma = self._sigma_at(t, u_dot)
+            u_ddot, q_drive, _ = self._free(u, u_dot, sigma)
+            u_ddot = np.where(sigma == 0.0, 0.0, u_ddot)
         w = self.terms.rows(u)[..., W]
-        torque = q_drive / w
         return SceneSamples(t=t, phase=u, phase_rate=u_dot, phase_acceleration=u_ddot,
                             energy=self.terms.energy(u, u_dot), dissipated=y[-2],
-                            drive_work=y[-1], drive_torque=torque, power=q_drive * u_dot,
+                            drive_work=y[-1], drive_torque=q_drive / w, power=q_drive * u_dot,
                             rolling_speed=w * u_dot)
 
     def _sigma_at(self, t, u_dot):
-        if math.isfinite(self.rest_time) and t >= self.rest_time:
-            return 0.0
-        if u_dot != 0:
-            return math.copysign(1.0, u_dot)
-        return self._sigma
+        """sgn u̇, or where u̇ = 0 the direction in force after the last stop before t."""
+        times = np.array([time for time, _ in self._stops])
+        after = np.array([sigma for _, sigma in self._stops])
+        held = after[np.clip(np.searchsorted(times, t, side='right') - 1, 0, len(times) - 1)]
+        return np.where(u_dot != 0, np.sign(u_dot), held)
+
+
+class ClosedSceneStream:
+    """The motion of a conservative scene in closed form (:mod:`~twodisk_ros.physics.
+    scene_closed`): ``sample``/``samples`` as :class:`SceneStream`, no time stepping."""
+
+    rest_time = math.nan
+    nfev = 0
+
+    def __init__(self, terms, solution):
+        self.terms, self.scene, self.solution = terms, terms.scene, solution
+        self.initial_energy = float(solution.energy) if hasattr(solution, 'energy') else \
+            float(terms.energy(*(float(x) for x in solution(0.0))))
+
+    @property
+    def solver(self):
+        """'quadrature', 'oscillation', 'libration' or 'rest'."""
+        return self.solution.name
+
+    def sample(self, t):
+        """(u, u̇) at times t (s, increasing)."""
+        t = np.asarray(t, dtype=float)
+        if isinstance(self.solution, DriftQuadrature) and t.size:
+            self.solution.forget_before(float(t[0]))
+        u, u_dot = self.solution(t)
+        return u, u_dot
+
+    def samples(self, t):
+        """:class:`SceneSamples` at times t (s, increasing)."""
+        t = np.asarray(t, dtype=float)
+        u, u_dot = self.sample(t)
+        return self._samples_of(t, u, u_dot)
+
+    def samples_at(self, t):
+        """:class:`SceneSamples` at any times t (s) the solution still holds."""
+        t = np.asarray(t, dtype=float)
+        return self._samples_of(t, *self.solution(t))
+
+    def _samples_of(self, t, u, u_dot):
+        m, v, dm, dv, w = np.moveaxis(self.terms.energy_jet(u)[..., :5], -1, 0)
+        zero = np.zeros(t.shape)
+        return SceneSamples(t=t, phase=u, phase_rate=u_dot,
+                            phase_acceleration=-(0.5 * dm * u_dot**2 + dv) / m,
+                            energy=0.5 * m * u_dot**2 + v, dissipated=zero, drive_work=zero,
+                            drive_torque=zero, power=zero,
+                            rolling_speed=w * u_dot)
 
 
 def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10, terms=None,
                  chunk=10.0, lookahead=0.5):
-    """The motion of a scene from (u0 (rad), u̇0 (rad/s)): a MotionStream where it holds.
+    """The motion of a scene from (u0 (rad), u̇0 (rad/s)): closed forms where they hold.
 
     * flat, free, conservative (``Scene()``): today's dynamic MotionStream, bit for bit;
     * speed drive whose command equals the initial speed (Ω₀ = |ω_u(u0)| u̇0, to 1e-12): the
       motion is today's kinematic MotionStream on any slope and with any dissipation (u(t)
       is then kinematic; only the drive torque depends on the scene);
-    * otherwise a :class:`SceneStream` (``terms`` reused if given).
+    * conservative on a slope, ``method='table'``: the closed forms of
+      :func:`~twodisk_ros.physics.scene_closed.conservative_solution` (rolling on, rocking,
+      rest) in a :class:`ClosedSceneStream`;
+    * otherwise a :class:`SceneStream` (DOP853; ``terms`` reused if given).
     """
     kwargs = dict(method=method, tolerance=tolerance, chunk=chunk, lookahead=lookahead)
     if scene.flat_free:
@@ -277,6 +349,10 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
             return MotionStream(dynamics, u0, u_dot0, mode='kinematic', **kwargs)
     if terms is None:
         terms = SceneTerms(dynamics, scene)
+    if scene.conservative and method == 'table':
+        solution = conservative_solution(terms, u0, u_dot0)
+        if solution is not None:
+            return ClosedSceneStream(terms, solution)
     return SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=chunk,
                        lookahead=lookahead)
 
@@ -292,9 +368,12 @@ def simulate_scene(terms, t_eval, u0, u_dot0, *, tolerance=1e-10):
 def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolerance=1e-10):
     """When a dissipative free body comes to rest: (time (s), u (rad), SceneEquilibrium).
 
-    At rest: stuck by rolling resistance (exact), or within ``rest_energy`` × M g L of the
-    bottom of the well it oscillates in (damping alone approaches it exponentially), the
-    first such time bracketed on a grid of ``step`` s and refined on a grid of step/1024.
+    The criterion: the body is at rest when it sticks (rolling resistance: u̇ = 0 with
+    |V′ − Q_drive| ≤ μ_r k N, the stop located by DOP853's event to its tolerance), or when
+    its energy above the bottom of the well it oscillates in first falls to ``rest_energy``
+    × M g L: E(t) − V(u*) = ε M g L (damping alone only approaches u* exponentially; E − V*
+    decreases monotonically, so that instant is unique). It is bracketed on a grid of step/8
+    s and located by Brent's method on the dense output (to 1e-9 s).
     (nan, nan, None) if not at rest by ``t_max`` s (e.g. it rolls down the slope).
     """
     stable = [eq for eq in terms.equilibria() if eq.stable]
@@ -302,44 +381,80 @@ def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolera
     threshold = rest_energy * terms.dynamics.energy_scale
 
     def excess(samples):
-        """E − V(u*) for the equilibrium nearest each sample (J), and that equilibrium."""
-        best = np.full(samples.t.shape, math.inf), [None] * samples.t.size
+        """E − V(u*) for the stable equilibrium within π/4 of each sample (J; 1e300 if
+        none), and (that equilibrium, its phase)."""
+        best, which = np.full(samples.t.shape, 1e300), [None] * samples.t.size
         for eq in stable:
             centre = eq.phase + 2 * math.pi * np.round((samples.phase - eq.phase) / (2 * math.pi))
             gap = samples.energy - terms.potential(centre)
             closer = np.abs(samples.phase - centre) < math.pi / 4
-            for i in np.flatnonzero(closer & (gap < best[0])):
-                best[0][i], best[1][i] = gap[i], (eq, centre[i])
-        return best
+            for i in np.flatnonzero(closer & (gap < best)):
+                best[i], which[i] = gap[i], (eq, centre[i])
+        return best, which
     t = 0.0
     while t < t_max:
         grid = np.linspace(t, t + step, 9)
         samples = stream.samples(grid)
         gap, which = excess(samples)
         if math.isfinite(stream.rest_time) and stream.rest_time <= grid[-1]:
-            i = int(np.searchsorted(grid, stream.rest_time))
-            eq = which[min(i, grid.size - 1)]
-            return stream.rest_time, float(samples.phase[-1]), eq[0] if eq else None
-        below = np.flatnonzero(gap < threshold)
+            rest = stream.samples_at(np.array([stream.rest_time]))
+            near = excess(rest)[1][0]
+            return stream.rest_time, float(rest.phase[0]), near[0] if near else None
+        below = np.flatnonzero(gap <= threshold)
         if below.size:
             i = int(below[0])
             if i == 0:
                 return float(grid[0]), float(samples.phase[0]), which[0][0]
-            fine = np.linspace(grid[i - 1], grid[i], 1025)
-            probe = SceneStream(terms, u0, u_dot0, tolerance=tolerance,
-                                chunk=10 * step).samples(np.concatenate([[0.0], fine]))
-            j = int(np.flatnonzero(excess(probe)[0][1:] < threshold)[0])
-            return float(fine[j]), float(probe.phase[j + 1]), which[i][0]
+            time = brentq(lambda x: float(excess(stream.samples_at(np.array([x])))[0][0])
+                          - threshold, grid[i - 1], grid[i], xtol=1e-9)
+            return time, float(stream.samples_at(np.array([time])).phase[0]), which[i][0]
         t = grid[-1]
     return math.nan, math.nan, None
 
 
-def first_failure(terms, samples):
+def first_failure(terms, samples, stream=None, *, resolution=0.01):
     """Where the rolling model first fails along sampled motion: lift-off or slip.
 
-    Returns a :class:`~twodisk_ros.physics.contact_validity.ValidityReport`: the first
-    sample at which N_A < 0, N_B < 0 or μ_required > the scene's friction (the time
-    resolution is the sampling), forces with the tilted gravity.
+    Returns a :class:`~twodisk_ros.physics.contact_validity.ValidityReport`, forces with the
+    tilted gravity. Without ``stream`` the time is the first sample at which N_A < 0, N_B < 0
+    or μ_required > the scene's friction (the sampling's resolution: a short lift-off
+    between two samples is missed). With the stream that produced ``samples`` (its latest
+    call; a SceneStream or ClosedSceneStream) the dense output is scanned between the
+    samples, every ``resolution`` rad of u at most, up to the first failing sample, and the
+    first sign change of N_A, N_B or μ − μ_required is located by Brent's method (to
+    1e-12 s); ``index`` is then the first sample after it.
     """
+    friction = terms.scene.friction
     forces = terms.forces(samples.phase, samples.phase_rate, samples.phase_acceleration)
-    return check_validity(samples.t, forces, terms.scene.friction)
+    report = check_validity(samples.t, forces, friction)
+    if not hasattr(stream, 'samples_at') or samples.t.size < 2:
+        return report
+    last = samples.t.size - 1 if report.valid else report.index
+    t, u = samples.t[:last + 1], samples.phase[:last + 1]
+    pieces = np.maximum(1, np.ceil(np.abs(np.diff(u)) / resolution)).astype(int)
+    fine = np.concatenate([np.linspace(a, b, k, endpoint=False)
+                           for a, b, k in zip(t[:-1], t[1:], pieces)] + [t[-1:]])
+    names = ['lift-off A', 'lift-off B'] + ([] if math.isinf(friction) else ['slip'])
+
+    def margins(times):
+        s = stream.samples_at(np.atleast_1d(times))
+        f = terms.forces(s.phase, s.phase_rate, s.phase_acceleration)
+        out = [f.normal_a, f.normal_b]
+        if 'slip' in names:
+            out.append(np.clip(friction - f.mu_required, -1e300, 1e300))
+        return np.stack(out)
+    bad = np.flatnonzero(np.any(margins(fine) < 0, axis=0))
+    if bad.size == 0 or bad[0] == 0:
+        return report
+    low, high = float(fine[bad[0] - 1]), float(fine[bad[0]])
+    before, after = margins(low)[:, 0], margins(high)[:, 0]
+    roots = [(brentq(lambda x, k=k: float(margins(x)[k, 0]), low, high, xtol=1e-12), names[k])
+             for k in range(len(names)) if before[k] >= 0 > after[k]]
+    time, kind = min(roots)
+    index = int(np.searchsorted(samples.t, time))
+    if kind == 'slip':
+        reason = (f'the body would slip at t = {time:.9g} s: mu_required reaches mu = '
+                  f'{friction:g}')
+    else:
+        reason = f'contact {kind[-1]} would lift off at t = {time:.9g} s: N_{kind[-1]} = 0'
+    return ValidityReport(False, time, index, kind, reason)

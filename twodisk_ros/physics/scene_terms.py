@@ -105,6 +105,7 @@ class SceneTerms:
         self._build(self.model.nodes)
 
     def _build(self, n):
+        self.table_nodes = n            #: nodes of the tables over one cycle
         body = self.dynamics.body
         u = TWO_PI * np.arange(n) / n
         r1, r2, normal, t1 = (np.real(x) for x in body.phase_vectors(u)[:4])
@@ -139,6 +140,17 @@ class SceneTerms:
             k.real, k.imag, general[:, 6:12], general[:, 12:18], edge.real, edge.imag])
         first = spectral_derivative(columns)
         self._table = HermiteTable.periodic(columns, first, spectral_derivative(first))
+        self._equilibria = None
+        # V = V_p(u) + drift u/2π: the periodic part tabulated once from G's composed
+        # positions, the drift of one cycle composed (exact for a turn of 2π per cycle)
+        v = self.weight * (self.cos_b * height - self.sin_b * self.downhill(u))
+        self.drift = float(self.weight * (self.cos_b * height[0] - self.sin_b * self.downhill(
+            TWO_PI)) - v[0])
+        jet = np.column_stack([m_u, v - self.drift * u / TWO_PI])
+        slope = spectral_derivative(jet)
+        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope)])
+        first = spectral_derivative(jet)
+        self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
 
     # -- the table ----------------------------------------------------------------------------
     def rows(self, u):
@@ -155,11 +167,29 @@ class SceneTerms:
         g = self.cycle.positions(u)[0]
         return np.real(np.exp(1j * self.phi0) * (g[..., 0] + 1j * g[..., 1]))
 
-    def potential(self, u):
-        """V(u) = M g (h cos β − s sin β) (J): G's height along gravity times M g."""
+    def potential_exact(self, u):
+        """V(u) = M g (h cos β − s sin β) (J) from G's composed positions (slow: ~10 µs)."""
         u = np.asarray(u, dtype=float)
         h = self.rows(u)[..., H]
         return self.weight * (self.cos_b * h - self.sin_b * self.downhill(u))
+
+    def energy_jet(self, u, derivative=0):
+        """(m, V, m′, V′, |ω_u|, m″, V″) at u (``derivative=0``) or their derivatives in u
+        (``1``), array u.shape + (7,), from one table of m, of V's periodic part (V = V_p +
+        drift u/2π) and of |ω_u|: the narrow table the closed forms and the samples read."""
+        u = np.asarray(u, dtype=float)
+        table = self._energy_table
+        jet = table.combine(*table.weights(np.mod(u, TWO_PI))) if derivative == 0 else \
+            table(np.mod(u, TWO_PI), derivative)
+        if derivative == 0:
+            jet[..., 1] += self.drift * u / TWO_PI
+        jet[..., 3 - 2 * derivative] += self.drift / TWO_PI
+        return jet
+
+    def potential(self, u):
+        """V(u) = M g (h cos β − s sin β) (J): G's height along gravity times M g (tables;
+        :meth:`potential_exact` from the positions)."""
+        return self.energy_jet(u)[..., 1]
 
     def potential_slope_from(self, u, row):
         """V′(u) (J/rad) from a table row at u."""
@@ -226,8 +256,13 @@ class SceneTerms:
 
         Roots bracketed on the table nodes and refined by Brent's method. V′ is periodic
         (λ = 1 to ~1e-11: the heading turns once per cycle); a slope steeper than the
-        tipping limit has none.
+        tipping limit has none. Computed once (a copy of the list is returned).
         """
+        if self._equilibria is None:
+            self._equilibria = self._find_equilibria()
+        return list(self._equilibria)
+
+    def _find_equilibria(self):
         n = self._table.last_index + 1
         u = TWO_PI * np.arange(n + 1) / n
         slope = self.potential_slope(u)
