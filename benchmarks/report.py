@@ -4,6 +4,7 @@ import math
 
 import ros_layer
 import general_shapes
+import scene_rate
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
 
@@ -228,6 +229,7 @@ def write_report(path, ctx):
     out.extend(ros_layer.report_lines(ctx['ros_layer']))
     out.extend(sweep_scaling.report_lines(ctx['sweep_scaling']))
     out.extend(general_shapes.report_lines(ctx['general_shapes']))
+    out.extend(scene_rate.report_lines(ctx['scene_rate']))
 
     # --- figure
     w('## Work-precision plot\n')

@@ -41,6 +41,7 @@ from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
 import sweep_scaling  # noqa: E402
 import general_shapes  # noqa: E402
+import scene_rate  # noqa: E402
 
 
 def _run(cmd):
@@ -244,6 +245,8 @@ def main(argv=None):
     scaling = sweep_scaling.measure(quick=args.quick, log=log)
     log('bodies of other laminae: the general path beside the closed forms')
     shapes = general_shapes.measure(quick=args.quick, log=log)
+    log('scenes: slopes, drives and losses beside the flat free motion')
+    scenes = scene_rate.measure(quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
 
     # why a target was missed
@@ -310,7 +313,7 @@ def main(argv=None):
                reference_check_rtol=REFERENCE_CHECK_RTOL, closed_form_check=check_text,
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
-               ros_layer=ros, sweep_scaling=scaling, general_shapes=shapes,
+               ros_layer=ros, sweep_scaling=scaling, general_shapes=shapes, scene_rate=scenes,
                commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
                elapsed=elapsed)
     write_report(args.out, ctx)
@@ -329,6 +332,7 @@ def main(argv=None):
                 ros_layer=ros_layer.as_dict(ros),
                 sweep_scaling=scaling,
                 general_shapes=shapes,
+                scene_rate=scenes,
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))
