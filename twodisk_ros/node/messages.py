@@ -79,7 +79,7 @@ def marker(frame_id, time_ns, spec):
 
 #: Marker ids of :func:`body_markers` (namespace ``twodisk``).
 MARKER_IDS = {'outline_1': 0, 'outline_2': 1, 'contact_line': 2, 'disk_1': 3, 'disk_2': 4,
-              'hull': 5}
+              'hull': 5, 'ground': 6}
 #: disk 1 and disk 2 (r, g, b): the package's one palette (plotting/palette.py)
 DISK_COLORS = (palette.rgb(palette.A), palette.rgb(palette.B))
 
@@ -204,3 +204,24 @@ def force_arrows(frame_id, time_ns, points, forces, weight, size):
     """The force arrows as ``Marker`` s (:func:`force_arrow_specs`)."""
     return [marker(frame_id, time_ns, spec)
             for spec in force_arrow_specs(points, forces, weight, size)]
+
+
+def ground_spec(point, slope, size, extent=8.0):
+    """The sloped ground as a TRIANGLE_LIST :class:`MarkerSpec` (id 6, namespace ``twodisk``).
+
+    A square of side ``extent × size`` (m) in the plane through the origin with normal
+    (sin β, 0, cos β) (``frame_id``, gravity-aligned), centred at the foot of ``point`` (G)
+    on it, edges along straight downhill (cos β, 0, −sin β) and across (0, 1, 0); grey, 30 %
+    opaque.
+    """
+    normal = np.array([math.sin(slope), 0.0, math.cos(slope)])
+    downhill = np.array([math.cos(slope), 0.0, -math.sin(slope)])
+    across = np.array([0.0, 1.0, 0.0])
+    point = np.asarray(point, dtype=float)
+    centre = point - float(np.dot(point, normal)) * normal
+    half = 0.5 * extent * size
+    corners = [centre + half * (i * downhill + j * across)
+               for i, j in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    triangles = [corners[0], corners[1], corners[2], corners[0], corners[2], corners[3]]
+    return MarkerSpec('twodisk', MARKER_IDS['ground'], Marker.TRIANGLE_LIST, Marker.ADD,
+                      (1.0, 1.0, 1.0), (0.5, 0.5, 0.5, 0.3), triangles)

@@ -20,6 +20,7 @@ from ..physics.body import TwoDiskBody
 from ..physics.lamina import SUPERELLIPSE_EXPONENT
 from ..physics.mass_models import MODELS, custom, mass_properties
 from ..physics.motion import METHODS, MODES
+from ..physics.scene import DRIVES
 from ..run import shape as shapes
 
 __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
@@ -27,6 +28,7 @@ __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', '
 
 B_OVER_A = (0.01, 100.0)             # allowed b/a
 DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
+SLOPE_MAX = 1.5                      # rad: |slope| allowed (86 deg; pi/2 is a wall)
 
 
 @dataclass(frozen=True)
@@ -48,6 +50,7 @@ class Parameter:
     choices: tuple | None = None
     read_only: bool = False
     physics: bool = False     #: a change restarts the motion
+    scene: bool = False       #: a change continues the motion from its current state
 
     @property
     def rule(self):
@@ -111,6 +114,25 @@ PARAMETERS = (
               'of the cycle', choices=(-1, 1), physics=True),
     Parameter('omega0', float, 3.0, 'rad/s', 'initial signed angular speed; + means theta '
               'increasing on branch +1', -1e3, 1e3, physics=True),
+    Parameter('slope', float, 0.0, 'rad', 'inclination of the ground (0: horizontal); poses '
+              'stay in frame_id, z up against gravity, x the horizontal of straight downhill',
+              -SLOPE_MAX, SLOPE_MAX, physics=True),
+    Parameter('heading0', float, 0.0, 'rad', 'heading of the mean travel (increasing phase) '
+              'from straight downhill, towards +y (+-pi/2: across the slope)',
+              -math.pi, math.pi, physics=True),
+    Parameter('drive', str, 'none', '', 'none (free motion), speed (the signed angular speed '
+              'follows cmd_speed with the first-order lag drive_lag; until the first command it '
+              'holds its speed) or torque (cmd_torque about the axis AB, 0 until commanded); '
+              'only with mode dynamic', choices=DRIVES, scene=True),
+    Parameter('drive_lag', float, 0.1, 's', 'time constant T of the speed drive: '
+              'd|omega|/dt = (cmd_speed - omega)/T', 1e-3, 1e3, scene=True),
+    Parameter('cmd_timeout', float, 0.5, 's', 'simulated time without a new command after '
+              'which the body returns to free motion (0: never)', 0.0, 1e6),
+    Parameter('rolling_resistance', float, 0.0, '', 'coefficient mu_r of a torque '
+              'mu_r (N_A + N_B) rho about AB against the rolling, rho the distance of G from AB',
+              0.0, 1.0, scene=True),
+    Parameter('damping', float, 0.0, 'N m s', 'viscous torque -damping * omega', 0.0, 1e6,
+              scene=True),
     Parameter('friction', float, 0.5, '', 'friction coefficient mu between body and ground '
               '(.inf: no limit); slip where the motion needs more is outside the rolling '
               'model', 0.0, math.inf),
@@ -225,6 +247,9 @@ def _check_together(s, outline=None):
         s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
     elif s.mass_model == 'custom':
         custom(s.mass, s.principal_moments)   # the triangle inequalities (any shape)
+    if s.drive != 'none' and s.mode != 'dynamic':
+        raise ValueError(f'drive {s.drive} needs mode dynamic (mode kinematic is the speed '
+                         f'drive holding |omega0|), got mode {s.mode!r}')
 
 
 def _check_body_frame(body_frame, frame_id):
@@ -293,6 +318,12 @@ class _SettingsMethods:
             unread |= {'a', 'b'}
         return any(getattr(self, p.name) != getattr(other, p.name)
                    for p in PARAMETERS if p.physics and p.name not in unread)
+
+    def scene_differs(self, other):
+        """True if a parameter that changes the scene but continues the motion differs
+        (``drive``, ``drive_lag``, ``rolling_resistance``, ``damping``)."""
+        return any(getattr(self, p.name) != getattr(other, p.name)
+                   for p in PARAMETERS if p.scene)
 
 
 #: Settings of the node (SI units): a frozen dataclass with one field per parameter.

@@ -29,16 +29,19 @@ from sensor_msgs.msg import JointState
 from visualization_msgs.msg import MarkerArray
 
 from rosgraph_msgs.msg import Clock
+from std_msgs.msg import String
 
 from .. import __version__
 from ..io import McapRecorder, cdr
 from ..outputs import check_output
 from ..io.cdr_markers import encode_markers
-from . import messages, run_summary, schedule, sim_clock
+from . import diagnostics, encoding, messages, run_summary, schedule, sim_clock
 from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
 from .descriptors import descriptor, ros_value
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
 from .path_history import PathHistory
+from .scene_control import EVENTS_QOS, SceneControl
+from .scene_simulation import frame_metadata
 from .simulation import Simulation
 from ..physics.startup import startup_estimate
 from ..run.description import RunDescription
@@ -103,6 +106,7 @@ class Roller(Node):
         if description.problem:
             self.get_logger().warn(description.problem)
         self._latched = LatchedTopics(self, description)
+        self.control = SceneControl(self)
         try:
             if self.settings.record:
                 self._open_recorder()
@@ -116,7 +120,7 @@ class Roller(Node):
         """The counters, history, clocks and callbacks of a run (after the recorder)."""
         self.samples_published = 0      # samples since start (across motion restarts)
         self.samples_dropped = 0        # realtime samples skipped to catch up with the clock
-        self._dropped_reported = 0      # samples_dropped at the last diagnostics
+        self.dropped_reported = 0      # samples_dropped at the last diagnostics
         self.messages_built = {topic: 0 for topic in self._pubs}
         self._history = PathHistory(self.settings.path_length)
         self._tick = 0                  # global sample index: simulated time tick / rate
@@ -124,10 +128,12 @@ class Roller(Node):
         self._next = {'path': 0.0, 'marker': 0.0, 'diagnostics': 0.0}
         self._pending = None
         self._block = None              # realtime: (first tick, Sample, encoded messages)
+        self._last = None               # (Sample, index, tick) of the last sample published
+        self._pause_wall = None         # wall time (monotonic, s) the pause began
         self._start_ns = self.get_clock().now().nanoseconds
         self._wall_start = time.monotonic()
         self._rate_window = deque(maxlen=64)   # (wall time, samples) for the achieved rate
-        self._lag = deque(maxlen=1000)          # s: wall clock minus the last sample's time
+        self.lag = deque(maxlen=1000)          # s: wall clock minus the last sample's time
         self.finished = False
         self.add_on_set_parameters_callback(self._on_set_parameters)
         if self.settings.realtime:
@@ -145,6 +151,7 @@ class Roller(Node):
             for topic, publisher in self._latched.publishers.items():
                 self._recorder.add_topic(publisher.topic_name, publisher.msg_type,
                                          publisher.qos_profile)
+            self._recorder.add_topic(self.control.publisher.topic_name, String, EVENTS_QOS)
         except BaseException:      # also a start-up cut short by a second signal
             if self._recorder is not None:
                 self._recorder.discard()
@@ -154,12 +161,22 @@ class Roller(Node):
     @property
     def pending_changes(self):
         """True while accepted parameter changes wait for the next sample."""
-        return self._pending is not None
+        return self._pending is not None or self.control.pending
+
+    @property
+    def recorder(self):
+        """The McapRecorder of ``record``, or None."""
+        return self._recorder
+
+    def stamp_of(self, tick):
+        """The stamp (int ns) of global tick ``tick``."""
+        return int(schedule.stamps(self._start_ns, [tick], self.settings.rate)[0])
 
     def _metadata(self):
         """The recording's metadata: the run's (parameters, a points run's outline)."""
         metadata = self.simulation.run.metadata()
         metadata.update(self.settings.as_strings())   # (friction, frames: changed in place)
+        metadata.update(frame_metadata(self.settings))
         metadata['version'] = __version__
         return metadata
 
@@ -188,17 +205,23 @@ class Roller(Node):
 
     def _apply_pending(self):
         (candidate, simulation, description), self._pending = self._pending, None
-        self.settings = candidate
+        previous, self.settings = self.settings, candidate
         if description.problem:
             self.get_logger().warn(description.problem, throttle_duration_sec=60.0)
         self._latched.take(description)
         self._history.length = candidate.path_length
         if simulation is not None:
-            self.simulation = simulation
-            self._motion_tick = self._tick
-            self._block = None
-            self._history.clear()
-            self._next['diagnostics'] = self._tick / self.settings.rate
+            self.control.forget_command()
+            self._restart(simulation)
+            self.control.event('restart', self._tick)
+        elif candidate.scene_differs(previous):
+            if candidate.drive != previous.drive:
+                self.control.forget_command()
+            self.continue_motion(*self.control.drive_state())
+            changed = [p.name for p in PARAMETERS if p.scene
+                       and getattr(candidate, p.name) != getattr(previous, p.name)]
+            self.control.event('scene ' + ' '.join(
+                f'{name}={getattr(candidate, name)}' for name in changed), self._tick)
         else:   # the same motion; friction, frame or path length may have changed
             self.simulation.update(candidate)
             if self._block is not None:     # the prepared samples, encoded again
@@ -206,6 +229,32 @@ class Roller(Node):
                 self._block = (first, sample, stamps, self._encode(first, sample, stamps))
         if self._recorder is not None:
             self._recorder.set_metadata(self._metadata())
+
+    def _restart(self, simulation):
+        self.simulation = simulation
+        self._motion_tick = self._tick
+        self._block = self._last = None
+        self._history.clear()
+        self._next['diagnostics'] = self._tick / self.settings.rate
+
+    def restart_motion(self):
+        """The motion from the initial state of the current parameters, at the next tick."""
+        self._restart(type(self.simulation)(self.settings, self.simulation.run))
+
+    def continue_motion(self, drive, command=None):
+        """The motion continued from the last published sample under ``drive``/``command``
+        and the current settings (from the start if no sample of this motion is out yet)."""
+        if self._last is None:
+            self.simulation = type(self.simulation)(
+                self.settings, self.simulation.run if self.simulation.run.settings
+                == self.settings else None, drive=drive, command=command)
+            self._motion_tick = self._tick
+        else:
+            sample, i, tick = self._last
+            self.simulation = self.simulation.continued(self.settings, sample, i,
+                                                        drive=drive, command=command)
+            self._motion_tick = tick
+        self._block = None
 
     # -- computing and publishing -----------------------------------------------------------
     def _wanted(self, topic):
@@ -227,39 +276,12 @@ class Roller(Node):
         return sample, stamps, self._encode(first, sample, stamps)
 
     def _encode(self, first, sample, stamps):
-        """CDR bytes of the per-sample topics somebody wants: {topic: [bytes per sample]}.
-
-        ``first``: the global tick of the block's first sample. /clock comes first (it is
-        published before each sample's messages) and may skip samples (None).
-        """
-        frame = self.settings.frame_id
-        encoded = {}
-        if self._pubs[sim_clock.CLOCK_TOPIC].get_subscription_count() > 0:
-            column = sim_clock.encode_clock_column(first, stamps,
-                                                   sim_clock.clock_step(self.settings.rate))
-            encoded[sim_clock.CLOCK_TOPIC] = column
-            self.messages_built[sim_clock.CLOCK_TOPIC] += sum(x is not None for x in column)
-        encoders = {
-            'pose': lambda: cdr.encode_pose_stamped(stamps, frame, sample.position_g,
-                                                    sample.quaternion),
-            TF_TOPIC: lambda: cdr.encode_tf_message(stamps, frame, self.settings.body_frame,
-                                                    sample.position_g, sample.quaternion),
-            'contact_a': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_a),
-            'contact_b': lambda: cdr.encode_point_stamped(stamps, frame, sample.contact_b),
-            'rolling_state': lambda: cdr.encode_joint_state(
-                stamps, messages.JOINT_NAMES,
-                np.column_stack([sample.theta, sample.psi, sample.phase]),
-                np.column_stack([sample.theta_rate, sample.psi_rate, sample.phase_rate])),
-        }
-        if sample.forces is not None:   # (a subscriber may appear after the sampling)
-            encoders['wrench_a'] = lambda: cdr.encode_wrench_stamped(stamps, frame,
-                                                                     sample.forces.force_a)
-            encoders['wrench_b'] = lambda: cdr.encode_wrench_stamped(stamps, frame,
-                                                                     sample.forces.force_b)
-        for topic, encode in encoders.items():
-            if self._wanted(topic):
-                encoded[topic] = encode()
-                self.messages_built[topic] += len(encoded[topic])
+        """CDR bytes of the per-sample topics somebody wants (:func:`encoding.encode_block`)."""
+        encoded, built = encoding.encode_block(
+            first, sample, stamps, self.settings, self._wanted,
+            self._pubs[sim_clock.CLOCK_TOPIC].get_subscription_count() > 0)
+        for topic, count in built.items():
+            self.messages_built[topic] += count
         return encoded
 
     def _emit(self, sample, stamps, encoded, start, stop):
@@ -287,6 +309,7 @@ class Roller(Node):
                              sample.contact_b[start:stop], sample.position_g[start:stop])
         self._tick += stop - start
         self.samples_published += stop - start
+        self._last = (sample, stop - 1, self._tick - 1)
 
     def _low_rate_topics(self, sample, stamps, start, stop):
         """Paths, markers and diagnostics of samples [start, stop), each at its own rate."""
@@ -340,6 +363,9 @@ class Roller(Node):
                 (sample.contact_a[i], sample.contact_b[i]),
                 (sample.forces.force_a[i], sample.forces.force_b[i]), self.simulation.weight,
                 self.simulation.body.size)
+        if self.settings.slope != 0.0:
+            specs.append(messages.ground_spec(sample.position_g[i], self.settings.slope,
+                                              self.simulation.body.size))
         self._send('markers', encode_markers(time_ns, self.settings.frame_id, specs), time_ns)
 
     def achieved_rate(self):
@@ -350,45 +376,10 @@ class Roller(Node):
         return (k1 - k0) / (w1 - w0) if w1 > w0 else None
 
     def _publish_diagnostics(self, sample, i, time_ns):
-        if not self._wanted('/diagnostics'):
-            return
-        s = self.settings
-        name, value, drift = self.simulation.invariant(sample, i)
-        level, message = messages.OK, 'rolling'
-        if drift > s.tolerance:
-            level, message = messages.WARN, (f'{name} drift {drift:.2e} exceeds tolerance '
-                                              f'{s.tolerance:.1e}')
-        achieved = self.achieved_rate()
-        dropped_lately = self.samples_dropped - self._dropped_reported
-        self._dropped_reported = self.samples_dropped
-        slow = achieved is not None and achieved < 0.95 * s.rate
-        if s.realtime and (slow or dropped_lately) and level < messages.ERROR:
-            level = messages.WARN
-            rate_text = f'achieved {achieved:.4g} Hz, ' if achieved is not None else ''
-            message = (f'cannot hold rate {s.rate:g} Hz: {rate_text}{dropped_lately} samples '
-                       f'dropped since the last report ({self.samples_dropped} in all) to keep '
-                       'real time')
-        contact_level, contact_message, contact_values = self.simulation.contact_status(
-            sample, i)
-        if contact_level > level:
-            level, message = contact_level, contact_message
-        values = [(name, value), (f'{name}_drift', drift),
-                  ('energy', self.simulation.energy(sample, i)),
-                  ('tilt', float(self.simulation.dynamics.cycle.state(sample.phase[i]).tilt)),
-                  ('phase', float(sample.phase[i])), ('mode', s.mode), ('method', s.method),
-                  ('rate', s.rate), ('achieved_rate', achieved if achieved else s.rate),
-                  ('clock_lag', float(np.mean(self._lag)) if self._lag else 0.0),
-                  ('samples_dropped', self.samples_dropped)] + contact_values
-        if name != 'energy':
-            values = [v for v in values if v[0] != 'energy'] + [
-                ('energy', self.simulation.energy(sample, i))]
-        for k, (eq, period) in enumerate(self.simulation.equilibria):
-            values.append((f'equilibrium {k}', (
-                f'{eq.name}: theta={eq.theta:.9g} rad, psi={eq.psi:.9g} rad, '
-                f'height={eq.height:.9g} m, d2z/d{eq.coordinate}2={eq.curvature:.6g} m, '
-                f'{eq.stability}' + (f', period={period:.9g} s' if period else ''))))
-        self._send('/diagnostics', cdr.serialize(messages.diagnostics(
-            time_ns, 'twodisk_ros: roller', level, message, values)), time_ns)
+        if self._wanted('/diagnostics'):
+            level, message, values = diagnostics.status(self, sample, i)
+            self._send('/diagnostics', cdr.serialize(messages.diagnostics(
+                time_ns, diagnostics.NAME, level, message, values)), time_ns)
 
     # -- the two ways to run ----------------------------------------------------------------
     def _on_timer(self):
@@ -405,6 +396,14 @@ class Roller(Node):
         due = int(math.floor((now - self._wall_start) * rate)) + 1   # ticks due so far
         if self._pending is not None:
             self._apply_pending()
+        for paused in self.control.apply(self._tick):
+            if paused:
+                self._pause_wall = now
+            elif self._pause_wall is not None:     # the schedule moves on by the pause
+                self._wall_start += now - self._pause_wall
+                due = int(math.floor((now - self._wall_start) * rate)) + 1
+        if self.control.paused:
+            return
         limit = self._end_tick()
         if limit is not None:
             due = min(due, limit)
@@ -419,11 +418,13 @@ class Roller(Node):
                 f'({self.samples_dropped} so far) to keep real time',
                 throttle_duration_sec=5.0)
         while self._tick < due:
+            self.control.check_timeout(self._tick)
             block = self._block
             if block is None or not block[0] <= self._tick < block[0] + len(block[1]):
                 count = max(1, int(AHEAD * rate), due - self._tick)
                 if limit is not None:
                     count = min(count, limit - self._tick)
+                count = self.control.limit(self._tick, count)
                 self._block = block = (self._tick, *self._prepare(self._tick, count))
             first, sample, stamps, encoded = block
             start = self._tick - first
@@ -431,7 +432,7 @@ class Roller(Node):
             self._emit(sample, stamps, encoded, start, stop)
         self._rate_window.append((now, self.samples_published))
         if self._tick:   # how far the newest published sample's time trails the wall clock
-            self._lag.append(now - self._wall_start - (self._tick - 1) / rate)
+            self.lag.append(now - self._wall_start - (self._tick - 1) / rate)
         if limit is not None and self._tick >= limit:
             self.finished = True
 

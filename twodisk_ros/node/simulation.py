@@ -14,6 +14,7 @@ from ..model.outline import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
 from ..run.description import RunDescription
+from .scene_simulation import SceneMotion, flat_free
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
 
@@ -65,6 +66,7 @@ class Sample:
     contact_b: np.ndarray
     quaternion: np.ndarray
     forces: object = None      #: ContactForces of the block (None if not asked for)
+    scene: object = None       #: SceneValues (energy balance, drive) of a scene's motion
 
     def __len__(self):
         return len(self.t)
@@ -79,6 +81,13 @@ class Simulation:
         Checked settings.
     run : RunDescription, optional
         The description of these settings if already built (else built here).
+    drive, command, start, carry, terms
+        A scene's motion (:class:`~twodisk_ros.node.scene_simulation.SceneMotion`): the drive
+        in force and its command, the state (u, u̇) at t = 0 (None: ``theta0``), the work
+        done before and the balance's E₀, reused tables. Today's path is taken where the
+        settings are flat, free and conservative and ``start`` is None.
+    orientation : array (4,), optional
+        The last quaternion published before (the signs stay continuous).
 
     Raises
     ------
@@ -86,21 +95,83 @@ class Simulation:
         If the settings define no motion that can be simulated (one-line message).
     """
 
-    def __init__(self, settings, run=None):
+    def __init__(self, settings, run=None, *, drive=None, command=None, start=None,
+                 carry=None, terms=None, orientation=None):
         if run is None or run.settings != settings:
             run = RunDescription(settings)
         self.run = run
         s = self.settings = run.settings
         self.body = run.body
         self.dynamics = run.dynamics
-        self.stream = run.stream()
-        self.equilibria = self.dynamics.equilibria_with_periods()
-        self.energy0 = self.stream.initial_energy
-        self.angular_speed0 = abs(s.omega0)
         self.forces = ContactForceModel(self.dynamics)
         self.weight = self.dynamics.mass.mass * self.dynamics.gravity   # M g (N)
         self.invalid = None        # ValidityReport of the first sample outside the model
-        self._last_quaternion = None
+        self._last_quaternion = orientation
+        self.angular_speed0 = abs(s.omega0)
+        #: None on today's path, else the SceneMotion of this stretch
+        self.scene = None
+        if start is None and flat_free(s):
+            self.stream = run.stream()
+            self.start = None
+        else:
+            self.start = run.start() if start is None else start
+            self.scene = SceneMotion(self.dynamics, s, self.forces, drive=drive,
+                                     command=command, start=self.start, carry=carry,
+                                     terms=terms)
+            self.stream = self.scene.stream
+            self.invalid = self.scene.standing_report()
+        self.energy0 = (self.stream.initial_energy if self.scene is None
+                        else self.scene.energy0)
+        if start is None:
+            self.equilibria     # (computed before the first sample, not during it)
+
+    @property
+    def equilibria(self):
+        """[(Equilibrium, period or None)] of the flat ground (empty in a scene on a slope:
+        :meth:`equilibrium_values` gives the rest poses there)."""
+        if self.scene is not None and self.settings.slope != 0.0:
+            return []
+        if '_equilibria' not in self.__dict__:
+            self.__dict__['_equilibria'] = self.dynamics.equilibria_with_periods()
+        return self.__dict__['_equilibria']
+
+    def equilibrium_values(self):
+        """[(key, text)] of the rest poses, for the diagnostics."""
+        if self.scene is not None and self.settings.slope != 0.0:
+            return self.scene.equilibrium_values()
+        return [(f'equilibrium {k}', (
+            f'{eq.name}: theta={eq.theta:.9g} rad, psi={eq.psi:.9g} rad, '
+            f'height={eq.height:.9g} m, d2z/d{eq.coordinate}2={eq.curvature:.6g} m, '
+            f'{eq.stability}' + (f', period={period:.9g} s' if period else '')))
+            for k, (eq, period) in enumerate(self.equilibria)]
+
+    def continued(self, settings, sample, i, *, drive=None, command=None):
+        """A Simulation of ``settings`` (same motion parameters) continuing from sample i.
+
+        Its t = 0 is sample i's time; the energy balance, the first failure found and the
+        orientation's sign carry over. ``drive``/``command``: the drive in force from now.
+        """
+        if settings.physics_differs(self.settings):
+            raise ValueError('these settings change the motion: build a new Simulation')
+        values = sample.scene
+        if values is not None:
+            carry = (values.dissipated[i], values.drive_work[i], self.energy0)
+        else:
+            carry = (0.0, 0.0, self.energy0)
+        nxt = Simulation(settings, self.run if self.run.settings == settings else None,
+                         drive=drive, command=command,
+                         start=(sample.phase[i], sample.phase_rate[i]), carry=carry,
+                         terms=self.scene.terms if self.scene is not None else None,
+                         orientation=sample.quaternion[i])
+        if self.invalid is not None and settings.friction == self.settings.friction:
+            nxt.invalid = self.invalid
+        if '_equilibria' in self.__dict__:
+            nxt.__dict__['_equilibria'] = self.__dict__['_equilibria']
+        return nxt
+
+    def initial_state(self):
+        """(u0, u̇0): the phase and phase rate this stretch starts from."""
+        return self.run.start() if self.start is None else self.start
 
     def sample(self, t, forces=False, time_offset=0.0):
         """Everything published at simulated times t (s, increasing array, after earlier ones).
@@ -110,6 +181,8 @@ class Simulation:
         time reported as ``t + time_offset`` (s, the node's simulated time).
         """
         t = np.asarray(t, dtype=float)
+        if self.scene is not None:
+            return self._scene_sample(t, forces, time_offset)
         u, u_dot = self.stream.sample(t)
         poses = self.dynamics.cycle.poses(u)
         quaternion = continuous_quaternions(poses.quaternion, self._last_quaternion)
@@ -120,14 +193,32 @@ class Simulation:
         if forces:
             contact = (self.forces.kinematic(u, self.angular_speed0)
                        if self.settings.mode == 'kinematic' else self.forces.dynamic(u, u_dot))
-            if self.invalid is None and len(t):
-                report = check_validity(t + time_offset, contact, self.settings.friction)
-                if not report.valid:
-                    self.invalid = report
+            self._check(t + time_offset, contact)
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,
                       position_g=poses.position_g, contact_a=poses.contact_a,
                       contact_b=poses.contact_b, quaternion=quaternion, forces=contact)
+
+    def _check(self, times, contact):
+        if self.invalid is None and len(times):
+            report = check_validity(times, contact, self.settings.friction)
+            if not report.valid:
+                self.invalid = report
+
+    def _scene_sample(self, t, forces, time_offset):
+        u, u_dot, u_ddot, values, (g, a, b, q) = self.scene.sample(t)
+        quaternion = continuous_quaternions(q, self._last_quaternion)
+        if len(quaternion):
+            self._last_quaternion = quaternion[-1]
+        theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
+        contact = None
+        if forces:
+            contact = self.scene.forces(u, u_dot, u_ddot)
+            self._check(t + time_offset, contact)
+        return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
+                      theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot, position_g=g,
+                      contact_a=a, contact_b=b, quaternion=quaternion, forces=contact,
+                      scene=values)
 
     def update(self, settings):
         """Take settings that leave the motion unchanged (e.g. friction, frame_id).
@@ -168,6 +259,10 @@ class Simulation:
         omega0 = 0). Energy is not conserved there: the motor does work.
         """
         u, u_dot = sample.phase[i], sample.phase_rate[i]
+        if sample.scene is not None:
+            balance = float(sample.scene.balance[i])
+            return ('energy_balance', balance,
+                    abs(balance - self.energy0) / self.dynamics.energy_scale)
         if self.settings.mode == 'kinematic':
             speed = float(self.dynamics.tabulated(u)[2] * abs(u_dot))
             scale = self.angular_speed0 if self.angular_speed0 > 0 else 1.0
@@ -177,6 +272,8 @@ class Simulation:
 
     def energy(self, sample, i):
         """E (J) at sample i."""
+        if sample.scene is not None:
+            return float(sample.scene.energy[i])
         return float(self.dynamics.energy(sample.phase[i], sample.phase_rate[i]))
 
     def rotation(self, sample, i):

@@ -1,0 +1,194 @@
+"""The node's motion in a scene other than the flat free one (no rclpy here).
+
+:class:`~twodisk_ros.node.simulation.Simulation` keeps today's path (its MotionStream, poses
+and contact forces, bit for bit) where the settings describe the flat, free, conservative
+scene and the motion starts at ``theta0``; everything else is a :class:`SceneMotion`: the
+scene's stream (:func:`~twodisk_ros.physics.scene_motion.scene_stream`, or the integrator of
+the speed drive), poses and ground forces in the gravity-aligned ``frame_id``
+(:class:`~twodisk_ros.physics.scene_terms.SceneTerms`), and the energy balance
+E + W − W_d = E₀ carried across commands, time-outs and runtime scene changes (each continues
+the motion from the state of the last published sample, in a new stretch).
+
+Commands (docs/physics.md "Scenes", README "Driving the body"): the speed drive's command is
+the signed angular speed Ω (rad/s; the sign of ``omega0``: + for increasing phase), followed
+with the first-order lag dΩ/dt = (Ω_cmd − Ω)/``drive_lag``; the torque drive's is the torque
+τ (N m) about the axis AB, positive in the sense of that rotation. Until its first command
+the speed drive holds the speed it starts from and the torque drive gives 0 N m.
+"""
+
+from copy import copy
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from ..physics.contact_validity import ValidityReport
+from ..physics.scene import Scene
+from ..physics.scene_motion import SceneStream, scene_stream
+from ..physics.scene_terms import SceneTerms
+
+__all__ = ['SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues', 'flat_free',
+           'frame_metadata', 'ground_normal', 'scene_of']
+
+#: rad/s: the largest |cmd_speed| (the range of omega0)
+SPEED_LIMIT = 1e3
+#: N m: the largest |cmd_torque|
+TORQUE_LIMIT = 10.0
+
+
+def flat_free(settings):
+    """True if the settings describe today's scene: no slope, drive or dissipation."""
+    s = settings
+    return (s.slope == 0.0 and s.drive == 'none' and s.rolling_resistance == 0.0
+            and s.damping == 0.0)
+
+
+def scene_of(settings, drive=None, command=None, speed=0.0):
+    """The :class:`~twodisk_ros.physics.scene.Scene` of the settings with the drive in force.
+
+    ``drive``: 'none', 'speed' or 'torque' (default ``settings.drive``); ``command``: its
+    command (rad/s or N m), None for none yet: the speed drive then holds ``speed`` (the
+    signed angular speed it starts from, rad/s), the torque drive gives 0 N m. Mode kinematic
+    is the speed drive holding ``omega0``; a torque of 0 N m is free motion.
+    """
+    s = settings
+    drive = s.drive if drive is None else drive
+    if command is None:
+        command = speed if drive == 'speed' else 0.0
+    if s.mode == 'kinematic':
+        drive, command = 'speed', s.omega0
+    if drive == 'none' or (drive == 'torque' and command == 0.0):
+        drive, command = 'none', 0.0
+    return Scene(slope=s.slope, heading0=s.heading0, gravity=s.gravity, drive=drive,
+                 command=command, lag=s.drive_lag, rolling_resistance=s.rolling_resistance,
+                 damping=s.damping, friction=s.friction, speed_limit=SPEED_LIMIT,
+                 torque_limit=TORQUE_LIMIT)
+
+
+def ground_normal(slope):
+    """The ground's unit normal (sin β, 0, cos β) in ``frame_id`` (gravity-aligned)."""
+    return np.array([math.sin(slope), 0.0, math.cos(slope)])
+
+
+def frame_metadata(settings):
+    """The recording's text entries on the slope frame and the events topic."""
+    half = 0.5 * settings.slope
+    return {
+        'slope_frame': 'x straight downhill in the ground, z the ground normal (up), '
+                       'y = z cross x; a slope-frame vector p is R_y(slope) p in frame_id, '
+                       'the rotation of slope_to_frame_id; the ground is the plane through '
+                       'the origin of frame_id with normal ground_normal',
+        'slope_to_frame_id': repr([0.0, math.sin(half), 0.0, math.cos(half)]) +
+                             ' (quaternion x, y, z, w)',
+        'ground_normal': repr([float(x) for x in ground_normal(settings.slope)]),
+        'events_topic': 'events (std_msgs/String: reset, pause, resume, command <drive> '
+                        '<value>, timeout, scene <changes>, restart; stamped with the first '
+                        'sample each applies to)',
+    }
+
+
+@dataclass
+class SceneValues:
+    """The energy terms of a block of samples (arrays over the block, J, N m, W)."""
+
+    energy: np.ndarray          #: E = T + V, V = M g × G's height along gravity (J)
+    dissipated: np.ndarray      #: W: work done against damping and rolling resistance (J)
+    drive_work: np.ndarray      #: W_d: work done by the drive (J)
+    drive_torque: np.ndarray    #: τ about AB (N m); 0 without drive
+    power: np.ndarray           #: the drive's power (W)
+
+    @property
+    def balance(self):
+        """E + W − W_d (J): E₀ along the whole run (between resets)."""
+        return self.energy + self.dissipated - self.drive_work
+
+
+class SceneMotion:
+    """One stretch of a scene's motion, from a state, with the work done before it.
+
+    Parameters
+    ----------
+    dynamics : RollingDynamics
+    settings : RollerSettings
+    model : ContactForceModel
+        Reused by the scene's tables.
+    drive, command : str, float or None
+        The drive in force and its command (:func:`scene_of`; None: none yet).
+    start : (float, float)
+        (u (rad), u̇ (rad/s)) at the stretch's t = 0.
+    carry : (float, float, float), optional
+        (W, W_d, E₀) (J) at the stretch's start: the work done before it and the energy
+        balance's constant; None for the start of a run.
+    terms : SceneTerms, optional
+        The tables of an earlier stretch with the same slope, heading and gravity (reused).
+    """
+
+    def __init__(self, dynamics, settings, model, *, drive=None, command=None, start,
+                 carry=None, terms=None):
+        u0, u_dot0 = (float(x) for x in start)
+        speed = u_dot0 * float(dynamics.angular_speed_per_phase(u0))
+        self.scene = scene = scene_of(settings, drive, command, speed)
+        if terms is None or (terms.scene.slope, terms.scene.heading0) != (scene.slope,
+                                                                          scene.heading0):
+            terms = SceneTerms(dynamics, scene, model)
+        else:                     # the same ground and gravity: the tables are the same
+            terms = copy(terms)
+            terms.scene = scene
+        self.terms = terms
+        if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
+            self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance)
+        else:
+            self.stream = scene_stream(dynamics, scene, u0, u_dot0, method=settings.method,
+                                       tolerance=settings.tolerance, terms=terms)
+        energy = float(terms.energy(u0, u_dot0))
+        self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x) for x in carry)
+        self.energy0 = self.carry[2]
+        self.standing = (True, '')
+        if carry is None and scene.slope != 0.0:
+            self.standing = terms.standing()
+
+    @property
+    def solver(self):
+        """The stream's solver ('quadrature', 'libration', 'DOP853', ...)."""
+        return self.stream.solver
+
+    def sample(self, t):
+        """(u, u̇, ü, SceneValues, (G, A, B, q)) at times t (s, increasing)."""
+        t = np.asarray(t, dtype=float)
+        w0, wd0, _ = self.carry
+        if hasattr(self.stream, 'samples'):
+            s = self.stream.samples(t)
+            u, u_dot, u_ddot = s.phase, s.phase_rate, s.phase_acceleration
+            values = SceneValues(s.energy, s.dissipated + w0, s.drive_work + wd0,
+                                 s.drive_torque, s.power)
+        else:         # today's MotionStream (flat, free, conservative from here on)
+            u, u_dot = self.stream.sample(t)
+            m, v, dm, dv = np.moveaxis(self.terms.energy_jet(u)[..., :4], -1, 0)
+            u_ddot = -(0.5 * dm * u_dot**2 + dv) / m
+            zero = np.zeros(t.shape)
+            values = SceneValues(0.5 * m * u_dot**2 + v, zero + w0, zero + wd0, zero, zero)
+        return u, u_dot, u_ddot, values, self.terms.poses(u)
+
+    def forces(self, u, u_dot, u_ddot):
+        """The ground's forces (:class:`~twodisk_ros.physics.scene_terms.SceneForces`)."""
+        return self.terms.forces(u, u_dot, u_ddot)
+
+    def standing_report(self):
+        """A ValidityReport at t = 0 if the body cannot stand on this slope, else None."""
+        ok, why = self.standing
+        if ok:
+            return None
+        return ValidityReport(False, 0.0, 0, 'standing', f'{why} (from t = 0)')
+
+    def equilibrium_values(self):
+        """[(key, text)] of the rest poses on the slope, for the diagnostics."""
+        values = []
+        body = self.terms.dynamics.body
+        for k, eq in enumerate(self.terms.equilibria()):
+            theta = float(np.real(body.phase_angles_with_rates(eq.phase)[0]))
+            period = f', period={eq.period:.9g} s' if math.isfinite(eq.period) else ''
+            values.append((f'equilibrium {k}', (
+                f'on the slope: u={eq.phase:.9g} rad, theta={theta:.9g} rad, '
+                f'{"stable" if eq.stable else "unstable"}, N_A={eq.normal_a:.6g} N, '
+                f'N_B={eq.normal_b:.6g} N, mu_required={eq.mu_required:.4g}{period}')))
+        return values
