@@ -92,6 +92,8 @@ class Roller(Node):
         if cost.message:      # an extreme body: say what the tables cost while it is paid
             self.get_logger().info(cost.message)
         self.simulation = Simulation(self.settings, run)
+        if self.simulation.invalid is not None:    # a slope the body cannot stand on
+            self.get_logger().error(self.simulation.invalid.reason)
         if self.settings.method == 'table' and self.simulation.stream.solver == 'DOP853':
             self.get_logger().info(
                 'no closed form of this motion is resolved (a start just below the barrier '

@@ -1,0 +1,189 @@
+"""The roller in scenes: slope, drive, dissipation, commands, reset and pause.
+
+References are independent of the node's scene code: today's MotionStream (flat, free),
+the closed-form body geometry (|ω| = |ω_u(u)| u̇ and the contact points of TwoDiskBody), the
+rigid-body kinematics of the recorded poses (finite differences) and the documented rules
+(first-order lag of the speed drive, dE/dt = τ|ω| of the torque drive). Batch runs in process
+in ROS domain 68; the realtime integration test drives the node from a second rclpy node in
+domain 67.
+"""
+
+import os
+
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+
+import math  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.mass_models import laminae  # noqa: E402
+from twodisk_ros.physics.motion import MotionStream  # noqa: E402
+
+pytestmark = pytest.mark.ros
+BATCH_DOMAIN, LIVE_DOMAIN = 68, 67
+BODY = TwoDiskBody(0.1, 0.1, 0.05)
+DYNAMICS = RollingDynamics(BODY, laminae(0.1, 0.1, 0.05, 1.0))
+
+
+@pytest.fixture(scope='module')
+def context():
+    import rclpy
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=BATCH_DOMAIN)
+    yield ctx
+    rclpy.try_shutdown(context=ctx)
+
+
+def record(context, path, **values):
+    from rclpy.parameter import Parameter
+    from twodisk_ros.node.roller import Roller
+    overrides = [Parameter('realtime', value=False), Parameter('record', value=str(path))]
+    overrides += [Parameter(k, value=v) for k, v in values.items()]
+    node = Roller(context=context, parameter_overrides=overrides)
+    try:
+        node.run_batch()
+    finally:
+        node.close()
+        node.destroy_node()
+    return read_recording(path)
+
+
+def by_topic(recording, name):
+    return [m.msg for m in recording.messages if m.topic.rsplit('/', 1)[-1] == name]
+
+
+def stamp(msg):
+    return msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+
+
+def states(recording):
+    """(stamps (ns), u, u̇) of rolling_state."""
+    msgs = by_topic(recording, 'rolling_state')
+    return (np.array([stamp(m) for m in msgs]), np.array([m.position[2] for m in msgs]),
+            np.array([m.velocity[2] for m in msgs]))
+
+
+def poses(recording):
+    msgs = by_topic(recording, 'pose')
+    g = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in msgs])
+    q = np.array([[m.pose.orientation.x, m.pose.orientation.y, m.pose.orientation.z,
+                   m.pose.orientation.w] for m in msgs])
+    return g, q
+
+
+def points(recording, name):
+    return np.array([[m.point.x, m.point.y, m.point.z] for m in by_topic(recording, name)])
+
+
+def speed(u, u_dot):
+    """|ω| signed (rad/s): the closed-form |ω_u(u)| of the body times u̇."""
+    return np.linalg.norm(BODY.phase_angular_velocity(u), axis=-1) * u_dot
+
+
+# -- batch ------------------------------------------------------------------------------------
+
+def test_flat_free_scene_is_todays_motion_bit_for_bit(context, tmp_path):
+    explicit = record(context, tmp_path / 'e.mcap', duration=2.0, slope=0.0, heading0=0.0,
+                      drive='none', rolling_resistance=0.0, damping=0.0)
+    t_ns, u, u_dot = states(explicit)
+    u0 = float(BODY.phase_from_theta(0.3, 1))
+    reference = MotionStream(DYNAMICS, u0, DYNAMICS.initial_phase_rate(u0, 3.0))
+    ref_u, ref_u_dot = reference.sample((t_ns - t_ns[0]) / 1e9)
+    assert len(u) == 201
+    assert np.array_equal(u, ref_u) and np.array_equal(u_dot, ref_u_dot)
+    default = record(context, tmp_path / 'd.mcap', duration=2.0)
+    for got, want in zip((*poses(explicit), points(explicit, 'contact_a'),
+                          points(explicit, 'contact_b'), *states(explicit)[1:]),
+                         (*poses(default), points(default, 'contact_a'),
+                          points(default, 'contact_b'), *states(default)[1:])):
+        assert np.array_equal(got, want)
+    g, q = poses(explicit)
+    ref = DYNAMICS.cycle.poses(ref_u)
+    assert np.array_equal(g, ref.position_g)
+
+
+def test_slope_run_contacts_on_the_plane_and_rolling(context, tmp_path):
+    slope = 0.1
+    recording = record(context, tmp_path / 's.mcap', duration=1.0, rate=1000.0, slope=slope,
+                       heading0=0.4, friction=math.inf)
+    normal = np.array([math.sin(slope), 0.0, math.cos(slope)])
+    a, b = points(recording, 'contact_a'), points(recording, 'contact_b')
+    assert np.max(np.abs(a @ normal)) <= 1e-12 and np.max(np.abs(b @ normal)) <= 1e-12
+    g, q = poses(recording)
+    _, u, u_dot = states(recording)
+    # the body where the geometry puts it: A − G and B − G are R r1(u), R r2(u)
+    r1, r2 = (np.real(x) for x in BODY.phase_vectors(u)[:2])
+    rot = np.array([rotation(x) for x in q])
+    np.testing.assert_allclose(np.einsum('nij,nj->ni', rot, r1), a - g, atol=1e-12)
+    np.testing.assert_allclose(np.einsum('nij,nj->ni', rot, r2), b - g, atol=1e-12)
+    # no slip: v_A = v_G + ω × (A − G) = 0 (central differences, h = 1 ms)
+    h = 1e-3
+    v_g = (g[2:] - g[:-2]) / (2 * h)
+    omega = angular_velocity(q, h)
+    v_a = v_g + np.cross(omega, (a - g)[1:-1])
+    assert np.max(np.linalg.norm(v_a, axis=1)) <= 1e-4 * np.max(np.linalg.norm(v_g, axis=1))
+    # energy E = ½ M |v_G|² + ½ ω·I ω + M g z_G (z along gravity) from the poses alone
+    mass = DYNAMICS.mass
+    inertia = np.diag(mass.principal_moments)
+    omega_body = np.einsum('nji,nj->ni', rot[1:-1], omega)
+    energy = (0.5 * mass.mass * np.sum(v_g**2, 1) + 0.5 * np.einsum(
+        'ni,ij,nj->n', omega_body, inertia, omega_body) + mass.mass * 9.81 * g[1:-1, 2])
+    assert np.ptp(energy) <= 1e-5 * DYNAMICS.energy_scale
+    assert np.ptp(energy) * 1e3 < np.ptp(mass.mass * 9.81 * g[:, 2])   # (it does fall)
+    # F_A + F_B + M g = M a_G with g = (0, 0, −g) in frame_id (the tilted g of the slope)
+    force = sum(np.array([[m.wrench.force.x, m.wrench.force.y, m.wrench.force.z]
+                          for m in by_topic(recording, name)]) for name in ('wrench_a',
+                                                                             'wrench_b'))
+    a_g = (g[2:] - 2 * g[1:-1] + g[:-2]) / h**2
+    residual = force[1:-1] + mass.mass * np.array([0.0, 0.0, -9.81]) - mass.mass * a_g
+    assert np.max(np.linalg.norm(residual, axis=1)) <= 1e-4 * mass.mass * 9.81
+    meta = recording.metadata['twodisk_ros']
+    assert eval(meta['ground_normal']) == pytest.approx(list(normal), abs=1e-15)
+
+
+def test_slope_the_body_cannot_stand_on_is_invalid_from_the_start(context, tmp_path):
+    recording = record(context, tmp_path / 'b.mcap', duration=1.0, slope=0.3)
+    first = by_topic(recording, 'diagnostics')[0]
+    (status,) = first.status
+    assert stamp(first) == stamp(by_topic(recording, 'pose')[0])
+    assert status.level == 2 and 'tips over' in status.message, status.message
+
+
+def test_damped_energy_balance_in_the_diagnostics(context, tmp_path):
+    recording = record(context, tmp_path / 'd.mcap', duration=3.0, damping=0.01,
+                       rolling_resistance=0.002)
+    _, u, u_dot = states(recording)
+    energy = DYNAMICS.energy(u, u_dot)
+    assert energy[-1] < energy[0] - 0.01          # it slows down
+    for msg in by_topic(recording, 'diagnostics'):
+        (status,) = msg.status
+        values = {kv.key: kv.value for kv in status.values}
+        balance = (float(values['energy']) + float(values['dissipated_work'])
+                   - float(values['drive_work']))
+        assert balance == pytest.approx(energy[0], abs=1e-9 * DYNAMICS.energy_scale)
+        assert float(values['energy_balance_drift']) <= 1e-9
+
+
+def rotation(q):
+    x, y, z, w = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def angular_velocity(q, h):
+    """ω (world frame) at the inner samples from central differences of the quaternions."""
+    q_dot = (q[2:] - q[:-2]) / (2 * h)
+    x, y, z, w = q[1:-1].T
+    conj = np.stack([-x, -y, -z, w], axis=1)
+    # ω = 2 q̇ ⊗ q*, vector part
+    px, py, pz, pw = q_dot.T
+    qx, qy, qz, qw = conj.T
+    return 2 * np.stack([pw * qx + px * qw + py * qz - pz * qy,
+                         pw * qy - px * qz + py * qw + pz * qx,
+                         pw * qz + px * qy - py * qx + pz * qw], axis=1)
