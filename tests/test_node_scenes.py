@@ -187,3 +187,142 @@ def angular_velocity(q, h):
     return 2 * np.stack([pw * qx + px * qw + py * qz - pz * qy,
                          pw * qy - px * qz + py * qw + pz * qx,
                          pw * qz + px * qy - py * qx + pz * qw], axis=1)
+
+
+# -- realtime: driven from a second node ------------------------------------------------------
+
+class Driver:
+    """A realtime Roller and a driver node (publishers, service clients) in one Context."""
+
+    def __init__(self, overrides):
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from std_msgs.msg import Float64, String
+        from std_srvs.srv import Empty, SetBool
+        from twodisk_ros.node.roller import Roller
+        self.ctx = rclpy.Context()
+        rclpy.init(context=self.ctx, domain_id=LIVE_DOMAIN)
+        self.node = Roller(context=self.ctx, parameter_overrides=overrides)
+        self.driver = rclpy.create_node('scene_driver', context=self.ctx)
+        self.speed = self.driver.create_publisher(Float64, 'cmd_speed', 10)
+        self.torque = self.driver.create_publisher(Float64, 'cmd_torque', 10)
+        self.reset = self.driver.create_client(Empty, 'reset')
+        self.pause = self.driver.create_client(SetBool, 'pause')
+        self.events, self.poses = [], []
+        self.driver.create_subscription(String, 'events', lambda m: self.events.append(m.data),
+                                        100)
+        from geometry_msgs.msg import PoseStamped
+        self.driver.create_subscription(PoseStamped, 'pose', self.poses.append, 1000)
+        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor.add_node(self.node)
+        self.executor.add_node(self.driver)
+        self.Float64, self.Empty, self.SetBool = Float64, Empty, SetBool
+
+    def spin(self, seconds, until=None):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.executor.spin_once(timeout_sec=0.01)
+            if until is not None and until():
+                return True
+        return False
+
+    def command(self, publisher, value):
+        publisher.publish(self.Float64(data=float(value)))
+
+    def call(self, client, request):
+        assert client.wait_for_service(timeout_sec=10.0)
+        future = client.call_async(request)
+        assert self.spin(10.0, future.done)
+        return future.result()
+
+    def event(self, text, count=1):
+        """Wait (≤ 10 s) until ``count`` events starting with ``text`` have been published."""
+        assert self.spin(10.0, lambda: sum(e.startswith(text) for e in self.events)
+                         >= count), (text, self.events)
+
+    def close(self):
+        self.executor.shutdown()
+        self.node.close()
+        self.node.destroy_node()
+        self.driver.destroy_node()
+        import rclpy
+        rclpy.try_shutdown(context=self.ctx)
+
+
+def test_driven_from_a_second_node(tmp_path):
+    from rclpy.parameter import Parameter
+    path = tmp_path / 'live.mcap'
+    rate, lag, timeout = 100.0, 0.1, 0.3
+    live = Driver([Parameter('drive', value='speed'), Parameter('drive_lag', value=lag),
+                   Parameter('cmd_timeout', value=timeout), Parameter('rate', value=rate),
+                   Parameter('record', value=str(path)), Parameter('friction', value=math.inf)])
+    try:
+        assert live.spin(10.0, lambda: len(live.poses) >= 10)
+        for k in range(8):                               # a speed ramp 3.25 … 5 rad/s
+            live.command(live.speed, 3.25 + 0.25 * k)
+            live.event(f'command speed {3.25 + 0.25 * k!r}')
+            live.spin(0.05)
+        live.command(live.speed, math.nan)              # ignored with a WARN
+        live.command(live.torque, 0.1)                  # the other drive: ignored
+        live.event('timeout')
+        live.node.set_parameters([Parameter('drive', value='torque')])
+        live.event('scene drive=torque')
+        for _ in range(3):                               # a torque pulse of 0.05 N m
+            live.command(live.torque, 0.05)
+            live.spin(0.05)
+        live.event('timeout', count=2)
+        live.node.set_parameters([Parameter('drive', value='speed')])   # the start's again
+        live.event('scene drive=speed')
+        live.spin(0.2)
+        live.call(live.reset, live.Empty.Request())
+        live.event('reset')
+        live.spin(0.3)
+        live.call(live.pause, live.SetBool.Request(data=True))
+        live.event('pause')
+        held = len(live.poses)
+        live.spin(0.5)
+        assert len(live.poses) <= held + 1      # (one in flight at most)
+        live.call(live.pause, live.SetBool.Request(data=False))
+        live.event('resume')
+        live.spin(0.3)
+    finally:
+        live.close()
+    recording = read_recording(path)
+    events = [(m.log_time_ns, m.msg.data) for m in recording.messages
+              if m.topic.endswith('/events')]
+    assert [e for _, e in events if e.split()[0] in ('reset', 'pause', 'resume', 'timeout')] \
+        == ['timeout', 'timeout', 'reset', 'pause', 'resume']
+    assert not any('nan' in e for _, e in events)
+    t_ns, u, u_dot = states(recording)
+    assert np.all(np.diff(t_ns) == round(1e9 / rate))      # the pause leaves no gap
+    omega = speed(u, u_dot)
+    index = {stamp_ns: i for i, stamp_ns in enumerate(t_ns)}
+    commands = [(index[s], float(e.split()[2])) for s, e in events
+                if e.startswith('command speed')]
+    first_timeout = index[events[[e for _, e in events].index('timeout')][0]]
+    # the speed drive: Ω = cmd + (Ω_c − cmd) e^{−(t − t_c)/T} from the last sample before
+    bounds = [c for c, _ in commands[1:]] + [first_timeout]
+    for (start, cmd), end in zip(commands, bounds):
+        t = (np.arange(start - 1, end) - (start - 1)) / rate
+        expected = cmd + (omega[start - 1] - cmd) * np.exp(-t / lag)
+        np.testing.assert_allclose(omega[start - 1:end], expected, rtol=0, atol=1e-8)
+    assert omega[first_timeout - 1] > 4.5
+    # the torque pulse: dE/dt = τ |ω| (E from the recorded states, central differences)
+    pulses = [index[s] for s, e in events if e.startswith('command torque')]
+    assert pulses
+    energy = DYNAMICS.energy(u, u_dot)
+    h = 1.0 / rate
+    second_timeout = index[[s for s, e in events if e == 'timeout'][1]]
+    inside = np.arange(pulses[0] + 1, second_timeout - 1)
+    inside = inside[~np.isin(inside, pulses)]
+    d_energy = (energy[inside + 1] - energy[inside - 1]) / (2 * h)
+    np.testing.assert_allclose(d_energy, 0.05 * np.abs(omega[inside]), rtol=0,
+                               atol=2e-3 * float(np.max(np.abs(d_energy))))
+    # reset: the first sample again, exactly; pause: the run goes on from the same sample
+    reset = index[[s for s, e in events if e == 'reset'][0]]
+    g, q = poses(recording)
+    assert np.array_equal(g[reset], g[0]) and np.array_equal(q[reset], q[0])
+    assert (u[reset], u_dot[reset]) == (u[0], u_dot[0])
+    pause = index[[s for s, e in events if e == 'pause'][0]]
+    assert [s for s, e in events if e == 'resume'][0] == t_ns[pause]
+    assert abs(u[pause] - u[pause - 1] - 0.5 * (u_dot[pause] + u_dot[pause - 1]) * h) < 1e-4

@@ -94,7 +94,8 @@ class Roller(Node):
         self.simulation = Simulation(self.settings, run)
         if self.simulation.invalid is not None:    # a slope the body cannot stand on
             self.get_logger().error(self.simulation.invalid.reason)
-        if self.settings.method == 'table' and self.simulation.stream.solver == 'DOP853':
+        if (self.settings.method == 'table' and self.simulation.scene is None
+                and self.simulation.stream.solver == 'DOP853'):
             self.get_logger().info(
                 'no closed form of this motion is resolved (a start just below the barrier '
                 'of a thin body): it is integrated numerically (DOP853), 0.5 s ahead at a '
