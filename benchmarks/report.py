@@ -3,6 +3,7 @@
 import math
 
 import ros_layer
+import sweep_exponent
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
 
@@ -226,6 +227,8 @@ def write_report(path, ctx):
     # --- the node and what is built on the physics
     out.extend(ros_layer.report_lines(ctx['ros_layer']))
     out.extend(sweep_scaling.report_lines(ctx['sweep_scaling']))
+    if ctx.get('sweep_exponent'):
+        out.extend(sweep_exponent.report_lines(ctx['sweep_exponent']))
 
     # --- figure
     w('## Work-precision plot\n')
