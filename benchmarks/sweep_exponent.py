@@ -9,8 +9,9 @@ the representative map (b/a in [0.2, 3], Δ/a in [0.05, 0.95]), in tasks of the 
 sizes (:data:`~twodisk_ros.sweep.request.DEFAULT_CHUNK_SIZE` bodies for n = 2,
 :data:`~twodisk_ros.sweep.request.GENERAL_CHUNK_SIZE` for n ≠ 2), with the general path's cost
 split by stage; beside them the per-body path on the ellipse's closed forms (TwoDiskBody, the
-same stages as the general path without the lamina's contact solve). A body that fails is reported with its one line (e.g. while LaminaBody is not
-implemented); the rate counts only the bodies computed.
+same stages as the general path without the lamina's contact solve). A body that fails is
+reported with its one line (e.g. while LaminaBody is not implemented); the rate counts only
+the bodies computed.
 
 Run: ``python benchmarks/sweep_exponent.py [--quick]`` (PYTHONPATH = the repository);
 ``make bench`` runs it (run_all.py) and writes its table into docs/benchmarks.md.

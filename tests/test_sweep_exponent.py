@@ -267,7 +267,7 @@ def test_maps_draw_one_panel_per_exponent_on_one_scale(tmp_path):
 # -- a real superellipse (once LaminaBody is implemented) -----------------------------------
 
 def _superellipse_plate_moments(b, n):
-    """Area and ∫x² dA, ∫y² dA of |x/b|ⁿ + |y|ⁿ ≤ 1 (Γ functions, independent of lamina.py)."""
+    """Area and ∫x² dA, ∫y² dA of |x/b|ⁿ + |y|ⁿ ≤ 1 (Γ functions; not lamina.py's code)."""
     g = math.gamma
     area = 4 * b * g(1 + 1 / n) ** 2 / g(1 + 2 / n)
     xx = 4 * b**3 * g(3 / n) * g(1 / n) / (n**2 * g(1 + 4 / n))
