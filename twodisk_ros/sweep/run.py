@@ -2,7 +2,8 @@
 
 The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`), each of one
 exponent n; each block is one Dask task on a worker (the batched path for n = 2, the per-body
-general path otherwise: :func:`~twodisk_ros.sweep.quantities.chunk_quantities`). Where the results go depends on the output's suffix:
+general path otherwise: :func:`~twodisk_ros.sweep.quantities.chunk_quantities`). Where the
+results go depends on the output's suffix:
 
 - ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.quantities.timed_chunk`) sends
   its block's values back to the client, which saves each finished block in the resume cache
