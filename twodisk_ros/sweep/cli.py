@@ -13,7 +13,8 @@ the machine, the outputs), before Dask or xarray is imported: a mistake costs a 
 second. The third axis is the superellipse exponent n of both laminae (|x/b|^n + |y/a|^n
 <= 1, 2 <= n <= 100; default 2 alone, the ellipse): n = 2 takes the batched closed forms, any
 other n the per-body general path (docs/sweeps.md "The exponent axis"). Outputs follow
-:mod:`twodisk_ros.outputs`: ``--out`` ends in ``.nc`` (a NetCDF file written by the client) or ``.zarr`` (a Zarr store written by the workers); an existing output
+:mod:`twodisk_ros.outputs`: ``--out`` ends in ``.nc`` (a NetCDF file written by the client) or
+``.zarr`` (a Zarr store written by the workers); an existing output
 (``FILE.nc``, a finished ``FILE.zarr``, or a ``DIR/NAME.png`` of ``--plot``) is refused unless
 ``--overwrite``; files are written through hidden temporary names and renamed, so an
 interrupted or failed sweep leaves them as they were. The resume state (``FILE.nc.parts/``,

@@ -5,7 +5,8 @@ Coordinates ``exponent`` (the superellipse exponent n; 2 is the ellipse), ``b_ov
 name of :data:`~twodisk_ros.sweep.quantities.VARIABLES` with ``units`` and ``description``
 attributes (and, when the grid has an exponent n != 2, ``general_path``: what the variable
 means there, or why it is NaN), NaN where a body failed; ``failure`` (str, '' on success)
-says why. The package version and the sweep's parameters are global attributes. NetCDF files are NetCDF3 (scipy
+says why. The package version and the sweep's parameters are global attributes. NetCDF files
+are NetCDF3 (scipy
 backend), written to a hidden temporary name and renamed. A Zarr store
 (:mod:`~twodisk_ros.sweep.store`) has the same variables, chunked, and ``computed``.
 """
@@ -98,7 +99,8 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None):
 def template_dataset(b_over_a, delta_over_a, block, attrs, exponent=None):
     """The sweep's Dataset with lazy (Dask) variables, and the encoding that chunks them in
     ``block`` = (1, rows, columns) (exponents ``exponent``, default 2 alone): what
-    ``to_zarr(compute=False, encoding=...)`` lays out as an empty store. Floats NaN, ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
+    ``to_zarr(compute=False, encoding=...)`` lays out as an empty store. Floats NaN,
+    ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
     (int8; 1 once a block is complete). Returns (Dataset, encoding).
 
     Each variable is one Dask chunk (a graph of one task per variable, however many blocks:
