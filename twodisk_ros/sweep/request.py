@@ -46,9 +46,9 @@ DEFAULT_CHUNK_SIZE = 128
 #: fewer files, tasks and client reads (~0.3 ms per chunk) than 16-body chunks on the large
 #: maps Zarr is for (docs/sweeps.md "Scaling"; benchmarks/sweep_scaling.py).
 DEFAULT_STORE_CHUNK_SIZE = 1024
-#: Bodies per task when the grid has an exponent n != 2 (the per-body general path, ~1 s a
-#: body: GENERAL_CORE_SECONDS_PER_BODY), so that a task stays a few seconds long and a small
-#: map still spreads over the cores. Blocks have one shape over the whole grid (Zarr's regular
+#: Bodies per task when the grid has an exponent n != 2 (the per-body general path, seconds
+#: to minutes a body: GENERAL_CORE_SECONDS_PER_BODY), so that a task stays short enough to
+#: resume from and a small map still spreads over the cores. Blocks have one shape over the whole grid (Zarr's regular
 #: chunks), so the n = 2 plane of a mixed grid is cut as finely.
 GENERAL_CHUNK_SIZE = 8
 #: Without --chunk-size a grid is cut into at least this many tasks (smaller chunks on small
@@ -72,9 +72,11 @@ BYTES_PER_AXIS_VALUE = 256
 #: measured ~3 ms on the benchmark's map; thin bodies need finer tables, hence the margin.
 CORE_SECONDS_PER_BODY = 0.004
 #: Work per body of the general path (exponent n != 2: LaminaBody, its cycle, dynamics and
-#: contact-force tables; core-seconds). Provisional until benchmarks/sweep_rate.py measures
-#: it on LaminaBody (docs/sweeps.md "Cost"): issue 20 asks ≤ 1 s for a body and its cycle.
-GENERAL_CORE_SECONDS_PER_BODY = 2.0
+#: contact-force tables; core-seconds). Measured once on a merge of the issue-20 branches
+#: (b/a = 1, Δ/a = 0.5, load average ~5 on 2 cores): 3.6 s at n = 4, 11.5 s at n = 10, 235 s
+#: at n = 2.5 and ~340 s at n = 2.0001, 80-97 % in the certified equilibrium search
+#: (docs/sweeps.md "The exponent axis"); benchmarks/sweep_exponent.py measures it in make bench.
+GENERAL_CORE_SECONDS_PER_BODY = 10.0
 #: The exponent of the ellipse: the batched closed-form path (:mod:`~twodisk_ros.sweep.batch`).
 ELLIPSE_EXPONENT = 2.0
 #: Allowed superellipse exponents n (|x/b|^n + |y/a|^n <= 1), inclusive.
