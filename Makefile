@@ -58,7 +58,7 @@ demo: venv
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
 	    -p realtime:=false -p duration:=20.0 -p record:=$(OUT)/oloid.mcap -p overwrite:=true
 	$(PY) -m twodisk_ros.inspect_mcap $(OUT)/oloid.mcap --plot $(OUT)/oloid.png --overwrite
-	$(PY) -m twodisk_ros.plotting.animation $(OUT)/oloid.mcap -o $(OUT)/oloid.gif \
+	$(PY) -m twodisk_ros.plotting.animate_cli $(OUT)/oloid.mcap -o $(OUT)/oloid.gif \
 	    --stop 6 --fps 15 --size 480x360 --overwrite
 
 ## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).

@@ -3,6 +3,8 @@
 import math
 
 import ros_layer
+import general_shapes
+import scene_rate
 import sweep_exponent
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
@@ -227,6 +229,8 @@ def write_report(path, ctx):
     # --- the node and what is built on the physics
     out.extend(ros_layer.report_lines(ctx['ros_layer']))
     out.extend(sweep_scaling.report_lines(ctx['sweep_scaling']))
+    out.extend(general_shapes.report_lines(ctx['general_shapes']))
+    out.extend(scene_rate.report_lines(ctx['scene_rate']))
     if ctx.get('sweep_exponent'):
         out.extend(sweep_exponent.report_lines(ctx['sweep_exponent']))
 

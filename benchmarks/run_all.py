@@ -41,6 +41,8 @@ from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
 import sweep_exponent  # noqa: E402
 import sweep_scaling  # noqa: E402
+import general_shapes  # noqa: E402
+import scene_rate  # noqa: E402
 
 
 def _run(cmd):
@@ -242,6 +244,10 @@ def main(argv=None):
     ros = ros_layer.measure(builds, quick=args.quick, log=log)
     log('the sweep on 1, 2, 4 workers and its extrapolation to a cluster')
     scaling = sweep_scaling.measure(quick=args.quick, log=log)
+    log('bodies of other laminae: the general path beside the closed forms')
+    shapes = general_shapes.measure(quick=args.quick, log=log)
+    log('scenes: slopes, drives and losses beside the flat free motion')
+    scenes = scene_rate.measure(quick=args.quick, log=log)
     log('the sweep along the exponent axis: n = 2 batched, n = 4 general, per body')
     exponent = sweep_exponent.measure(quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
@@ -310,7 +316,8 @@ def main(argv=None):
                reference_check_rtol=REFERENCE_CHECK_RTOL, closed_form_check=check_text,
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
-               ros_layer=ros, sweep_scaling=scaling, sweep_exponent=exponent,
+               ros_layer=ros, sweep_scaling=scaling, general_shapes=shapes, scene_rate=scenes,
+               sweep_exponent=exponent,
                commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
                elapsed=elapsed)
     write_report(args.out, ctx)
@@ -327,7 +334,10 @@ def main(argv=None):
                 hours=[h.as_dict() for h in hours],
                 ratios=[r.as_dict() for r in ratios],
                 ros_layer=ros_layer.as_dict(ros),
-                sweep_scaling=scaling, sweep_exponent=exponent,
+                sweep_scaling=scaling,
+                general_shapes=shapes,
+                scene_rate=scenes,
+                sweep_exponent=exponent,
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))

@@ -11,7 +11,7 @@ import pytest
 from PIL import Image, ImageChops
 
 from twodisk_ros.plotting import animation
-from twodisk_ros.plotting.runs import RunError, library_run, recorded_run, settings_from
+from twodisk_ros.runs import RunError, library_run, recorded_run, settings_from
 
 REPO = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
@@ -80,7 +80,7 @@ def test_recording_gif_cli(recording, tmp_path):
     assert np.allclose(run.contact_a[:, 2], 0.0, atol=1e-12)
     out = tmp_path / 'rec.gif'
     result = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.plotting.animation', str(recording), '-o',
+        [sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', str(recording), '-o',
          str(out), '--stop', '0.9', '--fps', '5', '--size', '160x120', '--view', 'top'],
         cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
     assert result.returncode == 0, result.stderr
@@ -155,3 +155,13 @@ def test_legend_readable_at_the_demo_size(view):
     assert box.x0 >= 0 and box.x1 <= 480 and box.y0 >= 0
     assert scene.trace_a.get_color() == palette.A and scene.trace_b.get_color() == palette.B
     assert scene.segment.get_color() == palette.AB
+
+
+def test_runs_moved_out_of_plotting_and_the_old_import_still_works():
+    # runs are loaded and simulated in twodisk_ros.runs (nothing there plots); the old
+    # module re-exports the same objects, and the library module has no command line
+    import twodisk_ros.plotting.runs as old
+    import twodisk_ros.runs as new
+    for name in old.__all__:
+        assert getattr(old, name) is getattr(new, name), name
+    assert not hasattr(animation, 'main')

@@ -29,7 +29,7 @@ ENV.pop('TWODISK_DEBUG', None)
 
 SWEEP = 'twodisk_ros.sweep'
 ANIMATE = 'twodisk_ros.plotting.animate_cli'      # twodisk-animate in setup.py
-ANIMATION = 'twodisk_ros.plotting.animation'
+ANIMATION = 'twodisk_ros.plotting.animate_cli'
 DASK_LIKE = ('dask', 'distributed', 'xarray', 'zarr')
 HEAVY = DASK_LIKE + ('scipy', 'matplotlib')
 REFUSED = 'imported before the command line was checked'

@@ -19,7 +19,8 @@ from numpy.testing import assert_allclose  # noqa: E402
 from twodisk_ros.plotting import figures  # noqa: E402
 from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
 
-EXPECTED = ['figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png']
+EXPECTED = ['figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png',
+            'laminae_traces.png']
 PNG_SIGNATURE = b'\x89PNG\r\n\x1a\n'
 
 
@@ -51,6 +52,20 @@ def test_main_writes_and_lists(tmp_path, capsys):
     assert figures.main(['--out', str(tmp_path)]) == 0
     printed = capsys.readouterr().out.split()
     assert [p.rsplit('/', 1)[-1] for p in printed] == EXPECTED
+
+
+def test_lamina_outline_is_the_superellipse():
+    """The drawn outline of the rounded square lies on |x/b|^4 + |y/a|^4 = 1 (its definition)."""
+    title, lamina, *_ = figures.LAMINA_BODIES[0]
+    fig, ax = plt.subplots()
+    try:
+        figures.plot_outline(lamina, ax)
+        x, y = _line(ax, 'outline').get_data()
+        assert_allclose(np.abs(x / 0.1) ** 4 + np.abs(y / 0.1) ** 4, 1.0, rtol=1e-13)
+        # the whole rim: the outline reaches all four extents
+        assert_allclose([x.max(), -x.min(), y.max(), -y.min()], 0.1, rtol=1e-12)
+    finally:
+        plt.close(fig)
 
 
 def test_oloid_trace_data():

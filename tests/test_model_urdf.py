@@ -174,3 +174,45 @@ def test_a_server_can_name_the_mesh_files_its_own_way(tmp_path):
     names = [m.get('filename') for m in ElementTree.fromstring(text).iter('mesh')]
     assert len(names) == 4 and all(n.startswith('package://twodisk_ros/meshes/') for n in names)
     assert {n.rsplit('/', 1)[1] for n in names} == {p.name for p in tmp_path.iterdir()}
+
+
+@pytest.mark.parametrize('model', ['laminae', 'solid'])
+@pytest.mark.parametrize('arrangement', ['parallel', 'swapped'])
+def test_urdf_of_a_non_elliptic_body(model, arrangement, tmp_path):
+    # an egg (not symmetric along the common axis, so G is off the centres' midpoint): the
+    # parsers read its meshes, and its joint origins put the exact contact points A and B of
+    # GeneralTwoDiskBody on the egg, mapped into the disk frames as frames.py documents
+    from twodisk_ros.physics.general_body import GeneralTwoDiskBody
+    from twodisk_ros.physics.lamina import Egg
+    lamina = Egg(0.2, 0.16, 0.012)
+    body = GeneralTwoDiskBody(lamina, 0.08, arrangement)
+    # the URDF only carries the mass model's numbers: an ellipse's stand in for the egg's
+    mass = _mass(model, (0.2, 0.16, 0.08))
+    text = body_description(body, mass, 'rover', directory=tmp_path / 'cache')
+    path, urdf = _load(text, tmp_path)
+    checked = _check_urdf(path)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    parts = mesh_parts(body, mass)
+    assert set(urdf.scene.geometry) == set(parts)
+    for name, loaded in urdf.scene.geometry.items():
+        assert np.array_equal(loaded.triangles, parts[name].triangles.astype(np.float32))
+    sigma = 1.0 if arrangement == 'parallel' else -1.0
+    pose = body.geometry(np.linspace(-1, 1, 41) * body.theta_max, 1)
+    expected_a = lamina.point(pose.parameter_a)
+    for child, points in (('rover_disk_a', pose.contact_a), ('rover_disk_b', pose.contact_b)):
+        frame = urdf.get_transform(child, 'rover')
+        local = (points - frame[:3, 3]) @ frame[:3, :3]
+        assert np.abs(local[:, 2]).max() <= 2e-15 * body.size
+        # frames.py: disk 1's lamina point (x, y) is (−y, x); disk 2's is (σy, −x)
+        if child.endswith('_a'):
+            x, y = local[:, 1], -local[:, 0]
+            # the translation's rounding (a few ulp of the size) and nothing else
+            np.testing.assert_allclose(np.stack([x, y], -1), expected_a, rtol=0,
+                                       atol=1e-15 * body.size)
+        else:
+            x, y = -local[:, 1], sigma * local[:, 0]
+        # on the egg's boundary: p·n = h(n) for its outward normal n (best of 20 001)
+        phi = np.linspace(0, 2 * np.pi, 20001)
+        n = np.stack([np.cos(phi), np.sin(phi)], -1)
+        gap = lamina.support(n).height[None, :] - np.stack([x, y], -1) @ n.T
+        assert gap.min() >= -1e-15 * body.size and gap.min(axis=1).max() <= 1e-7 * body.size

@@ -115,9 +115,8 @@ def _check_inputs(problems, chosen, model):
     if model is None and not detail:
         detail.append('no model')
     if not detail:
-        body = model.body
         return _check('inputs', 0, 0, 'problems', [
-            f'body a = {body.a:g} m, b = {body.b:g} m, delta = {body.delta:g} m, mass model '
+            f'body {model.shape}, mass model '
             f'{model.dynamics.mass.model}, mode {model.mode}; topics '
             + ', '.join(chosen[role] for role in TOPIC_TYPES if role in chosen)])
     return _check('inputs', len(detail), 0, 'problems', detail)

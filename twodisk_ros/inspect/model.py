@@ -1,15 +1,17 @@
 """The body, mass model and mode that a recording's parameters describe.
 
-The recorded parameters are read with the node's own contract
-(:func:`twodisk_ros.node.parameters.parse_recorded`), so the inspector accepts exactly what
-the node accepts.
+The recorded parameters are read with the node's own contract, through the run description
+(:meth:`twodisk_ros.run.description.RunDescription.from_recorded`), so the inspector accepts
+exactly what the node accepts and builds the body the node built: a recording without the
+shape parameters (made before them) is an ellipse run, and one of shape points is rebuilt from
+the fitted outline it holds, not from its shape file.
 """
 
 from dataclasses import dataclass
 
-from ..node.parameters import parse_recorded
-from ..physics.body import TwoDiskBody
 from ..physics.dynamics import RollingDynamics
+from ..physics.rolling_body import RollingBody
+from ..run.description import RunDescription
 
 __all__ = ['RecordedModel', 'build_model']
 
@@ -18,12 +20,13 @@ __all__ = ['RecordedModel', 'build_model']
 class RecordedModel:
     """What the recorded parameters define: body, dynamics, mode, rates and tolerance."""
 
-    body: TwoDiskBody
+    body: RollingBody
     dynamics: RollingDynamics
     mode: str
     omega0: float
     rate: float | None
     solver_tolerance: float
+    shape: str = ''          #: one line on the shape, for the report
 
 
 def build_model(parameters, problems):
@@ -31,16 +34,16 @@ def build_model(parameters, problems):
 
     Problems found (one line each) are appended to ``problems``.
     """
-    settings, found = parse_recorded(parameters)
+    run, found = RunDescription.from_recorded(parameters)
     problems.extend(found)
-    if settings is None:
+    if run is None:
         return None
+    settings = run.settings
     try:
-        body = TwoDiskBody(settings.a, settings.b, settings.delta)
-        dynamics = RollingDynamics(body, settings.mass_properties(), settings.gravity)
+        dynamics = run.dynamics
     except (ValueError, TypeError, RuntimeError) as error:
         problems.append(f'the recorded parameters define no body: {error}')
         return None
     rate = settings.rate if 'rate' in parameters else None
-    return RecordedModel(body, dynamics, settings.mode, settings.omega0, rate,
-                         settings.tolerance)
+    return RecordedModel(run.body, dynamics, settings.mode, settings.omega0, rate,
+                         settings.tolerance, run.shape_line)

@@ -8,24 +8,31 @@ R v), so a ``geometry_msgs/Transform`` with parent ``body_frame`` and child the 
 carries ``translation`` and ``quaternion`` as they are.
 
 Each disk frame has its origin at the disk's centre, z normal to the disk's plane, and its
-x axis along the semi-axis ``a`` pointing away from G, towards the disk's far tip (where
-θ = 0, resp. ψ = 0); y completes the right-handed frame. The rim is then
-x²/a² + y²/b² = 1, z = 0, on both disks, and the contact angle of the disk is the polar
-angle from x towards y, so the contact point is ρ (cos ∠, sin ∠, 0) with ρ = ab/D(∠):
+x axis along the common axis pointing away from G, towards the disk's far tip (where
+θ = 0, resp. ψ = 0); y completes the right-handed frame. The contact angle of the disk is
+the polar angle from x towards y. For ellipses the rim is x²/a² + y²/b² = 1, z = 0, on both
+disks, so the contact point is ρ (cos ∠, sin ∠, 0) with ρ = ab/D(∠); for any lamina
+(:mod:`~twodisk_ros.model.outline`) disk 1's lamina point (x, y) is (−y, x, 0) in its frame
+and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
 
 ``{body_frame}_disk_a`` — disk 1, which carries the contact point A (angle θ):
-    centre C1 = −Δ e2; x = −e2, y = +e1, z = +e3 (a turn by −90° about e3).
+    centre C1 = −Δ e2 − G; x = −e2, y = +e1, z = +e3 (a turn by −90° about e3).
 ``{body_frame}_disk_b`` — disk 2, which carries the contact point B (angle ψ):
-    centre C2 = +Δ e2; x = +e2, y = −e3, z = −e1.
+    centre C2 = +Δ e2 − G; x = +e2, y = −e3, z = −e1.
 
-The two frames are exact (quaternion components 0, ±1/2, ±√½); only the translations depend
-on the body (±Δ e2).
+G is the laminae's centroid seen from the midpoint of the centres
+(:attr:`GeneralTwoDiskBody.centroid <twodisk_ros.physics.general_body.GeneralTwoDiskBody>`,
+along e2): zero for laminae symmetric along the common axis (ellipses, superellipses), not
+for an egg in the 'parallel' arrangement. The two rotations are exact (quaternion components
+0, ±1/2, ±√½) and the same for every body; only the translations depend on it.
 """
 
 from dataclasses import dataclass
 import math
 
 import numpy as np
+
+from .outline import body_shape
 
 __all__ = ['DiskFrame', 'disk_frames', 'check_frame_id', 'DISK_SUFFIXES']
 
@@ -65,7 +72,7 @@ class DiskFrame:
         ``f'{body_frame}_disk_a'`` (disk 1, contact A) or ``f'{body_frame}_disk_b'``
         (disk 2, contact B).
     translation : numpy.ndarray, shape (3,)
-        The disk's centre in the body frame (m): (0, ∓Δ, 0).
+        The disk's centre in the body frame (m): (0, ∓Δ − g, 0), g = G's offset along e2.
     quaternion : numpy.ndarray, shape (4,)
         (x, y, z, w), unit, w > 0: rotates disk-frame components into body-frame ones.
     parent_frame_id : str
@@ -91,8 +98,8 @@ def disk_frames(body, body_frame='twodisk_body'):
 
     Parameters
     ----------
-    body : twodisk_ros.physics.body.TwoDiskBody
-        Uses ``body.delta`` (m).
+    body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
+        Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.model.outline.body_shape`).
     body_frame : str
         The parent frame's name (see :func:`check_frame_id`).
 
@@ -102,10 +109,11 @@ def disk_frames(body, body_frame='twodisk_body'):
         (disk 1 / contact A, disk 2 / contact B); see the module docstring for the axes.
     """
     check_frame_id(body_frame)
+    shape = body_shape(body)
     frames = []
     for suffix, sign, quaternion, axes in zip(DISK_SUFFIXES, _CENTRE_SIGNS, _QUATERNIONS, _AXES):
-        arrays = [np.array([0.0, sign * float(body.delta), 0.0]), np.array(quaternion),
-                  axes.copy()]
+        centre = np.array([0.0, sign * shape.delta, 0.0]) - shape.centroid
+        arrays = [centre, np.array(quaternion), axes.copy()]
         for array in arrays:
             array.setflags(write=False)
         frames.append(DiskFrame(body_frame + suffix, arrays[0], arrays[1], body_frame,

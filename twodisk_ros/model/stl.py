@@ -12,7 +12,9 @@ ament index of an installed package). Instead :func:`cached_stl` writes it once 
 ``XDG_CACHE_HOME`` is unset, empty or relative, as the XDG base-directory rules say) and the
 URDF refers to it by its absolute ``file://`` URI, which RViz and the Foxglove desktop app
 open directly on the machine that runs them. The name is the content's hash: the same mesh is
-written once and reused by every run and process, a changed body gets a new file, and an
+written once and reused by every run and process, a changed body gets a new file (the key is
+the mesh itself, so it tells apart every parameter that changes the mesh, the lamina's shape
+included: an ellipse and a superellipse of the same a, b, Δ are two files), and an
 existing file is never rewritten (its content is its name; nothing the user made is touched,
 the cache directory is the package's own). The file is written to a hidden temporary file
 beside it and renamed in one step (:func:`twodisk_ros.outputs.temporary_beside`), so a

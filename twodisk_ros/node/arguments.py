@@ -18,7 +18,7 @@ given counts, as in rcl.
 import difflib
 import re
 
-from .parameters import BY_NAME, ROS_OWN
+from .parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
 from .usage import split_ros_args
 from .params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
 
@@ -153,7 +153,25 @@ def check_arguments(argv):
         problem = parameter and type_problem(parameter, value)
         if problem:
             raise ArgumentError(f'{where}: {problem}')
-    return warnings + _unknown_warnings([name for _, name, _ in given])
+    return (warnings + _unknown_warnings([name for _, name, _ in given])
+            + _unused_warnings({name: value.value for _, name, value in given}))
+
+
+def _unused_warnings(last):
+    """Warnings for shape parameters given but not read by the shape the run will have.
+
+    ``last``: the last value given of each name (the one rcl keeps, the types being checked).
+    """
+    shape = last.get('shape', BY_NAME['shape'].default)
+    warnings = [f'{name} is set but not used: it is read only with shape {only} (shape is '
+                f'{shape})' for name, only in SHAPE_ONLY.items()
+                if name in last and shape != only and shape in BY_NAME['shape'].choices]
+    given = [name for name in ('a', 'b') if name in last]
+    if shape == 'points' and given:
+        warnings.append(f'{" and ".join(given)} {"is" if len(given) == 1 else "are"} set but '
+                        'not used with shape points: the outline in shape_file gives the '
+                        "disk's size")
+    return warnings
 
 
 def _nothing_applied(loaded, fqn):

@@ -17,10 +17,12 @@ import re
 
 from ..model.frames import DISK_SUFFIXES, check_frame_id
 from ..physics.body import TwoDiskBody
-from ..physics.mass_models import MODELS, mass_properties
+from ..physics.lamina import SUPERELLIPSE_EXPONENT
+from ..physics.mass_models import MODELS, custom, mass_properties
 from ..physics.motion import METHODS, MODES
+from ..run import shape as shapes
 
-__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings',
+__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
            'markdown_table', 'parse_recorded']
 
 B_OVER_A = (0.01, 100.0)             # allowed b/a
@@ -73,6 +75,27 @@ PARAMETERS = (
               1e-5, 1e5, physics=True),
     Parameter('delta', float, 0.05, 'm', 'half the distance between the disk centres; '
               f'{DELTA_OVER_A[0]:g} <= delta/a <= 1 - 1e-6', 1e-6, 1e3, physics=True),
+    Parameter('shape', str, 'ellipse', '', 'the shape of each disk: ellipse (a, b), '
+              'superellipse (a, b, exponent), egg (a, b, egg_asymmetry) or points (the '
+              'outline in shape_file; a and b are then the outline\'s and the parameters a, b '
+              'are not used)', choices=shapes.SHAPES, physics=True),
+    Parameter('exponent', float, 4.0, '', 'superellipse exponent n: |x/b|^n + |y/a|^n <= 1 '
+              '(2: the ellipse; large: a rounded rectangle); only for shape superellipse',
+              SUPERELLIPSE_EXPONENT[0], SUPERELLIPSE_EXPONENT[1], physics=True),
+    Parameter('egg_asymmetry', float, 0.5, '', 'egg: the third harmonic epsilon of the '
+              'support function as a share of its largest convex value epsilon_max(a, b); > 0 '
+              'makes the end of disk 1 away from disk 2 the sharper; only for shape egg',
+              -shapes.EGG_ASYMMETRY, shapes.EGG_ASYMMETRY, physics=True),
+    Parameter('shape_file', str, '', '', 'shape points: a CSV (x, y per line) or YAML (list '
+              'of [x, y]) file of outline points in metres, in order around the outline, x '
+              'across, y along the common axis, origin at the disk centre; fitted by a '
+              'smooth convex curve symmetric in x (a relative path is from the working '
+              'directory); only for shape points', physics=True),
+    Parameter('arrangement', str, 'parallel', '', 'parallel (disk 2 is disk 1 turned by 90 '
+              'deg about the common axis: an egg points the same way on both) or swapped '
+              '(disk 2 also turned end for end: the body looks the same from both ends); the '
+              'same body for laminae symmetric end to end (ellipse, superellipse)',
+              choices=shapes.ARRANGEMENT_NAMES, physics=True),
     Parameter('mass', float, 1.0, 'kg', 'total mass', 1e-6, 1e6, physics=True),
     Parameter('gravity', float, 9.81, 'm/s^2', 'gravitational acceleration g', 0.0, 1e3,
               physics=True),
@@ -115,6 +138,8 @@ PARAMETERS = (
 )
 
 BY_NAME = {p.name: p for p in PARAMETERS}
+#: Parameters that only one shape reads: {name: shape}.
+SHAPE_ONLY = {'exponent': 'superellipse', 'egg_asymmetry': 'egg', 'shape_file': 'points'}
 #: Names the node accepts that belong to rclpy itself (no warning for them).
 ROS_OWN = ('use_sim_time', 'start_type_description_service')
 
@@ -148,19 +173,37 @@ def _check_one(parameter, value):
     return value
 
 
-def _check_together(s):
-    """Rules that involve several parameters; raise ValueError (one line)."""
-    ratio = s.b / s.a
+def _check_together(s, outline=None):
+    """Rules that involve several parameters; raise ValueError (one line).
+
+    ``outline``: a ``points`` run's fitted outline, used instead of reading ``shape_file``
+    (a recording's). The lamina's own a and b (:func:`~twodisk_ros.run.shape.axes_of`) obey
+    the rules of the parameters a and b.
+    """
+    if s.shape == 'ellipse':
+        a, b, what = s.a, s.b, ''
+    else:
+        lamina = shapes.lamina_of(s, outline)
+        a, b = shapes.axes_of(lamina)
+        what = "the outline's " if s.shape == 'points' else ''
+        for name, value in (('a', a), ('b', b)):
+            p = BY_NAME[name]
+            if not p.low <= value <= p.high:
+                raise ValueError(f'{what}{name} must satisfy {p.rule}, got {value:.6g} m')
+    ratio = b / a
     if not B_OVER_A[0] <= ratio <= B_OVER_A[1]:
-        raise ValueError(f'b/a must be in [{B_OVER_A[0]:g}, {B_OVER_A[1]:g}], got '
-                         f'b = {s.b!r} m, a = {s.a!r} m (b/a = {ratio:.6g})')
-    ratio = s.delta / s.a
+        raise ValueError(f'{what}b/a must be in [{B_OVER_A[0]:g}, {B_OVER_A[1]:g}], got '
+                         f'b = {b!r} m, a = {a!r} m (b/a = {ratio:.6g})')
+    ratio = s.delta / a
     if not DELTA_OVER_A[0] <= ratio <= DELTA_OVER_A[1]:
         raise ValueError(f'delta/a must be in [{DELTA_OVER_A[0]:g}, 1 - 1e-6] (0 < delta < a), '
-                         f'got delta = {s.delta!r} m, a = {s.a!r} m (delta/a = {ratio:.6g})')
-    body = TwoDiskBody(s.a, s.b, s.delta)
-    if abs(s.theta0) > body.theta_max:
-        raise ValueError(f'theta0 must satisfy |theta0| <= theta_max = {body.theta_max:.6g} '
+                         f'got delta = {s.delta!r} m, {what}a = {a!r} m (delta/a = {ratio:.6g})')
+    if s.shape == 'ellipse':
+        theta_max = TwoDiskBody(s.a, s.b, s.delta).theta_max
+    else:
+        theta_max = shapes.theta_max_of(lamina, s.delta, s.arrangement)
+    if abs(s.theta0) > theta_max:
+        raise ValueError(f'theta0 must satisfy |theta0| <= theta_max = {theta_max:.6g} '
                          f'rad for this body, got {s.theta0!r}')
     if not s.realtime and s.duration <= 0:
         raise ValueError('duration must be > 0 s when realtime is false (a batch run needs '
@@ -178,7 +221,10 @@ def _check_together(s):
         if min(moments) <= 0:
             raise ValueError('principal_moments must be 3 numbers > 0 kg m^2 for '
                              f'mass_model custom, got {list(moments)!r}')
-    s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
+    if s.shape == 'ellipse':
+        s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
+    elif s.mass_model == 'custom':
+        custom(s.mass, s.principal_moments)   # the triangle inequalities (any shape)
 
 
 def _check_body_frame(body_frame, frame_id):
@@ -199,11 +245,15 @@ def _check_body_frame(body_frame, frame_id):
 
 
 class _SettingsMethods:
-    def checked(self):
-        """Return self if every value is allowed, else raise ValueError (one line)."""
+    def checked(self, outline=None):
+        """Return self if every value is allowed, else raise ValueError (one line).
+
+        ``outline``: for shape points, the fitted outline to check instead of reading
+        ``shape_file`` (a recording's, :func:`~twodisk_ros.run.shape.outline_from_metadata`).
+        """
         for p in PARAMETERS:
             _check_one(p, getattr(self, p.name))
-        _check_together(self)
+        _check_together(self, outline)
         return self
 
     def with_values(self, **values):
@@ -213,11 +263,18 @@ class _SettingsMethods:
             raise ValueError(f'unknown parameter {unknown[0]!r}')
         return replace(self, **{k: _check_one(BY_NAME[k], v) for k, v in values.items()})
 
-    def mass_properties(self):
-        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of these settings."""
+    def mass_properties(self, outline=None):
+        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of these settings.
+
+        Ellipses: the closed forms of a, b, delta. Other shapes: those of the run's body
+        (:meth:`twodisk_ros.run.description.RunDescription.mass`).
+        """
         moments = self.principal_moments if self.mass_model == 'custom' else None
-        return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
-                               principal_moments=moments)
+        if self.shape == 'ellipse':
+            return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
+                                   principal_moments=moments)
+        from ..run.description import RunDescription
+        return RunDescription(self, outline).mass
 
     def as_strings(self):
         """Every parameter as text (the recording's metadata; read by :func:`parse_recorded`)."""
@@ -225,9 +282,17 @@ class _SettingsMethods:
                          else str(getattr(self, p.name))) for p in PARAMETERS}
 
     def physics_differs(self, other):
-        """True if a parameter that shapes the motion differs (the motion restarts)."""
+        """True if a parameter that shapes the motion differs (the motion restarts).
+
+        A parameter that only another shape reads (:data:`SHAPE_ONLY`: ``exponent`` of an
+        ellipse run) does not count; ``a`` and ``b`` of two ``points`` runs do not either.
+        """
+        unread = {name for name, shape in SHAPE_ONLY.items()
+                  if self.shape != shape and other.shape != shape}
+        if self.shape == other.shape == 'points':
+            unread |= {'a', 'b'}
         return any(getattr(self, p.name) != getattr(other, p.name)
-                   for p in PARAMETERS if p.physics)
+                   for p in PARAMETERS if p.physics and p.name not in unread)
 
 
 #: Settings of the node (SI units): a frozen dataclass with one field per parameter.
@@ -263,6 +328,10 @@ def _from_text(parameter, text):
 def parse_recorded(strings):
     """Settings from a recording's ``twodisk_ros`` metadata (every value as text).
 
+    A recording without the shape parameters (made before them) is an ellipse run. One of
+    shape points is checked with the fitted outline it holds (``outline``), never by reading
+    its ``shape_file``.
+
     Returns
     -------
     (RollerSettings or None, list of str)
@@ -286,7 +355,12 @@ def parse_recorded(strings):
         values.pop('principal_moments', None)
     settings = replace(DEFAULTS, **values)
     try:
-        _check_together(settings)
+        outline = (shapes.outline_from_metadata(strings) if settings.shape == 'points'
+                   else None)
+    except ValueError as error:
+        return None, [str(error)]
+    try:
+        _check_together(settings, outline)
     except (ValueError, RuntimeError) as error:
         return None, [f'the recorded parameters define no valid run: {error}']
     return settings, []

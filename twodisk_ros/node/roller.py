@@ -40,8 +40,8 @@ from .descriptors import descriptor, ros_value
 from .parameters import BY_NAME, DEFAULTS, PARAMETERS
 from .path_history import PathHistory
 from .simulation import Simulation
-from ..physics.body import TwoDiskBody
 from ..physics.startup import startup_estimate
+from ..run.description import RunDescription
 
 __all__ = ['Roller']
 
@@ -82,10 +82,13 @@ class Roller(Node):
         if self.settings.record:   # before any work; never a file the node did not create
             check_output(self.settings.record, overwrite=self.settings.overwrite,
                          suffixes=('.mcap',), option='-p overwrite:=true')
-        cost = startup_estimate(TwoDiskBody(self.settings.a, self.settings.b, self.settings.delta))
+        run = RunDescription(self.settings)
+        if self.settings.shape != 'ellipse':
+            self.get_logger().info(f'shape: {run.shape_line}')
+        cost = startup_estimate(run.body)
         if cost.message:      # an extreme body: say what the tables cost while it is paid
             self.get_logger().info(cost.message)
-        self.simulation = Simulation(self.settings)
+        self.simulation = Simulation(self.settings, run)
         if self.settings.method == 'table' and self.simulation.stream.solver == 'DOP853':
             self.get_logger().info(
                 'no closed form of this motion is resolved (a start just below the barrier '
@@ -154,7 +157,9 @@ class Roller(Node):
         return self._pending is not None
 
     def _metadata(self):
-        metadata = self.settings.as_strings()
+        """The recording's metadata: the run's (parameters, a points run's outline)."""
+        metadata = self.simulation.run.metadata()
+        metadata.update(self.settings.as_strings())   # (friction, frames: changed in place)
         metadata['version'] = __version__
         return metadata
 

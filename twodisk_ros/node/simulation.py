@@ -1,19 +1,19 @@
 """The physics objects the node's settings build, sampled in blocks (no rclpy here).
 
-:class:`Simulation` turns :class:`~twodisk_ros.node.parameters.RollerSettings` into a body,
-a mass model, the dynamics, the equilibria and a motion stream, and samples everything the
-node publishes at a block of simulated times.
+:class:`Simulation` takes the body, mass model, dynamics and motion stream that
+:class:`~twodisk_ros.run.description.RunDescription` builds from
+:class:`~twodisk_ros.node.parameters.RollerSettings`, adds the equilibria and the contact
+forces, and samples everything the node publishes at a block of simulated times.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..physics.body import TwoDiskBody
+from ..model.outline import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
-from ..physics.dynamics import RollingDynamics
-from ..physics.motion import MotionStream
+from ..run.description import RunDescription
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
 
@@ -77,6 +77,8 @@ class Simulation:
     ----------
     settings : RollerSettings
         Checked settings.
+    run : RunDescription, optional
+        The description of these settings if already built (else built here).
 
     Raises
     ------
@@ -84,14 +86,14 @@ class Simulation:
         If the settings define no motion that can be simulated (one-line message).
     """
 
-    def __init__(self, settings):
-        s = self.settings = settings.checked()
-        self.body = TwoDiskBody(s.a, s.b, s.delta)
-        self.dynamics = RollingDynamics(self.body, s.mass_properties(), s.gravity)
-        u0 = float(self.body.phase_from_theta(s.theta0, s.branch))
-        u_dot0 = self.dynamics.initial_phase_rate(u0, s.omega0)
-        self.stream = MotionStream(self.dynamics, u0, u_dot0, mode=s.mode, method=s.method,
-                                   tolerance=s.tolerance)
+    def __init__(self, settings, run=None):
+        if run is None or run.settings != settings:
+            run = RunDescription(settings)
+        self.run = run
+        s = self.settings = run.settings
+        self.body = run.body
+        self.dynamics = run.dynamics
+        self.stream = run.stream()
         self.equilibria = self.dynamics.equilibria_with_periods()
         self.energy0 = self.stream.initial_energy
         self.angular_speed0 = abs(s.omega0)
@@ -185,13 +187,14 @@ class Simulation:
             [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
-    def disk_outlines(self, rotation, position_g, points=64):
-        """World points (m) of both disk outlines for one pose: two arrays (points + 1, 3)."""
-        a, b, d = self.body.a, self.body.b, self.body.delta
-        s = np.linspace(0.0, 2 * np.pi, points + 1)
-        disk1 = np.stack([b * np.sin(s), -d - a * np.cos(s), 0 * s], -1)
-        disk2 = np.stack([0 * s, d + a * np.cos(s), b * np.sin(s)], -1)
-        return disk1 @ rotation.T + position_g, disk2 @ rotation.T + position_g
+    def disk_outlines(self, rotation, position_g):
+        """World points (m) of both disk outlines for one pose: two closed arrays (N + 1, 3),
+        the real outline of the body's lamina to a polygon error of 2e-3 of its size
+        (:func:`~twodisk_ros.model.outline.disk_rims`, sampled once per body)."""
+        rims = self.__dict__.get('_outline_rims')
+        if rims is None:
+            rims = self.__dict__['_outline_rims'] = disk_rims(self.body)
+        return tuple(rim @ rotation.T + position_g for rim in rims)
 
     def hull_rims(self, rotation, position_g, points=64):
         """World end points A, B of the hull's rulings over one cycle: two arrays (points + 1, 3).

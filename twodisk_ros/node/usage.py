@@ -19,11 +19,17 @@ PROG = 'roller'
 USAGE = f"""\
 usage: {PROG} [-h] [--version] [--ros-args [-p NAME:=VALUE ...] [--params-file FILE ...] ...]
 
-The twodisk_ros node: a rigid body of two elliptic disks (the oloid among them) rolling on a
-plane. It simulates the motion and publishes the pose, the body frame on /tf, the contact
-points, paths, markers, /diagnostics and /clock at `rate`, the disk frames on /tf_static and
-the URDF on robot_description, optionally recording every message to an MCAP file (`record`).
-It runs until `duration` of simulated time (0: until SIGINT or SIGTERM).
+The twodisk_ros node: a rigid body of two congruent disks in perpendicular planes (the oloid
+among them) rolling on a plane. It simulates the motion and publishes the pose, the body frame
+on /tf, the contact points, paths, markers, /diagnostics and /clock at `rate`, the disk frames
+on /tf_static and the URDF on robot_description, optionally recording every message to an MCAP
+file (`record`). It runs until `duration` of simulated time (0: until SIGINT or SIGTERM).
+
+The disks' shape (`shape`): ellipse (semi-axes a along the common axis, b across), superellipse
+(a, b and `exponent` n: |x/b|^n + |y/a|^n <= 1), egg (a, b and `egg_asymmetry`) or points (the
+outline of `shape_file`, a CSV or YAML list of x, y points in metres around it: a and b are
+then the outline's, and the parameters a and b are not used). `arrangement` turns the second
+disk end for end (swapped) or not (parallel). A recording keeps a points outline as fitted.
 
 Parameters are ROS 2 parameters and go after --ros-args:
   -p NAME:=VALUE        one parameter; doubles need a decimal point (rate:=50.0)
@@ -35,6 +41,8 @@ Every parameter with its type, default, unit and allowed values:
 examples:
   ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml -p rate:=50.0
   {PROG} --ros-args -p realtime:=false -p duration:=2.0 -p record:=run.mcap
+  {PROG} --ros-args -p shape:=superellipse -p exponent:=4.0 -p delta:=0.05
+  {PROG} --ros-args -p shape:=points -p shape_file:=outline.csv -p delta:=0.03
 
 exit status: 0 the run ended (duration reached, SIGINT, SIGTERM); 1 internal error;
 2 invalid input (one line on stderr); 3 the recording could not be written.

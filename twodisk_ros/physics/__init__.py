@@ -15,7 +15,9 @@ Modules, from geometry to motion (docs/physics.md derives each):
   foundation of general bodies, with :mod:`~twodisk_ros.physics.general_body` (their
   contact geometry from the support function) and
   :mod:`~twodisk_ros.physics.symmetric_stability` (the stability of their symmetric
-  equilibria in closed form); not yet used by the cycle, dynamics or node;
+  equilibria in closed form); :mod:`~twodisk_ros.physics.lamina_body` makes them rolling
+  bodies (:mod:`~twodisk_ros.physics.rolling_body`: the protocol the cycle, dynamics, forces
+  and equilibria read, which :class:`TwoDiskBody` implements with its closed forms);
 - :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
   :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
 """

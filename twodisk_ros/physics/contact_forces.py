@@ -4,20 +4,14 @@ Frames and units: world frame with z up (the ground is z = 0); body frame ``G e1
 :mod:`twodisk_ros.body`. Forces in N, moments in N m, speeds in rad/s. The derivation is in
 docs/physics.md, section "Contact forces".
 
-Newton-Euler with both contacts at rest (no slip), in the body frame, per unit of the phase u:
-ω = ω_u u̇, ω̇ = ω_u′ u̇² + ω_u ü, v_G = u̇ c with c = −ω_u × r1, hence
-
-    a_G = u̇² (ω_u × c + c′) + ü c,          (c′ = dc/du: A moves along the boundary)
-    F_A + F_B = M a_G + M g n,                L_G = u̇² (I ω_u′ + ω_u × I ω_u) + ü I ω_u,
-
-n the ground normal, r1 = GA, r2 = GB (paper eq. (2)), d = r2 − r1 = |AB| ê. Moments about A:
+Newton–Euler with both contacts at rest (no slip), moments about A (d = r2 − r1 = |AB| ê):
 d × F_B + τ ê = L_G − r1 × (F_A + F_B) =: L_A, so F_B⊥ = (L_A × d)/|d|² and τ = ê·L_A (the
-drive torque; zero along a free motion, where it is the residual of m ü + ½ m′ u̇² + V′ = 0).
-Only the sum S of the components along ê is determined (the squeeze, resolved by
-:func:`squeeze_split`). Every output is linear in (1, u̇², ü) with coefficients that depend on
-u only: they are tabulated once per cycle (quintic Hermite, spectral derivatives), so 10⁶
-states take ~0.4 s (benchmarks/contact_forces_rate.py). V = M g z_G is the paper's section 4;
-the heading of the trace of A, which orients ê in the world, solves its eqs. (4)-(6).
+drive torque; zero along a free motion). Only the sum S along ê is determined (the squeeze,
+resolved by :func:`squeeze_split`). The coefficients, per unit of the body's turn γ for any
+RollingBody, are built in :mod:`~twodisk_ros.physics.contact_terms` and tabulated once per
+cycle (quintic Hermite, spectral derivatives): 10⁶ states take ~0.4 s
+(benchmarks/contact_forces_rate.py). The heading of the trace of A, which orients ê in the
+world, solves the paper's eqs. (4)-(6).
 
 Public API: :class:`ContactForceModel` (``forces``, ``dynamic``, ``kinematic``, ``along``,
 ``coefficients``), :class:`ContactForces`, :func:`squeeze_split`. Validity checks and
@@ -28,10 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .analytic import complex_step
 from .body_batch import cross, dot
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
+from .contact_terms import ForceTerms
 from .spectral import real_spectral_derivative, spectral_derivative, spectral_tail
 from .tables import HermiteTable
 
@@ -48,12 +42,6 @@ BLOCK = 8192   # states per block (keeps the temporaries in cache)
 
 def _dot(x, y):
     return np.sum(x * y, axis=-1)
-
-
-def _periodic_table(values):
-    """Quintic Hermite table over one cycle of columns sampled at u_j = 2πj/N (spectral f′, f″)."""
-    first = spectral_derivative(values)
-    return HermiteTable.periodic(values, first, spectral_derivative(first))
 
 
 def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
@@ -107,7 +95,8 @@ def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
 def kinematic_coefficients(samples, inertia, mass, gravity):
     """The kinematic columns of :class:`ContactForceModel` at one cycle's nodes, for a batch.
 
-    The same construction as the model's tables (Newton-Euler per unit u, moments about A,
+    Ellipses only (TwoDiskBodies, which turn at every u: |ω_u| > 0); the same construction
+    as the model's tables in u (Newton-Euler per unit u, moments about A,
     spectral u-derivatives of dG/du, ω_u and |ω_u|), for B bodies at once and component by
     component, without the heading and the drive torque, which the lift-off speed and
     μ_required do not need.
@@ -169,7 +158,10 @@ class ContactForces:
     """Ground forces on the body at A and at B, arrays over states (world frame, N).
 
     ê is the horizontal unit vector from A to B, p = e_z × ê; the split of the total along ê
-    is the one needing the least friction (:func:`squeeze_split`).
+    is the one needing the least friction (:func:`squeeze_split`). Where the body stops
+    turning while a contact sweeps a flat vertex (docs/physics.md#contact-forces) a force
+    component is ±inf for that instant (0 if its singular part vanishes), μ_required and the
+    ratios are their limits there, u̇ = inf and ü = nan (u is no coordinate at that instant).
     """
 
     phase: np.ndarray               #: u (rad)
@@ -188,12 +180,10 @@ class ContactForces:
     ratio_b: np.ndarray             #: |F_B tangential|/N_B at the split (inf if N_B ≤ 0)
     mu_required: np.ndarray         #: least friction coefficient for rolling (inf on lift-off)
     drive_torque: np.ndarray        #: τ (N m): external moment τ ê on the body (≈ 0 if free)
+    along_b: np.ndarray             #: F_B·ê (N) of the chosen split (S − F_A·ê)
+    angular_speed: np.ndarray       #: w = |ω| (rad/s), ≥ 0, finite where u̇ is not
+    angular_acceleration: np.ndarray  #: ẇ (rad/s²): the body's angular acceleration about AB
     weight: float                   #: M g (N)
-
-    @property
-    def along_b(self):
-        """F_B·ê (N) of the chosen split."""
-        return self.along_ab - self.along_a
 
     @property
     def normal_a_per_weight(self):
@@ -214,6 +204,11 @@ class ContactForces:
 class ContactForceModel:
     """Contact forces of one body with one mass model, from per-cycle tables.
 
+    Any :class:`~twodisk_ros.physics.rolling_body.RollingBody`: the coefficients are built
+    per unit of the body's turn γ (:mod:`~twodisk_ros.physics.contact_terms`), so they stay
+    finite where the body stops turning in u; where it stops turning while a contact sweeps
+    a flat vertex the forces are infinite for an instant (docs/physics.md#contact-forces).
+
     Parameters
     ----------
     dynamics : RollingDynamics
@@ -229,6 +224,8 @@ class ContactForceModel:
     spectral_tail : float
         Relative size of the unresolved spectrum of the coefficient tables (~1e-13 or less
         when resolved).
+    terms : ForceTerms
+        The coefficients at the nodes of the table coordinate y (``terms.regular``: y = u).
     """
 
     def __init__(self, dynamics, nodes=None):
@@ -243,113 +240,170 @@ class ContactForceModel:
 
     # -- tables ------------------------------------------------------------------------------
     def _build(self, n):
-        u = TWO_PI * np.arange(n) / n
-        geo = self.body.phase_geometry(u)
-        r1, r2, normal, t1 = geo.contact_a, geo.contact_b, geo.ground_normal, geo.tangent_a
-        inertia, mass, g = self.dynamics.mass.inertia, self.mass, self.dynamics.gravity
-        w = self.body.phase_angular_velocity(u)                  # ω_u, body frame
-        c = -np.cross(w, r1)                                     # dG/du, body frame
-        k = np.cross(w, c) + spectral_derivative(c)             # a_G per u̇² (body frame)
-        iw = w @ inertia
-        d = r2 - r1
-        length2 = _dot(d, d)
-        e = d / np.sqrt(length2)[:, None]
-        p = np.cross(normal, e)
-        # coefficient sets (gravity, u̇², ü) of the total force and of the moment about G
-        force = (mass * g * normal, mass * k, mass * c)
-        moment = (np.zeros_like(w), spectral_derivative(w) @ inertia + np.cross(w, iw), iw)
-        coef = np.empty((n, 3, _K))
-        for j, (f, m) in enumerate(zip(force, moment)):
-            moment_a = m - np.cross(r1, f)
-            f_b = np.cross(moment_a, d) / length2[:, None]
-            coef[:, j] = np.stack([_dot(f, normal) - _dot(f_b, normal), _dot(f_b, normal),
-                                   _dot(f, p) - _dot(f_b, p), _dot(f_b, p), _dot(f, e),
-                                   _dot(moment_a, e)], axis=-1)
-        # world direction of ê: heading α of t1 (paper eqs. (4)-(6)) plus the angle of ê from
-        # t1, stored as a periodic part plus slope·u (the cycle's turn, plus any winding)
-        gamma = np.unwrap(np.arctan2(_dot(e, np.cross(normal, t1)), _dot(e, t1)))
+        terms = self.terms = ForceTerms(self.body, self.dynamics.mass.inertia, self.mass,
+                                        self.dynamics.gravity, n)
         self._turn = self.cycle.displacement.turn
-        periodic = self.cycle.heading(u) + gamma - self._turn / TWO_PI * u
-        winding = round((2 * periodic[-1] - periodic[-2] - periodic[0]) / TWO_PI)
-        self._slope = self._turn / TWO_PI + winding
-        heading = periodic - winding * u
-        # the modes: ü = −(V′ + ½ m′ u̇²)/m (dynamic); u̇ = Ω/w, ü = −Ω² w′/w³ (kinematic)
-        m_u = _dot(w, iw) + mass * _dot(c, c)
-        speed = np.linalg.norm(w, axis=-1)
-        dv = mass * g * complex_step(self.body.phase_height, u)
-        dyn0, dyn2 = -dv / m_u, -0.5 * spectral_derivative(m_u) / m_u
-        kin2 = -spectral_derivative(speed) / speed**3
+        heading, self._slope = self._heading(terms)
+        # Q = A + a C / s (a = Ω² or w²); the 7th quantity is ẇ = γ̈
+        j, dj = terms.inertia_line, terms.inertia_slope
+        dyn0 = -terms.potential_turn_slope() / j
+        dyn2 = -0.5 * dj / j
+        zero = np.zeros((n, 1))
+        rates = np.column_stack([terms.s, terms.s_u, terms.ds_u, heading])
         self._columns = {
-            'general': np.column_stack([coef.reshape(n, 3 * _K), heading]),
-            'dynamic': np.column_stack([coef[:, 0] + dyn0[:, None] * coef[:, 2], dyn0,
-                                        coef[:, 1] + dyn2[:, None] * coef[:, 2], dyn2,
-                                        heading]),
-            'kinematic': np.column_stack([coef[:, 0], np.zeros(n), coef[:, 1] / speed[:, None]**2
-                                          + kin2[:, None] * coef[:, 2], kin2, 1.0 / speed,
-                                          heading])}
-        self.spectral_tail = max(spectral_tail(x) for x in self._columns.values())
+            'dynamic': np.column_stack([terms.q_g + dyn0[:, None] * terms.q_a, dyn0,
+                                        terms.p + dyn2[:, None] * terms.q_a, dyn2, rates]),
+            'kinematic': np.column_stack([terms.q_g, zero, terms.p, zero, rates])}
+        if terms.regular:
+            self._general_columns(terms, heading)
+        self.spectral_tail = max(spectral_tail(x[:, :-3]) for x in self._columns.values())
+        # a singular coefficient below this is taken as zero at a flat-vertex instant
+        self._singular_floor = 1e-9 * np.max(np.abs(self._columns['kinematic'][:, 7:14]),
+                                             axis=0)
         self._tables = {}
 
+    def _heading(self, terms):
+        """Periodic part of the world heading of ê at the nodes (rad), and its slope per y:
+        the heading α of t1 (paper eqs. (4)-(6)) plus the angle of ê from t1, as a periodic
+        part plus slope·y (the cycle's turn, plus any winding)."""
+        e, normal, t1, y = terms.e, terms.normal, terms.t1, terms.y
+        gamma = np.unwrap(np.arctan2(_dot(e, np.cross(normal, t1)), _dot(e, t1)))
+        periodic = self.cycle.heading(terms.u) + gamma - self._turn / TWO_PI * y
+        winding = round((2 * periodic[-1] - periodic[-2] - periodic[0]) / TWO_PI)
+        return periodic - winding * y, self._turn / TWO_PI + winding
+
+    def _general_columns(self, terms, heading):
+        """(Q_g, Q_u̇², Q_ü) on nodes of u (smooth in u for any body: no division)."""
+        self._columns['general'] = np.column_stack([
+            terms.q_g, terms.ratio[:, None] * terms.p + terms.ds_u[:, None] * terms.q_a,
+            terms.s_u[:, None] * terms.q_a, terms.s_u, terms.ds_u, heading])
+
     def _table(self, kind):
-        if kind not in self._tables:
-            self._tables[kind] = _periodic_table(self._columns[kind])
+        if kind == 'general' and kind not in self._columns:
+            phase = ForceTerms(self.body, self.dynamics.mass.inertia, self.mass,
+                               self.dynamics.gravity, self.nodes, phase_only=True)
+            heading, slope = self._heading(phase)
+            if slope != self._slope:
+                raise RuntimeError('the heading of AB winds differently in u and in y')
+            self._general_columns(phase, heading)
+        if kind not in self._tables:      # quintic Hermite, spectral f′ and f″ at the nodes
+            first = spectral_derivative(self._columns[kind])
+            self._tables[kind] = HermiteTable.periodic(self._columns[kind], first,
+                                                       spectral_derivative(first))
         return self._tables[kind]
 
     def coefficients(self, u, kind='kinematic'):
         """The tabulated coefficients at phase(s) u (rad), shape u.shape + (columns,).
 
-        ``'kinematic'``: Q0 (7 columns) then Q2 (7) with Q = Q0 + Ω² Q2 for each of
-        :data:`QUANTITIES` and ü, then 1/|ω_u|; ``'dynamic'``: Q0, Q2 with Q = Q0 + u̇² Q2
-        along a free motion; ``'general'``: (Q_g, Q_u̇², Q_ü), 6 each, for a given ü. The last
-        column is the periodic part of the heading of ê (rad).
+        ``'kinematic'``: A (7 columns) then C (7) with Q = A + Ω² C / s for each of
+        :data:`QUANTITIES` and γ̈ (rad/s²), then s = dγ/dy, dγ/du = |ω_u|, d²γ/du² and the
+        periodic part of the heading of ê (rad), tabulated in y = ``terms.coordinate(u)``
+        (u itself for TwoDiskBody and LaminaBody); ``'dynamic'``: the same with
+        Q = A + w² C / s along a free motion of angular speed w; ``'general'``:
+        (Q_g, Q_u̇², Q_ü), 6 each, then dγ/du, d²γ/du² and the heading, tabulated in u.
         """
         u = np.asarray(u, dtype=float)
-        return self._table(kind)(np.mod(u, TWO_PI))
+        y = u if kind == 'general' else self.terms.coordinate(u)
+        return self._table(kind)(np.mod(y, TWO_PI))
 
     # -- forces ------------------------------------------------------------------------------
-    def _evaluate(self, kind, u, a, b=None):
-        """States in blocks: u (rad), a = u̇² or Ω², b = ü (general only)."""
+    def _evaluate(self, kind, u, a, b=None, per_phase=False):
+        """States in blocks: u (rad), a = u̇² (general) or Ω², w² (kinematic, dynamic), b = ü;
+        ``per_phase``: a is u̇² of a free motion (w² = |ω_u|² u̇²)."""
         arrays = [np.asarray(x, dtype=float) for x in (u, a) + ((b,) if b is not None else ())]
         shape = np.broadcast_shapes(*(x.shape for x in arrays))
         u, a, *b = (np.broadcast_to(x, shape).ravel() for x in arrays)
-        names = QUANTITIES + _SPLIT + ('phase_rate', 'phase_acceleration')
+        names = QUANTITIES + _SPLIT + ('along_b', 'phase_rate', 'phase_acceleration',
+                                       'angular_speed', 'angular_acceleration')
         out = {name: np.empty(u.size) for name in names}
         for name in ('force_a', 'force_b', 'direction_ab'):
             out[name] = np.empty((u.size, 3))
         table = self._table(kind)
-        width = _K if kind == 'general' else _K + 1
         for start in range(0, u.size, BLOCK):
             part = slice(start, start + BLOCK)
-            cycles = np.floor(u[part] / TWO_PI)
-            rest = u[part] - TWO_PI * cycles
+            y = u[part] if kind == 'general' else self.terms.coordinate(u[part])
+            cycles = np.floor(y / TWO_PI)
+            rest = y - TWO_PI * cycles
             f = table.combine(*table.weights(rest))
-            values = f[:, :width] + a[part, None] * f[:, width:2 * width]
-            if kind == 'general':
-                values += b[0][part, None] * f[:, 2 * width:3 * width]
-                out['phase_acceleration'][part] = b[0][part]
-            else:
-                out['phase_acceleration'][part] = values[:, _K]
-            out['phase_rate'][part] = np.sqrt(a[part]) * (f[:, -2] if kind == 'kinematic'
-                                                          else 1.0)
+            square = a[part]
+            if per_phase:
+                turn = (f[:, 15] if self.terms.regular else self.terms.turn_rates(u[part])[0])
+                square = square * turn * turn
+            values, singular = self._values(kind, f, square, b[0][part] if b else None)
+            out['phase_rate'][part] = u[part]       # (the phases, for _rates)
+            self._rates(kind, f, square, b[0][part] if b else None, values, out, part)
             for j, name in enumerate(QUANTITIES):
                 out[name][part] = values[:, j]
-            split = squeeze_split(*values[:, :5].T)
+            with np.errstate(invalid='ignore'):       # ±inf at flat-vertex instants
+                split = list(squeeze_split(*values[:, :5].T))
+                along_b = values[:, 4] - split[0]
+            if singular is not None:            # flat-vertex instants: the limits
+                limit = squeeze_split(*singular[:, :5].T)
+                rows = np.any(singular != 0, axis=1)
+                for k in (1, 2, 3):
+                    split[k] = np.where(rows, limit[k], split[k])
+                split[0] = np.where(rows, _infinite(limit[0]), split[0])
+                along_b = np.where(rows, _infinite(singular[:, 4] - limit[0]), along_b)
             for name, x in zip(_SPLIT, split):
                 out[name][part] = x
+            out['along_b'][part] = along_b
             heading = f[:, -1] + self._slope * rest + cycles * self._turn
             cos_h, sin_h = np.cos(heading), np.sin(heading)
             e = out['direction_ab'][part]
             e[:, 0], e[:, 1], e[:, 2] = cos_h, sin_h, 0.0
-            along = (split[0], values[:, 4] - split[0])
-            for name, x, tangential, normal in zip(('force_a', 'force_b'), along,
-                                                   values[:, 2:4].T, values[:, :2].T):
+            along = (split[0], along_b)
+            for k, (name, x, tangential) in enumerate(zip(('force_a', 'force_b'), along,
+                                                          values[:, 2:4].T)):
                 vector = out[name][part]
-                vector[:, 0] = x * cos_h - tangential * sin_h
-                vector[:, 1] = x * sin_h + tangential * cos_h
-                vector[:, 2] = normal
+                with np.errstate(invalid='ignore'):
+                    vector[:, 0] = x * cos_h - tangential * sin_h
+                    vector[:, 1] = x * sin_h + tangential * cos_h
+                vector[:, 2] = values[:, k]
+                if singular is not None:        # the direction of the singular parts
+                    x_s = limit[0] if k == 0 else singular[:, 4] - limit[0]
+                    t_s = singular[:, 2 + k]
+                    for j, value in ((0, x_s * cos_h - t_s * sin_h),
+                                     (1, x_s * sin_h + t_s * cos_h)):
+                        vector[:, j] = np.where(rows, _infinite(value), vector[:, j])
         out['phase'] = u
         return ContactForces(weight=self.weight, **{
             name: value.reshape(shape + value.shape[1:]) for name, value in out.items()})
+
+    def _values(self, kind, f, a, b):
+        """The 6 quantities and γ̈ (kinematic, dynamic) of a block; the singular parts a·C
+        (None if no state of the block sits where the body does not turn)."""
+        if kind == 'general':
+            return f[:, :_K] + a[:, None] * f[:, _K:2 * _K] + b[:, None] * f[:, 2 * _K:3 * _K], \
+                None
+        s = f[:, 14]
+        stopped = s <= 0.0
+        with np.errstate(divide='ignore', invalid='ignore'):
+            values = f[:, :7] + np.where(stopped, 0.0, a / s)[:, None] * f[:, 7:14]
+        if not np.any(stopped & (a > 0)):
+            return values, None
+        part = np.where(np.abs(f[:, 7:14]) > self._singular_floor, f[:, 7:14], 0.0)
+        singular = np.where((stopped & (a > 0))[:, None], a[:, None] * part, 0.0)
+        values = np.where(singular != 0, np.copysign(np.inf, singular),
+                          np.where(stopped[:, None], f[:, :7], values))
+        return values, singular
+
+    def _rates(self, kind, f, a, b, values, out, part):
+        """u̇, ü, w, ẇ of a block (u̇ = inf and ü = nan where the body does not turn in u)."""
+        if kind == 'general' or self.terms.regular:
+            s_u, ds_u = f[:, -3], f[:, -2]
+        else:                       # |ω_u| is smooth in u, not in the arc length
+            s_u, ds_u = self.terms.turn_rates(out['phase_rate'][part])
+        with np.errstate(divide='ignore', invalid='ignore'):
+            if kind == 'general':
+                u_dot = np.sqrt(a)
+                w, w_dot = s_u * u_dot, s_u * b + ds_u * a
+                u_ddot = b
+            else:
+                w, w_dot = np.sqrt(a), values[:, _K]
+                u_dot = np.where(s_u > 0, w / s_u, np.inf)
+                u_ddot = np.where(s_u > 0, (w_dot - ds_u * u_dot**2) / s_u, np.nan)
+        out['phase_rate'][part], out['phase_acceleration'][part] = u_dot, u_ddot
+        out['angular_speed'][part], out['angular_acceleration'][part] = w, w_dot
 
     def forces(self, u, u_dot, u_ddot):
         """Contact forces for any state (u, u̇, ü), with the drive moment that ü needs.
@@ -358,7 +412,8 @@ class ContactForceModel:
         ----------
         u, u_dot, u_ddot : array_like
             Phase (rad, any real value), its rate (rad/s) and acceleration (rad/s²),
-            broadcast together.
+            broadcast together (finite: where the body stops turning in u use
+            :meth:`kinematic` or :meth:`dynamic` with the angular speed).
 
         Returns
         -------
@@ -370,27 +425,34 @@ class ContactForceModel:
         """
         return self._evaluate('general', u, np.square(u_dot), u_ddot)
 
-    def dynamic(self, u, u_dot):
-        """Forces along a free motion (gravity only): ü = −(V′ + ½ m′ u̇²)/m.
+    def dynamic(self, u, u_dot=None, *, angular_speed=None):
+        """Forces along a free motion (gravity only): ẇ = −(½ J_γ w² + V_γ)/J.
 
         Parameters
         ----------
         u, u_dot : array_like
-            Phase (rad) and its rate (rad/s), broadcast together (e.g. a
-            :class:`~twodisk_ros.dynamics.RollingMotion`'s ``phase`` and ``phase_rate``).
+            Phase (rad) and its rate (rad/s, e.g. a RollingMotion's ``phase_rate``); or
+        angular_speed : array_like
+            instead of u̇, the angular speed w = |ω_u| u̇ (rad/s), finite where u̇ is not.
 
         Returns
         -------
         ContactForces
             ``drive_torque`` is the residual of the equation of motion (~1e-13 M g L).
         """
-        forces = self._evaluate('dynamic', u, np.square(u_dot))
-        forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
-                                            forces.phase.shape).copy()
+        if (u_dot is None) == (angular_speed is None):
+            raise TypeError('give exactly one of u_dot and angular_speed')
+        if angular_speed is None:
+            forces = self._evaluate('dynamic', u, np.square(u_dot), per_phase=True)
+        else:
+            forces = self._evaluate('dynamic', u, np.square(angular_speed))
+        if u_dot is not None:
+            forces.phase_rate = np.broadcast_to(np.asarray(u_dot, dtype=float),
+                                                forces.phase.shape).copy()
         return forces
 
     def kinematic(self, u, omega):
-        """Forces when a drive holds |ω| = Ω: u̇ = Ω/|ω_u|, ü = −Ω² |ω_u|′/|ω_u|³.
+        """Forces when a drive holds |ω| = Ω: u̇ = Ω/|ω_u|, ẇ = 0.
 
         Parameters
         ----------
@@ -400,7 +462,7 @@ class ContactForceModel:
         Returns
         -------
         ContactForces
-            Every component is Q0(u) + Ω² Q2(u); ``drive_torque`` τ (N m) is the drive's
+            Every component is A(u) + Ω² C(u)/s(u); ``drive_torque`` τ (N m) is the drive's
             moment τ ê about AB (convention of :meth:`forces`). u̇ is reported ≥ 0:
             reversing the motion changes no force.
         """
@@ -408,9 +470,28 @@ class ContactForceModel:
 
     def along(self, motion):
         """Forces at the samples of a :class:`~twodisk_ros.dynamics.RollingMotion`."""
+        state = getattr(motion.sol, 'state', None)
+        if state is not None:                       # SundmanSolution: (u, w) directly
+            speed = state(motion.t)[1]
+        else:
+            s_u = self.terms.turn_rates(motion.phase)[0]
+            with np.errstate(invalid='ignore'):
+                speed = s_u * motion.phase_rate
+            if not np.all(np.isfinite(speed)):      # u̇ = ∞ where the body does not turn
+                j = self.dynamics.tabulated_inertia(motion.phase)
+                energy = motion.energy[np.isfinite(motion.energy)][0]
+                free = np.sqrt(np.maximum(2 * (energy - self.dynamics.tabulated_potential(
+                    motion.phase)), 0.0) / j)
+                speed = np.where(np.isfinite(speed), speed, free if motion.mode == 'dynamic'
+                                 else speed[np.isfinite(speed)][0])
         if motion.mode == 'dynamic':
-            return self.dynamic(motion.phase, motion.phase_rate)
-        omega = abs(motion.phase_rate[0]) * float(self.dynamics.tabulated(motion.phase[0])[2])
-        forces = self.kinematic(motion.phase, omega)
+            forces = self.dynamic(motion.phase, angular_speed=speed)
+        else:
+            forces = self.kinematic(motion.phase, np.abs(speed).max())
         forces.phase_rate = np.asarray(motion.phase_rate, dtype=float).copy()
         return forces
+
+
+def _infinite(x):
+    """±inf with the sign of x, 0 where x = 0 (the limit of x/s as s → 0⁺)."""
+    return np.where(x == 0, 0.0, np.copysign(np.inf, x))

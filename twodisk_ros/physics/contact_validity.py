@@ -22,7 +22,7 @@ __all__ = ['ValidityReport', 'check_validity', 'motion_validity', 'liftoff_speed
            'liftoff_speed_batch', 'mu_required_kinematic', 'mu_required_kinematic_batch',
            'mu_required_dynamic']
 
-_STRIDE = len(QUANTITIES) + 1   # kinematic columns: Q0 (6 + ü) then Q2 (6 + ü)
+_STRIDE = len(QUANTITIES) + 1   # kinematic columns: A (6 + ẇ), C (6 + ẇ), s = dγ/dy, …
 
 
 @dataclass(frozen=True)
@@ -85,10 +85,12 @@ def motion_validity(model, motion, mu=math.inf):
 def liftoff_speed(model):
     """Critical |ω| (rad/s) above which a contact lifts off in kinematic motion.
 
-    In kinematic mode N(u; Ω) = N0(u) + Ω² N2(u) exactly, so Ω_c² = min over u and both
-    contacts of −N0/N2 where N2 < 0 (Ω_c = 0 if N0 ≤ 0 somewhere: the drive holding the body
-    at rest already lifts a contact). The minimum is located on the table nodes and refined
-    by bounded Brent on the interpolated tables (to ~1e-12 rad in u).
+    In kinematic mode N(u; Ω) = N0(u) + Ω² C_N(u)/s(u) exactly (s = dγ/dy ≥ 0, contact_terms),
+    so Ω_c² = min over u and both contacts of −N0 s/C_N where C_N < 0 (Ω_c = 0 if N0 ≤ 0
+    somewhere: the drive holding the body at rest already lifts a contact; Ω_c = 0 also
+    where the body stops turning on a flat vertex with C_N < 0: the force there is −∞ at any
+    speed). The minimum is located on the table nodes and refined by bounded Brent on the
+    interpolated tables (to ~1e-12 rad in u).
 
     Parameters
     ----------
@@ -103,28 +105,33 @@ def liftoff_speed(model):
     contact : str
         'A' or 'B' ('' if never).
     """
-    u = TWO_PI * np.arange(model.nodes) / model.nodes
+    u = model.terms.u                               # the phases of the table's nodes
     cols = model.coefficients(u)
-    step = TWO_PI / model.nodes
     best = (math.inf, math.nan, '')
     for j, name in ((0, 'A'), (1, 'B')):
-        n0, n2 = cols[:, j], cols[:, _STRIDE + j]
+        n0, n2, s = cols[:, j], cols[:, _STRIDE + j], cols[:, 2 * _STRIDE]
         if np.any(n0 <= 0):
-            return 0.0, float(u[np.argmin(n0)]), name
-        ratio = np.where(n2 < 0, -n0 / np.where(n2 < 0, n2, -1.0), np.inf)
+            return 0.0, float(u[np.argmin(n0)] % TWO_PI), name
+        # Ω² = −N0 s / C_N where C_N < 0: smooth, 0 where a flat vertex lifts the contact
+        ratio = np.where(n2 < 0, -n0 * np.maximum(s, 0.0) / np.where(n2 < 0, n2, -1.0),
+                         np.inf)
         i = int(np.argmin(ratio))
         if not np.isfinite(ratio[i]):
             continue
+        if ratio[i] == 0.0:
+            return 0.0, float(u[i] % TWO_PI), name
 
         def square(x, j=j):
             c = model.coefficients(x)
-            return -c[j] / c[_STRIDE + j] if c[_STRIDE + j] < 0 else math.inf
-        res = minimize_scalar(square, bounds=(u[i] - step, u[i] + step), method='bounded',
+            return -c[j] * c[2 * _STRIDE] / c[_STRIDE + j] if c[_STRIDE + j] < 0 else math.inf
+        low, high = u[i - 1] if i else u[-1] - TWO_PI, u[(i + 1) % len(u)] + (
+            TWO_PI if i + 1 == len(u) else 0.0)
+        res = minimize_scalar(square, bounds=(low, high), method='bounded',
                               options={'xatol': 1e-12})
         value, phase = (float(res.fun), float(res.x)) if res.fun <= ratio[i] else (
             float(ratio[i]), float(u[i]))
         if value < best[0] ** 2:
-            best = (math.sqrt(value), phase % TWO_PI, name)
+            best = (math.sqrt(max(value, 0.0)), phase % TWO_PI, name)
     return best
 
 
@@ -204,7 +211,8 @@ def mu_required_dynamic(model, energy, u0=None, samples=2048):
     """μ_required over the phases a free motion of energy E (J) reaches.
 
     Rolling over (E above every maximum of V) reaches the whole cycle; otherwise the well of
-    V holding ``u0`` (rad) if given, else every u with V(u) ≤ E. u̇² = 2(E − V)/m.
+    V holding ``u0`` (rad) if given, else every u with V(u) ≤ E. w² = 2(E − V)/J (the
+    angular speed, J the inertia about AB: finite also where the body does not turn in u).
 
     Returns
     -------
@@ -220,11 +228,10 @@ def mu_required_dynamic(model, energy, u0=None, samples=2048):
     if u0 is not None and energy < dynamics.potential_range[1]:
         _, low, high = dynamics.well(float(u0))
         u = low + (high - low) * (np.arange(samples) + 0.5) / samples
-    f = dynamics.tabulated(u)
-    rate2 = 2 * (energy - f[..., 1]) / f[..., 0]
+    rate2 = 2 * (energy - dynamics.tabulated_potential(u)) / dynamics.tabulated_inertia(u)
     reached = rate2 >= 0
-    mu = np.where(reached, model.dynamic(u, np.sqrt(np.maximum(rate2, 0.0))).mu_required,
-                  np.nan)
+    mu = np.where(reached, model.dynamic(u, angular_speed=np.sqrt(np.maximum(rate2, 0.0)))
+                  .mu_required, np.nan)
     return (float(np.nanmax(mu)) if np.any(reached) else math.nan), u, mu
 
 

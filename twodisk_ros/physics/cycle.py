@@ -21,8 +21,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
-from .body import TwoDiskBody
 from .orientation import contact_quaternion_samples
+from .rolling_body import check_rolling_body
 from .spectral import (TAIL_TOLERANCE, node_sum, refine_grid, spectral_antiderivative,
                        spectral_derivative, spectral_tail, spectral_tails)
 from .tables import HermiteTable
@@ -186,7 +186,8 @@ class RollingCycle:
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : RollingBody
+        TwoDiskBody or LaminaBody (rolling_body.py).
     resolution : int, optional
         Grid size of the spectral integration (power of two). By default it is doubled from
         512 until the upper half of the spectra of dα/du and of the trace's rate is below
@@ -217,9 +218,7 @@ class RollingCycle:
     BLOCK = 16384
 
     def __init__(self, body, resolution=None, oversampling=4):
-        if not isinstance(body, TwoDiskBody):
-            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
-        self.body = body
+        self.body = check_rolling_body(body)
         if resolution is None:
             resolution, tail = self._refine(body)
         else:

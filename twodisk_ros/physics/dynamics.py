@@ -18,10 +18,11 @@ import math
 import numpy as np
 
 from .analytic import complex_step
-from .body import TwoDiskBody
 from .cycle import RollingCycle, TWO_PI
 from .equilibria import equilibria, NEUTRAL, STABLE
+from .body import TwoDiskBody
 from .mass_models import MassProperties
+from .rolling_body import check_rolling_body
 from .spectral import spectral_derivative
 from .tables import HermiteTable
 from .wells import LocalWell, TabulatedWell
@@ -36,7 +37,7 @@ class RollingDynamics:
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : RollingBody
     mass_properties : MassProperties
         Mass (kg) and inertia about G (kg m², body frame); the centre of mass must be G.
     gravity : float
@@ -46,8 +47,7 @@ class RollingDynamics:
     """
 
     def __init__(self, body, mass_properties, gravity=9.81, cycle=None):
-        if not isinstance(body, TwoDiskBody):
-            raise TypeError(f'body must be a TwoDiskBody, got {type(body).__name__}')
+        check_rolling_body(body)
         if not isinstance(mass_properties, MassProperties):
             raise TypeError('mass_properties must be a MassProperties')
         gravity = float(gravity)
@@ -59,11 +59,13 @@ class RollingDynamics:
         self.mass = mass_properties
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
-        self._feature_width = min(1.0, body.b / body.a, body.a / body.b,
-                                  2 * math.sqrt(body.delta / body.a))
+        #: True for any body but the ellipse (whose closed forms keep today's paths)
+        self._general = not isinstance(body, TwoDiskBody)
+        self._feature_width = body.feature_width
         self._build_tables(4 * self.cycle.resolution)
         self._equilibria = None
         self._local_wells = {}
+        self._inertia_table = None
 
     # -- closed forms (the direct method) ---------------------------------------------------
     def effective_mass(self, u):
@@ -74,6 +76,17 @@ class RollingDynamics:
         v = np.cross(omega, r1)
         inertia = self.mass.inertia
         return (np.einsum('...i,ij,...j->...', omega, inertia, omega)
+                + self.mass.mass * np.sum(v * v, axis=-1))
+
+    def contact_line_inertia(self, u):
+        """J(u) = êᵀ I_G ê + M |ê × r1|² (kg m²): the moment of inertia about the contact
+        line AB (ê its unit direction), so that T = ½ J γ̇², γ̇ = |ω_u| u̇ the body's angular
+        speed. m = J |ω_u|²; unlike m, J stays positive where the body does not turn in u."""
+        geo = self.body.phase_geometry(np.asarray(u, dtype=float))
+        d = geo.contact_b - geo.contact_a
+        e = d / np.linalg.norm(d, axis=-1)[..., None]
+        v = np.cross(e, geo.contact_a)
+        return (np.einsum('...i,ij,...j->...', e, self.mass.inertia, e)
                 + self.mass.mass * np.sum(v * v, axis=-1))
 
     def angular_speed_per_phase(self, u):
@@ -119,6 +132,42 @@ class RollingDynamics:
         self.table_size = n
         self.potential_range = (float(v.min()), float(v.max()))
 
+    def tabulated_inertia(self, u, derivative=0):
+        """J(u) (kg m², :meth:`contact_line_inertia`) or J′(u) from a periodic table (built on
+        first use, on the grid of the other tables)."""
+        if self._inertia_table is None:
+            n = self.table_size
+            j = self.contact_line_inertia(TWO_PI * np.arange(n) / n)
+            first = spectral_derivative(j)
+            self._inertia_table = HermiteTable.periodic(j, first, spectral_derivative(first))
+        return self._inertia_table(np.mod(np.asarray(u, dtype=float), TWO_PI), derivative)
+
+    def contact_line_inertia_jet(self, u):
+        """(J, dJ/du) at u: :meth:`contact_line_inertia` and its 5-point slope (the step of
+        :meth:`effective_mass_jet`)."""
+        u = np.asarray(u, dtype=float)
+        h = _FD_STEP * self._feature_width
+        j = np.moveaxis(self.contact_line_inertia(u[..., None] + h * np.arange(-2.0, 3.0)),
+                        -1, 0)
+        return j[2], (j[0] - 8 * j[1] + 8 * j[3] - j[4]) / (12 * h)
+
+    @property
+    def general(self):
+        """True for any body but the ellipse: the motion is integrated in the regularised
+        time of :class:`~twodisk_ros.physics.solvers.SundmanSolution` where no closed form
+        applies, and wells about an equilibrium where the body does not turn in u have none."""
+        return self._general
+
+    def regular_centre(self, u_star):
+        """False if the body does not turn in u at the equilibrium u* (|ω_u| = 0) or z_G is
+        not quadratic there: no libration model in u (the ODE in τ is used instead)."""
+        if not self._general:
+            return True
+        for eq, _ in self.equilibria_with_periods():
+            if abs(math.remainder(u_star - eq.phase, TWO_PI)) < 1e-9:
+                return eq.order == 2.0 and eq.phase_curvature != 0.0
+        return True
+
     def tabulated(self, u, derivative=0):
         """(m, V, |ω_u|) at phase(s) u from the tables, shape u.shape + (3,)."""
         u = np.asarray(u, dtype=float)
@@ -141,18 +190,29 @@ class RollingDynamics:
         return self.mass.mass * g * self.body.size
 
     def equilibria_with_periods(self):
-        """[(Equilibrium, small-oscillation period in s or None)] for all eight equilibria.
+        """[(Equilibrium, small-oscillation period in s or None)] for all the equilibria.
 
-        T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u).
+        T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u); for a body
+        other than the ellipse T = 2π √(J(u*) / (M g d²z_G/dγ²)) in the body's turn γ
+        (:meth:`contact_line_inertia`), which holds also where the body does not turn in u
+        (m = V″ = 0 there). None where z_G − z* ~ |γ|^q with q < 2 (a flat vertex): the
+        period then depends on the amplitude (docs/physics.md#equilibria-of-any-body).
         Computed once per dynamics object.
         """
         if self._equilibria is None:
             result = []
             for eq in equilibria(self.body):
                 period = None
-                stiffness = self.mass.mass * self.gravity * eq.phase_curvature
-                if eq.stability == STABLE and stiffness > 0:
-                    period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase)) / stiffness)
+                if self._general:
+                    stiffness = self.mass.mass * self.gravity * eq.gamma_curvature
+                    if eq.has_linear_period and stiffness > 0:
+                        period = TWO_PI * math.sqrt(
+                            float(self.contact_line_inertia(eq.phase)) / stiffness)
+                else:
+                    stiffness = self.mass.mass * self.gravity * eq.phase_curvature
+                    if eq.stability == STABLE and stiffness > 0:
+                        period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase))
+                                                    / stiffness)
                 result.append((eq, period))
             self._equilibria = result
         return list(self._equilibria)

@@ -13,12 +13,17 @@ import math
 import numpy as np
 
 from .analytic import complex_step
+from .body import TwoDiskBody
+from .equilibria_general import (certified_roots, classify_root, max_rotation_rate,
+                                 root_series_curvatures)
+from .rolling_body import check_rolling_body
 from .spectral import node_sum, refine_grid, spectral_derivative_at, spectral_tail
 
 __all__ = ['Equilibrium', 'EquilibriumArrays', 'equilibria', 'equilibria_batch', 'stability_map',
            'STABLE', 'UNSTABLE', 'NEUTRAL']
 
 STABLE, UNSTABLE, NEUTRAL = 'stable', 'unstable', 'neutral'
+TWO_PI = 2 * math.pi
 
 #: |b² − 2a² + 2Δ²| below this fraction of max(a, b)² is reported as neutral.
 NEUTRAL_TOLERANCE = 1e-9
@@ -38,6 +43,19 @@ class Equilibrium:
     curvature: float          #: d²z_G/d(coordinate)² (m/rad²)
     phase_curvature: float    #: d²z_G/du² (m/rad²)
     stability: str            #: 'stable', 'unstable' or 'neutral'
+    #: q of z_G − z* ≈ A|γ|^q, γ the body's turn about AB (2 for every ellipse equilibrium)
+    order: float = 2.0
+    #: d²z_G/dγ² (m/rad²) when q = 2 (nan for the ellipse path: use ``curvature``)
+    gamma_curvature: float = math.nan
+    #: A (m/rad^q) of z_G − z* ≈ A|γ|^q (nan for the ellipse path)
+    leading: float = math.nan
+    #: |ω_u(u*)| (rad per rad of u): 0 at a degenerate phase (the body does not turn in u)
+    rotation_rate: float = math.nan
+
+    @property
+    def has_linear_period(self):
+        """True if stable with z_G quadratic in the turn: a small-oscillation period exists."""
+        return self.stability == STABLE and self.order == 2.0
 
 
 def _height_phase_curvatures(body, phases):
@@ -87,20 +105,73 @@ def _classify(curvature, margin_is_zero):
     return STABLE if curvature > 0 else UNSTABLE
 
 
-def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE):
-    """All eight equilibria of one cycle, ordered by phase.
+def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE, certificate=False):
+    """All equilibria of one cycle, ordered by phase.
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : RollingBody
+        A :class:`~twodisk_ros.physics.body.TwoDiskBody`: the eight equilibria at the
+        ellipse's fixed angles (exact). Any other body: every root of dz_G/du over the cycle
+        with a certificate that none is missed (:mod:`~twodisk_ros.physics.equilibria_general`).
     neutral_tolerance : float
-        |b² − 2a² + 2Δ²| ≤ neutral_tolerance · max(a, b)² is reported as 'neutral'
-        (z_G is then constant: the neutral case of the paper).
+        Ellipse: |b² − 2a² + 2Δ²| ≤ neutral_tolerance · max(a, b)² is reported as 'neutral'
+        (z_G is then constant: the neutral case of the paper). Other bodies:
+        |d²z_G/dγ²| ≤ neutral_tolerance · size is 'neutral'.
+    certificate : bool
+        Also return the :class:`~twodisk_ros.physics.equilibria_general.RootCertificate`
+        (None for the ellipse, whose equilibria are known in closed form).
 
     Returns
     -------
-    list of Equilibrium
+    list of Equilibrium, or (list, RootCertificate or None)
     """
+    check_rolling_body(body)
+    if not isinstance(body, TwoDiskBody):
+        found, proof = _general_equilibria(body, neutral_tolerance)
+        return (found, proof) if certificate else found
+    found = _ellipse_equilibria(body, neutral_tolerance)
+    return (found, None) if certificate else found
+
+
+def _general_equilibria(body, neutral_tolerance):
+    """Equilibria of any RollingBody: certified roots of dz_G/du, classified (module
+    equilibria_general)."""
+    roots, proof = certified_roots(body)
+    if not roots:
+        return [], proof
+    curvatures = root_series_curvatures(body, roots, proof.nodes)
+    max_rate = max_rotation_rate(body, proof.nodes)
+    phases = np.array([u for u, _, _ in roots])
+    found = []
+    for i, ((u, _, _), series_curv) in enumerate(zip(roots, curvatures)):
+        if len(phases) > 1:
+            gaps = np.abs(np.remainder(phases - u + math.pi, TWO_PI) - math.pi)
+            reach = 0.5 * float(np.min(np.delete(gaps, i)))
+        else:
+            reach = math.pi / 2
+        local = classify_root(body, float(series_curv), u, min(reach, math.pi / 4), max_rate)
+        geo = body.phase_geometry(u)
+        if local['order'] == 2.0:
+            curvature = local['gamma_curvature']
+            stability = (NEUTRAL if abs(curvature) <= neutral_tolerance * body.size
+                         else STABLE if curvature > 0 else UNSTABLE)
+        else:
+            curvature = math.nan
+            stability = STABLE if local['leading'] > 0 else UNSTABLE
+        branch = int(geo.branch)
+        found.append(Equilibrium(
+            name=f'theta={float(geo.theta):+.6f} (branch {branch:+d})', phase=float(u),
+            theta=float(geo.theta), psi=float(geo.psi), branch=branch,
+            height=float(geo.height), coordinate='gamma', curvature=curvature,
+            phase_curvature=0.0 if local['degenerate'] else float(series_curv),
+            stability=stability, order=local['order'], gamma_curvature=curvature,
+            leading=local['leading'], rotation_rate=local['rate']))
+    return found, proof
+
+
+def _ellipse_equilibria(body, neutral_tolerance):
+    """The eight equilibria of the ellipse at their fixed angles (exact)."""
     neutral = abs(body.stability_margin) <= neutral_tolerance * max(body.a, body.b) ** 2
     u_half_pi = math.asin(min(1.0, (math.pi / 2) / body.eta_max))
     entries = [
@@ -147,6 +218,9 @@ class EquilibriumArrays:
 
 def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
     """:func:`equilibria` of a batch of bodies at once (arrays instead of a list).
+
+    Ellipses only (TwoDiskBodies: the eight equilibria at the fixed angles); a batch of other
+    bodies takes :func:`equilibria` body by body.
 
     Parameters
     ----------
@@ -203,6 +277,9 @@ def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
 
 def stability_map(b_over_a, delta_over_a, neutral_tolerance=NEUTRAL_TOLERANCE):
     """Which family of equilibria is stable over a grid of shapes (a = 1).
+
+    Ellipses only (the paper's margin b² − 2a² + 2Δ²); for other laminae the symmetric
+    equilibria's stability is :mod:`~twodisk_ros.physics.symmetric_stability`.
 
     Parameters
     ----------

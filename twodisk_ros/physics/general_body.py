@@ -1,7 +1,8 @@
 """Two congruent laminae of any shape: the contact geometry solved from the support function.
 
-Step 2 of issue 20 (docs/physics.md#the-contact-geometry-of-any-laminae). Nothing else in
-the package uses this module yet; :class:`~twodisk_ros.physics.body.TwoDiskBody` stays the
+docs/physics.md#the-contact-geometry-of-any-laminae. :class:`~twodisk_ros.physics.lamina_body.
+LaminaBody` tabulates these exact solutions over the cycle; the hull (hull_general.py) and the
+drawing (model/) use them directly. :class:`~twodisk_ros.physics.body.TwoDiskBody` stays the
 exact, fast path for ellipses and is the reference the tests hold this one to.
 
 Body frame as in body.py (metres): O, the midpoint of the centres, is the origin; e2 is the
@@ -52,6 +53,9 @@ ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
 #: would mean a family in several pieces, which is refused).
 _CHECK_NODES = 2049
 _MAX_BISECTIONS = 2200
+#: Newton steps of the convex elevation equation at most (5 to 8 needed; bisection steps of
+#: the guard, if any, are among them).
+_NEWTON_STEPS = 200
 
 
 def _bisect(func, lo, hi):
@@ -91,6 +95,7 @@ class ContactGeometry:
     height: np.ndarray          #: z_G = n·(G − A) (m), G's height above the ground
     support_height: np.ndarray  #: h1(m) = h2(m) = max of m·P over the body, P from O (m)
     tilt: np.ndarray            #: angle between the plane of disk 1 and the ground (rad)
+    parameter_b: np.ndarray = None  #: B's lamina parameter on disk 2 (rad, in (−π, π])
 
 
 class GeneralTwoDiskBody:
@@ -170,14 +175,48 @@ class GeneralTwoDiskBody:
         """h(τ, c) of the lamina (m): disk 2's support in lamina coordinates."""
         return self.lamina.support(np.stack([tau, c], axis=-1)).height
 
-    def _elevation(self, nu, big_l):
-        """|τ| ≥ 0 with h(|τ|, σν_y) = L (0 where L ≤ h(0, σν_y): the turning point)."""
-        c = self.sigma * nu[..., 1]
-        # h(τ, c) ≥ τ x_max − |c| max(−y_min, y_max) bounds the root from above
+    def _elevation(self, nu, big_l, fast=False):
+        """|τ| ≥ 0 with h(|τ|, σν_y) = L (0 where L ≤ h(0, σν_y): the turning point).
+
+        By bisection, or with ``fast`` by :meth:`_convex_newton` (the same root).
+        """
+        return self._convex_root(self.sigma * nu[..., 1], big_l, fast)
+
+    def _convex_root(self, c, big_l, fast):
+        """t ≥ 0 with h(t, c) = L; h is even and convex in t (0 where L ≤ h(0, c))."""
+        # h(t, c) ≥ t x_max − |c| max(−y_min, y_max) bounds the root from above
         reach = max(-self.y_min, self.y_max)
         hi = np.maximum((big_l + np.abs(c) * reach) / self.x_max, 0.0) * (1 + 1e-12) + 1e-300
-        tau = _bisect(lambda t: self._h2(t, c) - big_l, np.zeros_like(hi), hi)
-        return np.where(big_l <= self._h_axis(c), 0.0, tau)
+        inside = big_l > self._h_axis(c)
+        if not fast:
+            tau = _bisect(lambda t: self._h2(t, c) - big_l, np.zeros_like(hi), hi)
+            return np.where(inside, tau, 0.0)
+        tau = np.zeros(np.shape(hi))
+        tau[inside] = self._convex_newton(c[inside], big_l[inside], hi[inside])
+        return tau
+
+    def _convex_newton(self, c, big_l, hi):
+        """The root t > 0 of f(t) = h(t, c) − L, f(0) < 0 < f(hi), by Newton's method from hi
+        with f′(t) = x of the support point (h's gradient): monotone for a convex f, guarded
+        by the bracket (bisection where a step would leave it); stops when a step changes t
+        by less than 4 ulp, or stalls at the rounding of f (a step no shorter than half the
+        previous one, below 1e-8 t)."""
+        lo, x = np.zeros_like(hi), hi.copy()
+        previous = np.full_like(hi, np.inf)
+        for _ in range(_NEWTON_STEPS):
+            found = self.lamina.support(np.stack([x, c], axis=-1))
+            f = found.height - big_l
+            lo, hi = np.where(f <= 0, x, lo), np.where(f > 0, x, hi)
+            with np.errstate(divide='ignore', invalid='ignore'):
+                new = x - f / found.point[..., 0]
+            new = np.where((new >= lo) & (new <= hi), new, lo + 0.5 * (hi - lo))
+            step = np.abs(new - x)
+            done = (step <= 4 * np.finfo(float).eps * x) | ((step >= 0.5 * previous)
+                                                             & (step <= 1e-8 * x))
+            x, previous = new, step
+            if np.all(done):
+                break
+        return x
 
     # -- assembling a pose -------------------------------------------------------------------
     def _pose(self, s, tau_abs, branch):
@@ -202,7 +241,8 @@ class GeneralTwoDiskBody:
             parameter_a=np.asarray(s, dtype=float) + zero, elevation=tau,
             contact_a=a_body - self.centroid, contact_b=b_body - self.centroid,
             ground_normal=n, tangent_a=tangent, height=height1 - m @ self.centroid,
-            support_height=height1, tilt=np.arctan2(np.hypot(n[..., 0], n[..., 1]), n[..., 2]))
+            support_height=height1, tilt=np.arctan2(np.hypot(n[..., 0], n[..., 1]), n[..., 2]),
+            parameter_b=support2.parameter + zero)
 
     @staticmethod
     def _branch_array(branch, shape):
@@ -316,25 +356,68 @@ class GeneralTwoDiskBody:
                     np.full_like(tau_abs, self.s_max))
         return self._pose(side * s, tau_abs, branch)
 
+    # -- the charts of the regular phase (lamina_phase.py) ------------------------------------
+    @property
+    def far_tip(self):
+        """Disk 2's lamina parameter (0 or π) of the tip B touches at the turning points."""
+        _, nu, _ = self._frame_a(np.asarray(self.s_max))
+        return 0.0 if self.sigma * float(nu[..., 1]) < 0 else math.pi
+
+    def elevation_of_parameter(self, s):
+        """|τ| (≥ 0) of the resting pose whose contact A has lamina parameter s (rad)."""
+        _, nu, big_l = self._frame_a(np.asarray(s, dtype=float))
+        return self._elevation(nu, big_l, fast=True)
+
+    def geometry_at_parameter(self, s, tau_abs, branch=1):
+        """:class:`ContactGeometry` from A's lamina parameter s (rad, its sign is θ's) and
+        the elevation |τ| (from either chart), on a branch (±1)."""
+        s = np.asarray(s, dtype=float)
+        return self._pose(s, np.asarray(tau_abs, dtype=float),
+                          self._branch_array(branch, s.shape))
+
+    def chart_from_b(self, s_b):
+        """(s, |τ|): A's lamina parameter (≥ 0, the side θ ≥ 0) and the elevation of the
+        resting pose whose contact B on disk 2 has lamina parameter ``s_b`` (rad).
+
+        The mirror of :meth:`geometry` with the disks' roles swapped: the in-plane part of
+        the downward normal m is B's outward lamina normal ν_B, so m ∝ (μ, σν_By, ν_Bx) with
+        μ ≥ 0 the elevation out of disk 2's plane, the root of the convex equation
+        h(μ, σν_By) = 2Δσν_By + B·ν_B (bisection); A is disk 1's support point in direction
+        (μ, σν_By). Well conditioned where A is away from disk 1's far tip (μ > 0), i.e. near
+        the turning points, where :meth:`geometry`'s ψ(θ) is not.
+        """
+        lam, sigma = self.lamina, self.sigma
+        s_b = np.asarray(s_b, dtype=float)
+        point = lam.point(s_b)
+        nu = lam.normal(s_b)
+        c = sigma * nu[..., 1]
+        big_l = 2 * self.delta * c + np.sum(point * nu, axis=-1)
+        mu = self._convex_root(c, big_l, fast=True)
+        s_a = lam.support(np.stack([mu, c], axis=-1)).parameter
+        return np.abs(s_a), np.abs(nu[..., 0]) / np.hypot(mu, c)
+
     # -- scale -------------------------------------------------------------------------------
     @property
     def size(self):
         """Largest distance (m) of a disk point from G (relative errors are quoted to it)."""
         cached = self.__dict__.get('_size')
         if cached is None:
-            g = float(self.centroid[1])
-            best = 0.0
-            # disk 1: |(x, y − Δ − g)|; disk 2: |(x, σy + Δ − g)| = |(x, y + σ(Δ − g))|
-            for offset in (-self.delta - g, self.sigma * (self.delta - g)):
-                def dist(s, offset=offset):
-                    p = self.lamina.point(s)
-                    return np.hypot(p[..., 0], p[..., 1] + offset)
-                grid = np.linspace(0.0, np.pi, 2049)
-                values = dist(grid)
-                j = int(np.argmax(values))
-                found = minimize_scalar(lambda s: -float(dist(s)),
-                                        bounds=(grid[max(j - 1, 0)], grid[min(j + 1, 2048)]),
-                                        method='bounded', options={'xatol': 1e-12})
-                best = max(best, float(values[j]), -float(found.fun))
-            cached = self.__dict__['_size'] = best
+            cached = self.__dict__['_size'] = self.size_about(float(self.centroid[1]))
         return cached
+
+    def size_about(self, g):
+        """Largest distance (m) of a disk point from the point g e2 (g in m, from O)."""
+        best = 0.0
+        # disk 1: |(x, y − Δ − g)|; disk 2: |(x, σy + Δ − g)| = |(x, y + σ(Δ − g))|
+        for offset in (-self.delta - g, self.sigma * (self.delta - g)):
+            def dist(s, offset=offset):
+                p = self.lamina.point(s)
+                return np.hypot(p[..., 0], p[..., 1] + offset)
+            grid = np.linspace(0.0, np.pi, 2049)
+            values = dist(grid)
+            j = int(np.argmax(values))
+            found = minimize_scalar(lambda s: -float(dist(s)),
+                                    bounds=(grid[max(j - 1, 0)], grid[min(j + 1, 2048)]),
+                                    method='bounded', options={'xatol': 1e-12})
+            best = max(best, float(values[j]), -float(found.fun))
+        return best

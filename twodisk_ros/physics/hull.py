@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-__all__ = ['hull_surface_area', 'unit_hull_moments']
+__all__ = ['PAIRS', 'hull_surface_area', 'relative_change', 'unit_hull_moments']
 
 # Quadrature settings of the solid hull: first grid (nodes in u), last grid, and the level
 # below which differences between successive grids are roundoff rather than truncation.
@@ -38,8 +38,8 @@ _ROUNDOFF = 1e-12
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(3)
 _LAMBDA = 0.5 * (_GL_X + 1.0)
 _LAMBDA_W = 0.5 * _GL_W
-# Index pairs of the six independent second moments, in the order of the integrand columns.
-_PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+#: Index pairs of the six independent second moments, in the order of the integrand columns.
+PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def _hull_surface(u, d):
@@ -102,7 +102,7 @@ def _hull_integrand(u, d):
     -------
     numpy.ndarray, shape (n, 10)
         Per unit ``u``: volume, the three first moments and the six second moments
-        (order of ``_PAIRS``); the integral over ``u`` in ``[0, 2 pi)`` gives the moments.
+        (order of ``PAIRS``); the integral over ``u`` in ``[0, 2 pi)`` gives the moments.
     """
     p, p_u, q, q_u = _hull_surface(u, d)
     w, w_u = q - p, q_u - p_u
@@ -113,7 +113,7 @@ def _hull_integrand(u, d):
         xn = weight * np.einsum('ij,ij->i', x, normal)
         out[:, 0] += xn / 3.0
         out[:, 1:4] += x * (xn / 4.0)[:, None]
-        for col, (i, j) in enumerate(_PAIRS, start=4):
+        for col, (i, j) in enumerate(PAIRS, start=4):
             out[:, col] += x[:, i] * x[:, j] * xn / 5.0
     return out
 
@@ -121,19 +121,21 @@ def _hull_integrand(u, d):
 def _unpack(sums):
     """Split the 10 integrals into volume, first moments (3,) and second moments (3, 3)."""
     second = np.empty((3, 3))
-    for col, (i, j) in enumerate(_PAIRS, start=4):
+    for col, (i, j) in enumerate(PAIRS, start=4):
         second[i, j] = second[j, i] = sums[col]
     return sums[0], sums[1:4].copy(), second
 
 
-def _difference(coarse, fine):
-    """Relative change between two quadratures (scale invariant under diagonal maps)."""
+def relative_change(coarse, fine):
+    """Relative change between two quadratures of the 10 integrals (volume, first moments,
+    second moments in the order of ``PAIRS``), scale invariant under diagonal maps: of the
+    volume, of each first moment to sqrt(vol S_ii), of each S_ij to sqrt(S_ii S_jj)."""
     v0, m0, s0 = _unpack(coarse)
     v1, m1, s1 = _unpack(fine)
     diag = np.diag(s1)
     errors = [abs(v1 - v0) / v1]
     errors.extend(np.abs(m1 - m0) / np.sqrt(v1 * diag))
-    for i, j in _PAIRS:
+    for i, j in PAIRS:
         errors.append(abs(s1[i, j] - s0[i, j]) / math.sqrt(diag[i] * diag[j]))
     return float(max(errors))
 
@@ -166,7 +168,7 @@ def unit_hull_moments(d, rtol):
         if not fine[0] > 0.0:
             raise RuntimeError(f'solid hull quadrature failed for delta/a = {d!r}: volume '
                                f'{fine[0]!r} is not positive')
-        error = _difference(coarse, fine)
+        error = relative_change(coarse, fine)
         if error <= rtol:
             volume, first, second = _unpack(fine)
             return volume, first, second, error

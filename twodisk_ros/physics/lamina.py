@@ -1,8 +1,8 @@
 """A planar lamina in its own plane: one protocol, and the ellipse, superellipse and egg.
 
 The foundation of bodies of any two congruent symmetric laminae: :mod:`general_body` solves
-their contact geometry from it; the cycle, dynamics and node do not use it yet
-(docs/physics.md#laminae-other-than-ellipses-foundation).
+their contact geometry from it and :mod:`lamina_body` makes them rolling bodies
+(docs/physics.md#laminae-other-than-ellipses).
 
 Lamina coordinates (metres), those of disk 1 in the body frame seen from its centre C1:
 ``x`` along e1 (the disk's other axis, semi-extent ``b``), ``y`` along e2 (the common axis,

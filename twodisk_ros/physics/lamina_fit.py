@@ -3,7 +3,7 @@
 The fitted lamina is a :class:`~twodisk_ros.physics.lamina.SupportLamina` whose support
 function is a cosine series h(φ) = Σ_{k=0..M} c_k cos kφ of the outward normal's angle φ
 (measured from −y): even in φ, so symmetric about the common axis y, exactly. The fit
-(docs/physics.md#laminae-other-than-ellipses-foundation), for points in order around the
+(docs/physics.md#laminae-other-than-ellipses), for points in order around the
 outline (either direction), x along the lamina's other axis and y along the common axis:
 
 1. checks: an (N, 2) array of finite numbers, N ≥ MIN_POINTS distinct consecutive points;

@@ -1,7 +1,11 @@
-"""Mass models of the rigid body made of two identical elliptical disks.
+"""Mass models of the rigid body made of two congruent laminae (ellipses or any shape).
 
-Body frame ``G e1 e2 e3`` (metres): G is the origin, the midpoint of the disk centres and the
-centre of mass of every model here. Disk 1 lies in the plane ``x3 = 0`` with centre
+:func:`mass_properties_of` takes any rolling body (its ``lamina``, ``delta``, ``arrangement``);
+:func:`mass_properties` and the functions below it are the closed-form path of two ellipses,
+which :func:`mass_properties_of` takes for every elliptic lamina.
+
+Ellipses. Body frame ``G e1 e2 e3`` (metres): G is the origin, the midpoint of the disk
+centres and the centre of mass of every model here. Disk 1 lies in the plane ``x3 = 0`` with centre
 ``(0, -delta, 0)`` and boundary ``x1**2 / b**2 + (x2 + delta)**2 / a**2 = 1``; disk 2 lies in the
 plane ``x1 = 0`` with centre ``(0, +delta, 0)`` and boundary
 ``(x2 - delta)**2 / a**2 + x3**2 / b**2 = 1``. Allowed parameters: ``a > 0``, ``b > 0`` (``b > a``
@@ -19,18 +23,32 @@ Three models are offered:
     Principal moments given by the user, principal axes along ``e1, e2, e3``.
 
 The solid hull is computed in :mod:`twodisk_ros.physics.hull`; docs/physics.md#mass-models.
+
+Any lamina (general_body.py's frame): disk 1's lamina point (x, y) at (x, y − Δ, 0) from O,
+the midpoint of the centres, disk 2's at (0, Δ + σ y, x); G, the body-frame origin, is the
+laminae's centroid (1 + σ) ȳ/2 e2 (ȳ the lamina's centroid). ``laminae`` takes the lamina's
+area moments (centre of mass G exactly); ``solid`` the convex hull of the two laminae from
+:mod:`twodisk_ros.physics.hull_general`, whose centre of mass is off G along e2 for an
+asymmetric lamina (the egg) in the parallel arrangement. :func:`centred_on_mass` moves such
+a body's origin to that centre of mass (LaminaBody.about), as the dynamics needs.
 """
 
-from dataclasses import dataclass, fields
+import dataclasses
 from functools import lru_cache
 import math
+import weakref
 
 import numpy as np
 
+from .general_body import ARRANGEMENTS
 from .hull import unit_hull_moments
+from .hull_general import general_hull_moments
+from .lamina import Ellipse, Lamina
+from .mass_record import MassProperties, check_rtol, one_line, positive, real_number
 
-__all__ = ['MODELS', 'MassProperties', 'clear_hull_cache', 'custom', 'laminae', 'mass_properties',
-           'solid_hull']
+__all__ = ['MODELS', 'MassProperties', 'centred_on_mass', 'clear_hull_cache', 'custom',
+           'laminae', 'laminae_of', 'mass_properties', 'mass_properties_of', 'solid_hull',
+           'solid_of']
 
 #: Model names accepted by :func:`mass_properties`.
 MODELS = ('laminae', 'solid', 'custom')
@@ -39,143 +57,15 @@ MODELS = ('laminae', 'solid', 'custom')
 _TRIANGLE_SLACK = 1e-12
 
 
-@dataclass(frozen=True, eq=False)
-class MassProperties:
-    """Mass properties of the two-disk body in the body frame ``G e1 e2 e3``.
-
-    Parameters
-    ----------
-    model : str
-        Name of the mass model: ``'laminae'``, ``'solid'`` or ``'custom'``.
-    mass : float
-        Total mass (kg).
-    center_of_mass : numpy.ndarray, shape (3,)
-        Centre of mass (m, body frame). It is G (the origin) for every model; for ``'solid'``
-        it is the computed value, zero up to roundoff.
-    inertia : numpy.ndarray, shape (3, 3)
-        Inertia tensor about G (kg m**2, body frame), symmetric.
-    volume : float or None
-        Volume of the solid (m**3) for ``'solid'``, else None.
-    relative_error : float
-        Estimated relative error of the quadrature (``'solid'``; 0.0 for the closed-form
-        models): the largest relative change of the volume, the centre of mass and each
-        second moment between the last two grids. It bounds the error of the returned values,
-        which come from the finer grid.
-
-    Notes
-    -----
-    The arrays are stored as read-only float copies. ``==`` compares all fields by value.
-    """
-
-    model: str
-    mass: float
-    center_of_mass: np.ndarray
-    inertia: np.ndarray
-    volume: float | None = None
-    relative_error: float = 0.0
-
-    def __post_init__(self):
-        com = np.array(self.center_of_mass, dtype=float)
-        inertia = np.array(self.inertia, dtype=float)
-        if com.shape != (3,):
-            raise ValueError(f'center_of_mass must have shape (3,), got shape {com.shape}')
-        if inertia.shape != (3, 3):
-            raise ValueError(f'inertia must have shape (3, 3), got shape {inertia.shape}')
-        com.setflags(write=False)
-        inertia.setflags(write=False)
-        object.__setattr__(self, 'center_of_mass', com)
-        object.__setattr__(self, 'inertia', inertia)
-        object.__setattr__(self, 'mass', float(self.mass))
-        object.__setattr__(self, 'relative_error', float(self.relative_error))
-        if self.volume is not None:
-            object.__setattr__(self, 'volume', float(self.volume))
-
-    def __eq__(self, other):
-        if not isinstance(other, MassProperties):
-            return NotImplemented
-        return all(
-            np.array_equal(getattr(self, f.name), getattr(other, f.name)) for f in fields(self)
-        )
-
-    __hash__ = None
-
-    @property
-    def principal_moments(self):
-        """Diagonal of the inertia tensor about G (kg m**2), along ``e1, e2, e3``.
-
-        Returns
-        -------
-        numpy.ndarray, shape (3,)
-            ``(I11, I22, I33)``. These are the principal moments: the products of inertia of
-            every model vanish by the symmetries of the body.
-        """
-        return np.diag(self.inertia).copy()
-
-
-# --------------------------------------------------------------------------- validation
-
-
-def _one_line(value, limit=80):
-    """Short one-line representation of ``value`` for error messages."""
-    text = ' '.join(repr(value).split())
-    return text if len(text) <= limit else text[:limit - 3] + '...'
-
-
-def _real(name, value, what):
-    """Convert a real scalar to float, or raise a one-line ValueError.
-
-    Parameters
-    ----------
-    name : str
-        Parameter name used in the message.
-    value : object
-        The value to convert.
-    what : str
-        What is allowed, e.g. ``'finite and > 0 kg'``.
-
-    Returns
-    -------
-    float
-    """
-    bad = isinstance(value, (bool, np.bool_, str, bytes))
-    if not bad:
-        try:
-            arr = np.asarray(value)
-            bad = arr.shape != () or arr.dtype.kind not in 'iuf'
-        except Exception:  # noqa: BLE001 - anything that is not array-like is invalid
-            bad = True
-    if bad:
-        raise ValueError(f'{name} must be a real number, {what}, got {_one_line(value)}')
-    return float(arr)
-
-
-def _positive(name, value, unit):
-    """Return ``value`` as a finite float > 0, or raise a one-line ValueError."""
-    what = f'finite and > 0 {unit}'
-    x = _real(name, value, what)
-    if not (math.isfinite(x) and x > 0.0):
-        raise ValueError(f'{name} must be {what}, got {x!r}')
-    return x
-
-
 def _geometry(a, b, delta):
     """Validate the disk geometry (m) and return it as floats ``(a, b, delta)``."""
-    a = _positive('a', a, 'm')
-    b = _positive('b', b, 'm')
+    a = positive('a', a, 'm')
+    b = positive('b', b, 'm')
     what = f'finite with 0 < delta < a = {a!r} m'
-    d = _real('delta', delta, what)
+    d = real_number('delta', delta, what)
     if not (math.isfinite(d) and 0.0 < d < a):
         raise ValueError(f'delta must be {what}, got {d!r}')
     return a, b, d
-
-
-def _rtol(rtol):
-    """Validate the relative tolerance of the solid quadrature."""
-    what = 'finite with 0 < rtol < 1'
-    x = _real('rtol', rtol, what)
-    if not (math.isfinite(x) and 0.0 < x < 1.0):
-        raise ValueError(f'rtol must be {what}, got {x!r}')
-    return x
 
 
 # --------------------------------------------------------------------------- models
@@ -207,7 +97,7 @@ def laminae(a, b, delta, mass):
         If a parameter is not allowed (one-line message).
     """
     a, b, d = _geometry(a, b, delta)
-    m = _positive('mass', mass, 'kg')
+    m = positive('mass', mass, 'kg')
     i11 = m * (2.0 * a * a + b * b) / 8.0 + m * d * d
     i22 = m * b * b / 4.0
     return MassProperties('laminae', m, np.zeros(3), np.diag([i11, i22, i11]))
@@ -236,7 +126,7 @@ def custom(mass, principal_moments):
     ValueError
         If a parameter is not allowed (one-line message).
     """
-    m = _positive('mass', mass, 'kg')
+    m = positive('mass', mass, 'kg')
     moments = _moments(principal_moments)
     return MassProperties('custom', m, np.zeros(3), np.diag(moments))
 
@@ -250,7 +140,7 @@ def _moments(principal_moments):
     except Exception:  # noqa: BLE001 - anything that is not array-like is invalid
         ok = False
     if not ok:
-        raise ValueError(f'principal_moments must be {what}, got {_one_line(principal_moments)}')
+        raise ValueError(f'principal_moments must be {what}, got {one_line(principal_moments)}')
     moments = arr.astype(float)
     shown = '(' + ', '.join(repr(float(x)) for x in moments) + ')'
     if not (np.all(np.isfinite(moments)) and np.all(moments > 0.0)):
@@ -279,8 +169,10 @@ def _unit_hull(d, rtol):
 
 
 def clear_hull_cache():
-    """Forget the quadratures :func:`solid_hull` remembers (to time a first call)."""
+    """Forget the quadratures :func:`solid_hull` and :func:`solid_of` remember (to time a
+    first call)."""
     _unit_hull.cache_clear()
+    _GENERAL_HULLS.clear()
 
 
 def solid_hull(a, b, delta, mass, *, rtol=1e-9):
@@ -319,8 +211,8 @@ def solid_hull(a, b, delta, mass, *, rtol=1e-9):
     the scaling after its first call.
     """
     a, b, d = _geometry(a, b, delta)
-    m = _positive('mass', mass, 'kg')
-    tol = _rtol(rtol)
+    m = positive('mass', mass, 'kg')
+    tol = check_rtol(rtol)
     vol, first, second, err = _unit_hull(d / a, tol)
     # Map the normalised body (a = b = 1) by diag(b, a, b); the Jacobian is a b**2.
     scale = np.array([b, a, b])
@@ -363,7 +255,7 @@ def mass_properties(model, a, b, delta, mass, principal_moments=None, rtol=1e-9)
     """
     if not isinstance(model, str) or model not in MODELS:
         allowed = ', '.join(repr(name) for name in MODELS)
-        raise ValueError(f'model must be one of {allowed}, got {_one_line(model)}')
+        raise ValueError(f'model must be one of {allowed}, got {one_line(model)}')
     a, b, d = _geometry(a, b, delta)
     if model == 'custom':
         if principal_moments is None:
@@ -375,8 +267,186 @@ def mass_properties(model, a, b, delta, mass, principal_moments=None, rtol=1e-9)
     if principal_moments is not None:
         raise ValueError(
             f"principal_moments must be None unless model is 'custom', got "
-            f'{_one_line(principal_moments)} for model {model!r}'
+            f'{one_line(principal_moments)} for model {model!r}'
         )
     if model == 'laminae':
         return laminae(a, b, d, mass)
     return solid_hull(a, b, d, mass, rtol=rtol)
+
+
+# --------------------------------------------------------------------------- any lamina
+
+# solid_of's quadratures per lamina object: {(delta, arrangement, rtol): moments}
+_GENERAL_HULLS = weakref.WeakKeyDictionary()
+
+
+def _shape(lamina, delta, arrangement):
+    """Validate (lamina, delta, arrangement) of any body; return them with σ and G's y (m)."""
+    if not isinstance(lamina, Lamina):
+        raise ValueError(f'lamina must be a Lamina (Ellipse, Superellipse, Egg, Outline), got '
+                         f'{type(lamina).__name__}')
+    if arrangement not in ARRANGEMENTS:
+        raise ValueError(f'arrangement must be one of {sorted(ARRANGEMENTS)}, got '
+                         f'{one_line(arrangement)}')
+    _, y_min, y_max = lamina.extents
+    limit = 0.5 * (y_max - y_min)
+    what = f'finite with 0 < delta < {limit:.6g} m (half the lamina\'s length along e2)'
+    d = real_number('delta', delta, what)
+    if not (math.isfinite(d) and 0.0 < d < limit):
+        raise ValueError(f'delta must be {what}, got {d!r}')
+    sigma = ARRANGEMENTS[arrangement]
+    return d, sigma, 0.5 * (1.0 + sigma) * float(lamina.moments.centroid[1])
+
+
+def laminae_of(lamina, delta, arrangement, mass):
+    """Two thin uniform plates of mass ``mass / 2`` of any lamina, inertia about G.
+
+    Parameters
+    ----------
+    lamina : Lamina
+        The plates' shape (lamina.py), from its area moments (area A, centroid ȳ, ∫x², ∫y²).
+    delta : float
+        Half the distance between the centres (m), 0 < Δ < (y_max − y_min)/2.
+    arrangement : str
+        'parallel' or 'swapped' (σ = ±1, general_body.py).
+    mass : float
+        Total mass (kg), > 0.
+
+    Returns
+    -------
+    MassProperties
+        Centre of mass G (zero: G is the laminae's centroid); with k = M/(2A), the second
+        moments about O are ∫x1² = ∫x3² = k ∫x² dA, ∫x2² = k (2 ∫y² dA + 2Δ² A
+        + 2(σ − 1) Δ A ȳ), moved to G by −M g², g = (1 + σ) ȳ/2; I = tr(S) 1 − S.
+    """
+    d, sigma, g = _shape(lamina, delta, arrangement)
+    m = positive('mass', mass, 'kg')
+    moments = lamina.moments
+    area, y_bar = moments.area, float(moments.centroid[1])
+    k = 0.5 * m / area
+    # plate 1 at (x, y − Δ, 0), plate 2 at (0, Δ + σ y, x); ∫x dA = 0 by symmetry
+    s22 = k * (moments.second_yy - 2 * d * area * y_bar + d * d * area
+               + moments.second_yy + 2 * sigma * d * area * y_bar + d * d * area) - m * g * g
+    s11 = s33 = k * moments.second_xx
+    s12, s23 = k * moments.second_xy, sigma * k * moments.second_xy
+    second = np.array([[s11, s12, 0.0], [s12, s22, s23], [0.0, s23, s33]])
+    return MassProperties('laminae', m, np.zeros(3), np.trace(second) * np.eye(3) - second)
+
+
+def solid_of(lamina, delta, arrangement, mass, *, rtol=1e-9):
+    """Uniform solid convex hull of two laminae of any shape (hull_general.py).
+
+    Parameters
+    ----------
+    lamina, delta, arrangement, mass
+        As in :func:`laminae_of`.
+    rtol : float
+        Requested relative accuracy (0 < rtol < 1; roundoff floor about 1e-13).
+
+    Returns
+    -------
+    MassProperties
+        ``volume`` (m³), centre of mass from G (m, on e2), inertia about the centre of mass
+        (kg m²) and the quadrature's ``relative_error``. Remembered per lamina object.
+
+    Raises
+    ------
+    ValueError
+        For a body GeneralTwoDiskBody refuses (one line).
+    RuntimeError
+        If the quadrature cannot reach ``rtol``.
+    """
+    d, _, g = _shape(lamina, delta, arrangement)
+    m = positive('mass', mass, 'kg')
+    tol = check_rtol(rtol)
+    remembered = _GENERAL_HULLS.setdefault(lamina, {})
+    key = (d, arrangement, tol)
+    if key not in remembered:
+        remembered[key] = general_hull_moments(lamina, d, arrangement, tol)
+    vol, first, second, err = remembered[key]
+    com = first / vol                                     # from O
+    central = second - vol * np.outer(com, com)
+    inertia = m / vol * (np.trace(central) * np.eye(3) - central)
+    return MassProperties('solid', m, com - np.array([0.0, g, 0.0]), inertia, volume=vol,
+                          relative_error=err)
+
+
+def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
+    """Mass properties of any rolling body by model name.
+
+    Parameters
+    ----------
+    model : str
+        'laminae', 'solid' or 'custom'.
+    body : RollingBody
+        Anything with ``lamina``, ``delta`` and ``arrangement`` (TwoDiskBody, LaminaBody,
+        GeneralTwoDiskBody). An :class:`~twodisk_ros.physics.lamina.Ellipse` lamina takes the
+        closed-form path: exactly :func:`mass_properties` (model, a, b, delta, ...).
+    mass, principal_moments, rtol
+        As in :func:`mass_properties`.
+
+    Returns
+    -------
+    MassProperties
+        In the body frame with origin G, the laminae's centroid (the midpoint of the centres
+        for symmetric laminae), or the body's reference point G + offset e2 for a body moved
+        by :meth:`~twodisk_ros.physics.lamina_body.LaminaBody.about` (centre of mass from
+        it; inertia about the centre of mass either way).
+    """
+    props = _properties_of(model, body, mass, principal_moments, rtol)
+    offset = float(getattr(body, 'offset', 0.0))
+    if not offset:
+        return props
+    return dataclasses.replace(props, center_of_mass=props.center_of_mass
+                               - np.array([0.0, offset, 0.0]))
+
+
+def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
+    """(body, mass properties) whose body-frame origin is the centre of mass.
+
+    For a :class:`~twodisk_ros.physics.lamina_body.LaminaBody` the body is moved by the
+    centre of mass's e2 coordinate (``body.about``, sharing its tables) and the returned
+    centre of mass is exactly zero (its e1 and e3 parts vanish by the mirror symmetries;
+    more than 1e-12 of the size there is refused). Any other body (the ellipse's
+    TwoDiskBody, centre of mass at G by its symmetries) is returned as it is, with its
+    properties. Arguments as in :func:`mass_properties_of`.
+
+    Returns
+    -------
+    (RollingBody, MassProperties)
+        Ready for :class:`~twodisk_ros.physics.dynamics.RollingDynamics`.
+    """
+    props = mass_properties_of(model, body, mass, principal_moments, rtol)
+    com = props.center_of_mass
+    if not hasattr(body, 'about'):
+        return body, props
+    if max(abs(com[0]), abs(com[2])) > 1e-12 * body.size:
+        raise ValueError(f'the centre of mass {com.tolist()} m is off the common axis e2: '
+                         'the body cannot be moved onto it along e2')
+    return body.about(float(com[1])), dataclasses.replace(props, center_of_mass=np.zeros(3))
+
+
+def _properties_of(model, body, mass, principal_moments, rtol):
+    """:func:`mass_properties_of` about G."""
+    if not isinstance(model, str) or model not in MODELS:
+        allowed = ', '.join(repr(name) for name in MODELS)
+        raise ValueError(f'model must be one of {allowed}, got {one_line(model)}')
+    try:
+        lamina, delta, arrangement = body.lamina, body.delta, body.arrangement
+    except AttributeError:
+        raise ValueError(f'body must be a rolling body with lamina, delta and arrangement '
+                         f'(TwoDiskBody, LaminaBody), got {type(body).__name__}') from None
+    if type(lamina) is Ellipse:
+        return mass_properties(model, lamina.a, lamina.b, delta, mass, principal_moments, rtol)
+    _shape(lamina, delta, arrangement)
+    if model == 'custom':
+        if principal_moments is None:
+            raise ValueError("principal_moments must be given (I1, I2, I3) in kg m**2 for "
+                             "model 'custom', got None")
+        return custom(mass, principal_moments)
+    if principal_moments is not None:
+        raise ValueError(f"principal_moments must be None unless model is 'custom', got "
+                         f'{one_line(principal_moments)} for model {model!r}')
+    if model == 'laminae':
+        return laminae_of(lamina, delta, arrangement, mass)
+    return solid_of(lamina, delta, arrangement, mass, rtol=rtol)

@@ -31,6 +31,7 @@ from scipy.integrate import solve_ivp
 
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
+from .motion_general import SundmanSolution, general_closed_form, sundman
 from .solvers import (LibrationSolution, OdeSolution, QuadratureSolution, RestSolution)
 from .spectral import STALL, spectral_tail
 
@@ -168,19 +169,34 @@ def simulate(dynamics, t_eval, *, mode='dynamic', theta0=0.0, branch=1, omega0=0
         raise ValueError('t_eval must be a non-empty 1-d array of finite, strictly increasing '
                          'times >= 0 s')
     u0 = float(dynamics.body.phase_from_theta(theta0, branch))
+    if dynamics.general:       # u̇₀ is infinite where the body does not turn in u
+        return simulate_phase(dynamics, t_eval, u0, None, mode=mode, method=method,
+                              tolerance=tolerance, angular_speed=omega0)
     return simulate_phase(dynamics, t_eval, u0, dynamics.initial_phase_rate(u0, omega0),
                           mode=mode, method=method, tolerance=tolerance)
 
 
 def simulate_phase(dynamics, t_eval, u0, u_dot0, *, mode='dynamic', method='table',
-                   tolerance=1e-10):
+                   tolerance=1e-10, angular_speed=None):
     """As :func:`simulate`, from the phase u0 (rad) and phase rate u_dot0 (rad/s).
 
-    In kinematic mode the angular speed held is |u_dot0|·|ω_u(u0)|.
+    In kinematic mode the angular speed held is |u_dot0|·|ω_u(u0)|. For a body other than the
+    ellipse the start may instead be given as ``angular_speed`` w0 = |ω_u(u0)| u̇0 (rad/s,
+    signed; u_dot0 is then ignored): the one form that holds where the body does not turn in
+    u (|ω_u(u0)| = 0, u̇0 infinite).
     """
     _check_choice('mode', mode, MODES)
     _check_choice('method', method, METHODS)
     t_eval = np.asarray(t_eval, dtype=float)
+    if dynamics.general:
+        u0 = float(u0)
+        w0 = (float(angular_speed) if angular_speed is not None
+              else float(u_dot0) * float(dynamics.angular_speed_per_phase(u0)))
+        closed = general_closed_form(dynamics, mode, method, u0, w0, _REGULAR_FORMS)
+        if closed is not None:
+            return _motion(dynamics, mode, method, t_eval, closed)
+        sol, nfev = sundman(dynamics, mode, method, float(t_eval[-1]), u0, w0, tolerance)
+        return _motion(dynamics, mode, method, t_eval, sol, nfev)
     u0, u_dot0 = float(u0), float(u_dot0)
     closed = _closed_form(dynamics, mode, method, u0, u_dot0)
     if closed is not None:
@@ -201,18 +217,29 @@ class MotionStream:
     """
 
     def __init__(self, dynamics, u0, u_dot0, *, mode='dynamic', method='table',
-                 tolerance=1e-10, chunk=10.0, lookahead=0.5):
+                 tolerance=1e-10, chunk=10.0, lookahead=0.5, angular_speed=None):
         _check_choice('mode', mode, MODES)
         _check_choice('method', method, METHODS)
         self.dynamics, self.mode, self.method, self.tolerance = dynamics, mode, method, tolerance
         self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
         self._start = 0.0
-        u0, u_dot0 = float(u0), float(u_dot0)
-        closed = _closed_form(dynamics, mode, method, u0, u_dot0)
-        #: the solution from ``_start`` on: closed form, or the ODE's segment so far
-        self._sol = closed if closed is not None else OdeSolution(None, [u0, u_dot0], 0.0)
-        self._end_state = (u0, u_dot0)
-        self.initial_energy = float(dynamics.energy(u0, u_dot0))
+        u0 = float(u0)
+        if dynamics.general:     # the state is (u, w), w = |ω_u| u̇ (simulate_phase)
+            w0 = (float(angular_speed) if angular_speed is not None
+                  else float(u_dot0) * float(dynamics.angular_speed_per_phase(u0)))
+            closed = general_closed_form(dynamics, mode, method, u0, w0, _REGULAR_FORMS)
+            self._end_state = (u0, w0)
+            self.initial_energy = float(0.5 * dynamics.tabulated_inertia(u0) * w0**2
+                                        + dynamics.tabulated(u0)[1])
+            self._sol = closed if closed is not None else SundmanSolution(
+                None, [u0, w0, 0.0], 0.0, dynamics.angular_speed_per_phase)
+        else:
+            u_dot0 = float(u_dot0)
+            closed = _closed_form(dynamics, mode, method, u0, u_dot0)
+            #: the solution from ``_start`` on: closed form, or the ODE's segment so far
+            self._sol = closed if closed is not None else OdeSolution(None, [u0, u_dot0], 0.0)
+            self._end_state = (u0, u_dot0)
+            self.initial_energy = float(dynamics.energy(u0, u_dot0))
         #: right-hand-side evaluations of the ODE segments so far (0 for a closed form)
         self.nfev = 0
 
@@ -232,12 +259,15 @@ class MotionStream:
             t = t[~inside]
             if not t.size:
                 break
+            general = self.dynamics.general
             if self._sol.t_end > 0:
-                self._end_state = tuple(float(x) for x in self._sol(self._sol.t_end))
+                state = (self._sol.state(self._sol.t_end) if general
+                         else self._sol(self._sol.t_end))
+                self._end_state = tuple(float(np.ravel(x)[0]) for x in state)
             self._start = end
             span = min(self._chunk, max(float(t[-1]) - end, self._lookahead))
-            self._sol, nfev = _ode(self.dynamics, self.mode, self.method, span,
-                                   *self._end_state, self.tolerance)
+            self._sol, nfev = (sundman if general else _ode)(
+                self.dynamics, self.mode, self.method, span, *self._end_state, self.tolerance)
             self.nfev += nfev
         joined = np.concatenate(pieces, axis=1)
         return joined[0], joined[1]
@@ -423,3 +453,7 @@ def _solve(rhs, t_end, y0, tolerance, scale, rate=None, centre=None):
     if not result.success:
         raise RuntimeError(f'integration failed: {result.message}')
     return OdeSolution(result.sol, y0, t_end, rate, centre), result.nfev
+
+
+#: the closed forms of the ellipse path that general_closed_form reuses where u is regular
+_REGULAR_FORMS = (_small_libration, _table_closed_form)

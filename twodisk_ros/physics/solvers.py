@@ -17,7 +17,7 @@ from .spectral import (STALL, refine_grid, spectral_antiderivative, spectral_der
 from .tables import HermiteTable
 
 __all__ = ['LibrationSolution', 'OdeSolution', 'PhaseSolution', 'QuadratureSolution',
-           'RestSolution']
+           'RestSolution', 'SundmanSolution']
 
 
 class PhaseSolution:
@@ -143,7 +143,9 @@ class QuadratureSolution(PhaseSolution):
     def __init__(self, u0, direction, inverse_speed, n):
         u = TWO_PI * np.arange(n) / n
         rate = inverse_speed(u)
-        if not np.all(np.isfinite(rate)) or np.any(rate <= 0):
+        # 1/|u̇| may vanish at isolated phases (a body that does not turn in u there:
+        # u̇ is infinite for an instant, t(u) still increases)
+        if not np.all(np.isfinite(rate)) or np.any(rate < 0) or not np.mean(rate) > 0:
             raise RuntimeError('the motion does not advance monotonically in u over a cycle')
         mean, periodic = spectral_antiderivative(rate)
         self._mean = mean
@@ -181,9 +183,14 @@ class QuadratureSolution(PhaseSolution):
         j = np.clip(np.searchsorted(taus, rest, side='right') - 1, 0, len(nodes) - 2)
         low, high = nodes[j], nodes[j + 1]
         x = low + (rest - taus[j]) * (high - low) / (taus[j + 1] - taus[j])
+        below, above = low, high       # the bracket, for where 1/|u̇| vanishes
         for _ in range(30):
-            step = (self._tau(x) - rest) / self._rate(self._u0 + self._s * x)
+            g = self._tau(x) - rest
+            below, above = np.where(g < 0, x, below), np.where(g > 0, x, above)
+            with np.errstate(divide='ignore', invalid='ignore'):
+                step = g / self._rate(self._u0 + self._s * x)
             x_new = np.clip(x - step, low, high)
+            x_new = np.where(np.isfinite(step), x_new, 0.5 * (below + above))
             done = np.max(np.abs(x_new - x), initial=0.0) <= 1e-13
             x = x_new
             if done:
@@ -192,7 +199,8 @@ class QuadratureSolution(PhaseSolution):
         if residual > 1e-10 * period:
             raise RuntimeError(f'inverting t(u) failed: residual {residual:.3g} s')
         u = self._u0 + self._s * (x + TWO_PI * cycles)
-        return u, self._s / self._rate(u)
+        with np.errstate(divide='ignore'):
+            return u, self._s / self._rate(u)
 
 
 class LibrationSolution(PhaseSolution):
@@ -332,3 +340,57 @@ class LibrationSolution(PhaseSolution):
         rest = np.mod(phi, TWO_PI)
         s = self._scale
         return s * self._x(rest), s * self._x(rest, derivative=1) * phi_dot
+
+
+class SundmanSolution(PhaseSolution):
+    """Dense output of DOP853 in the regularised time τ of a body that may stop turning in u.
+
+    Where |ω_u| vanishes (m(u) = 0) the equation m ü + ½ m′ u̇² + V′ = 0 is singular and u̇
+    infinite for an instant. With w = |ω_u| u̇ the body's angular speed about the contact line
+    AB, J = m/|ω_u|² its moment of inertia about AB (positive everywhere) and dt/dτ = |ω_u|:
+
+        du/dτ = w,   dw/dτ = −(½ J′ w² + V′)/J,   dt/dτ = |ω_u(u)|,
+
+    all regular (derivatives in u; derived from Lagrange's equation,
+    docs/physics.md#bodies-that-stop-turning-in-u). In kinematic mode w = ±Ω is constant.
+
+    Parameters
+    ----------
+    dense : callable or None
+        scipy's ``sol`` of y(τ) = (u, w, t); None for a span of zero length.
+    y0 : sequence of float
+        (u0, w0, 0).
+    tau_end : float
+        End of the span in τ.
+    rotation_rate : callable
+        |ω_u|(u) (rad per rad of u), to report u̇ = w/|ω_u| (inf where it vanishes).
+    """
+
+    name = 'DOP853'
+    closed_form = False
+
+    def __init__(self, dense, y0, tau_end, rotation_rate):
+        self._dense, self._y0, self._rotation_rate = dense, np.asarray(y0, dtype=float), \
+            rotation_rate
+        self._tau_end = float(tau_end)
+        self.t_end = float(dense(self._tau_end)[2]) if dense is not None else 0.0
+
+    def state(self, t):
+        """(u, w) at times t (s): the phase and the body's angular speed about AB (rad/s)."""
+        t = np.asarray(t, dtype=float).ravel()
+        if self._dense is None or t.size == 0:
+            return np.full(t.shape, self._y0[0]), np.full(t.shape, self._y0[1])
+        low, high = np.zeros(t.size), np.full(t.size, self._tau_end)
+        for _ in range(64):                     # t(τ) is non-decreasing: bisection
+            mid = 0.5 * (low + high)
+            later = np.asarray(self._dense(mid))[2] >= t
+            low, high = np.where(later, low, mid), np.where(later, mid, high)
+            if np.all(high - low <= 1e-15 * max(1.0, self._tau_end)):
+                break
+        y = np.asarray(self._dense(0.5 * (low + high))).reshape(3, t.size)
+        return y[0], y[1]
+
+    def _evaluate(self, t):
+        u, w = self.state(t)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return u, w / self._rotation_rate(u)

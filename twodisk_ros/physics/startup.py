@@ -32,7 +32,7 @@ class StartupEstimate:
 
 
 def startup_estimate(body):
-    """The :class:`StartupEstimate` of a :class:`~twodisk_ros.physics.body.TwoDiskBody`.
+    """The :class:`StartupEstimate` of a :class:`~twodisk_ros.physics.rolling_body.RollingBody`.
 
     Costs ~1 % of the build itself (0.04 s at the costliest allowed body).
     """
@@ -40,7 +40,7 @@ def startup_estimate(body):
     seconds = SECONDS_PER_NODE * resolution
     message = None
     if seconds > NOTICE_SECONDS:
-        message = (f'building tables for an extreme body (b/a = {body.b / body.a:.6g}, '
-                   f'delta/a = {body.delta / body.a:.6g}: {resolution} nodes per cycle): '
+        message = (f'building tables for an extreme body ({body!r}, feature width '
+                   f'{body.feature_width:.3g} rad: {resolution} nodes per cycle): '
                    f'about {seconds:.0f} s')
     return StartupEstimate(resolution, seconds, message)

@@ -169,7 +169,7 @@ def _check_request(args):
 
 
 def _run_of(args):
-    from .runs import LIBRARY_RATE, RunError, library_run, recorded_run, settings_from
+    from ..runs import LIBRARY_RATE, RunError, library_run, recorded_run, settings_from
     if args.recording:
         given = [f'--{n.replace("_", "-")}' for n in ('params_file', 'a', 'b', 'delta',
                                                        'theta0', 'branch', 'omega0', 'mass',
@@ -202,7 +202,7 @@ def main(argv=None):
         _check_request(args)
     except (_Refusal, OutputError, LimitError) as error:
         return _refuse(error)      # before numpy, scipy and matplotlib are imported
-    from .runs import RunError
+    from ..runs import RunError
     try:
         run = _run_of(args)
         from .animation import animate

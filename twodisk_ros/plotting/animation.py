@@ -1,9 +1,10 @@
 """Animations of a rolling run: GIF (Pillow) or MP4 (ffmpeg), in 3D or seen from above.
 
-Each frame shows the body as two filled elliptic disks (disk 1 blue, disk 2 orange), the
+Each frame shows the body as its two filled laminae (disk 1 blue, disk 2 orange; the real
+outline of ``run.body.lamina``, :mod:`~twodisk_ros.model.outline`), the
 contact segment AB (green), the traces of A and B so far on the ground, the path of G and,
 optionally, the ground forces on the body at A and B as arrows (length L for M g, L the
-body size). :func:`animate` renders a :class:`~twodisk_ros.plotting.runs.Run` (or the
+body size). :func:`animate` renders a :class:`~twodisk_ros.runs.Run` (or the
 node's settings, simulated on the fly); the command line is
 :mod:`twodisk_ros.plotting.animate_cli` (``twodisk-animate``,
 ``python -m twodisk_ros.plotting.animation``).
@@ -16,9 +17,9 @@ import shutil
 import numpy as np
 
 from . import palette
-from .runs import Run, RunError, library_run
+from ..runs import Run, RunError, library_run
 
-__all__ = ['VIEWS', 'CAMERAS', 'animate', 'frame_times', 'main']
+__all__ = ['VIEWS', 'CAMERAS', 'animate', 'frame_times', 'still']
 
 VIEWS = ('3d', 'top')
 CAMERAS = ('auto', 'follow', 'fit')
@@ -269,6 +270,26 @@ class _Scene:
                     arrowprops=dict(arrowstyle='-|>', color=COLOR_FORCE, lw=1.5)))
 
 
+def _check_view(view, camera):
+    if view not in VIEWS:
+        raise RunError(f'view must be one of {", ".join(VIEWS)}, got {view!r}')
+    if camera not in CAMERAS:
+        raise RunError(f'camera must be one of {", ".join(CAMERAS)}, got {camera!r}')
+
+
+def _figure(size):
+    """A white Agg figure of ``size`` (w, h) pixels, rounded up to even numbers."""
+    width, height = (int(x) for x in size)
+    if not (64 <= width <= 4096 and 64 <= height <= 4096):
+        raise RunError(f'size must be between 64x64 and 4096x4096 pixels, got {width}x{height}')
+    width, height = width + width % 2, height + height % 2
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    figure = Figure(figsize=(width / DPI, height / DPI), dpi=DPI, facecolor='white')
+    FigureCanvasAgg(figure)
+    return figure
+
+
 def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 480),
             forces=False, camera='auto'):
     """Render a run as an animated GIF or MP4 (chosen by the suffix of ``path``).
@@ -276,8 +297,8 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     Parameters
     ----------
     run : Run or RollerSettings
-        A sampled run (:func:`~twodisk_ros.plotting.runs.library_run`,
-        :func:`~twodisk_ros.plotting.runs.recorded_run`), or the node's settings, then
+        A sampled run (:func:`~twodisk_ros.runs.library_run`,
+        :func:`~twodisk_ros.runs.recorded_run`), or the node's settings, then
         simulated over [0, stop].
     path : str or os.PathLike
         ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
@@ -304,14 +325,7 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     RunError
         One line, for a bad span, view, size or an unwritable output.
     """
-    if view not in VIEWS:
-        raise RunError(f'view must be one of {", ".join(VIEWS)}, got {view!r}')
-    if camera not in CAMERAS:
-        raise RunError(f'camera must be one of {", ".join(CAMERAS)}, got {camera!r}')
-    width, height = (int(x) for x in size)
-    if not (64 <= width <= 4096 and 64 <= height <= 4096):
-        raise RunError(f'size must be between 64x64 and 4096x4096 pixels, got {width}x{height}')
-    width, height = width + width % 2, height + height % 2
+    _check_view(view, camera)
     kind = _output_kind(path)
     if not isinstance(run, Run):
         run = library_run(run, stop=6.0 if stop is None else stop, forces=forces)
@@ -321,10 +335,7 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     shown = run.span(start, stop)
     frames = np.clip(np.searchsorted(shown.t, times - 1e-9), 0, len(shown) - 1)
     from matplotlib.animation import FFMpegWriter, PillowWriter
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    figure = Figure(figsize=(width / DPI, height / DPI), dpi=DPI, facecolor='white')
-    FigureCanvasAgg(figure)
+    figure = _figure(size)
     scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None, frames)
     writer = PillowWriter(fps=fps) if kind == 'gif' else FFMpegWriter(
         fps=fps, codec='libx264', extra_args=['-pix_fmt', 'yuv420p'])
@@ -338,11 +349,25 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     return len(frames)
 
 
-def main(argv=None):
-    """``python -m twodisk_ros.plotting.animation``: the ``twodisk-animate`` command line."""
-    from .animate_cli import main as cli_main
-    return cli_main(argv)
 
 
-if __name__ == '__main__':
-    raise SystemExit(main())
+def still(run, path, *, at=None, start=0.0, view='3d', size=(640, 480), forces=False,
+          camera='fit'):
+    """Write one frame of a run as a PNG: the body at time ``at`` (s, default the run's end),
+    the traces from ``start`` to ``at``; other arguments as :func:`animate`. ``path`` is
+    written as it is (a command line refuses existing files first, outputs.py).
+    """
+    _check_view(view, camera)
+    if os.path.splitext(os.fspath(path))[1].lower() != '.png':
+        raise RunError(f'cannot write {path}: the file name must end in .png')
+    at = float(run.t[-1]) if at is None else at
+    _check_span(run, start, at, 1.0)
+    shown = run.span(start, at)
+    figure = _figure(size)
+    scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None,
+                   [len(shown) - 1])
+    scene.draw(0)
+    try:
+        figure.savefig(os.fspath(path), dpi=DPI, facecolor='white')
+    except OSError as error:
+        raise RunError(f'cannot write {path}: {error.strerror or error}') from None

@@ -7,7 +7,10 @@ Run ``python -m twodisk_ros.plotting.figures --out DIR [--overwrite]`` (``make f
   on the ground over three whole cycles (world frame, m), as in the paper's Figures 3 and 4;
 * ``height.png``: the height of G over one cycle for the oloid, the Figure 3 body and the
   Two-Circle-Roller, with the eight equilibria per cycle;
-* ``stability_map.png``: which family of equilibria is stable, over b/a and Δ/a.
+* ``stability_map.png``: which family of equilibria is stable, over b/a and Δ/a;
+* ``laminae_traces.png``: the two bodies of other laminae shipped in ``config/`` (a rounded
+  square, superellipse n = 4, and an egg): each lamina's outline beside the ellipse of the
+  same extents, and the traces of A and B over whole cycles.
 
 Plotting lives only here; the physics core never imports matplotlib.
 """
@@ -27,17 +30,26 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from ..physics.body import TwoDiskBody  # noqa: E402
+from ..physics.lamina import Egg, Superellipse  # noqa: E402
+from ..physics.lamina_body import LaminaBody  # noqa: E402
 from ..outputs import OutputError, check_output_dir, replacing  # noqa: E402
 from . import palette  # noqa: E402
 from ..physics.cycle import RollingCycle  # noqa: E402
 from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
-__all__ = ['FIGURE3', 'FIGURE4', 'NAMES', 'plot_traces', 'plot_height', 'plot_stability_map',
+__all__ = ['FIGURE3', 'FIGURE4', 'LAMINA_BODIES', 'NAMES', 'plot_traces', 'plot_height',
+           'plot_outline', 'plot_stability_map',
            'write_figures', 'main']
 
 #: The paper's bodies (a, b, Δ) in m.
 FIGURE3 = (2.0, 1.0, 1.0)
 FIGURE4 = (math.sqrt(1.5), 1.0, 1.0)
+#: The bodies of other laminae in config/ (rounded_square.yaml, egg.yaml): title, lamina, Δ (m),
+#: arrangement, cycles drawn. The egg's ε is half its largest convex value (egg_asymmetry 0.5).
+LAMINA_BODIES = (
+    ('Rounded square (superellipse n = 4)', Superellipse(0.1, 0.1, 4.0), 0.05, 'parallel', 3),
+    ('Egg (parallel)', Egg(0.1, 0.08, 0.5 * Egg.epsilon_max(0.1, 0.08)), 0.04, 'parallel', 8),
+)
 
 COLOR_A, COLOR_B, COLOR_RULING = palette.A, palette.B, '0.72'
 DPI = 150
@@ -51,11 +63,47 @@ plt.rcParams.update({
 
 
 def _describe(body):
-    return f'a = {body.a:.4g} m, b = {body.b:.4g} m, Δ = {body.delta:.4g} m'
+    if isinstance(body, TwoDiskBody):
+        return f'a = {body.a:.4g} m, b = {body.b:.4g} m, Δ = {body.delta:.4g} m'
+    lamina = body.lamina
+    extra = (f', n = {lamina.n:g}' if isinstance(lamina, Superellipse) else
+             f', ε = {lamina.epsilon:.3g} m' if isinstance(lamina, Egg) else '')
+    return (f'{type(lamina).__name__.lower()} a = {lamina.a:.4g} m, b = {lamina.b:.4g} m{extra}, '
+            f'Δ = {body.delta:.4g} m, {body.arrangement}')
+
+
+def plot_outline(lamina, ax, samples=721):
+    """One lamina's outline in its own plane (m), beside the ellipse of the same extents.
+
+    x across (e1), y along the common axis (e2), origin at the disk centre; the ellipse has
+    semi-axes b = the largest x and a = the lamina's half length along y (dashed).
+    """
+    s = np.linspace(-math.pi, math.pi, samples)
+    rim = lamina.point(s)
+    x_max, y_min, y_max = lamina.extents
+    half, mid = 0.5 * (y_max - y_min), 0.5 * (y_max + y_min)
+    ax.plot(x_max * np.sin(s), mid - half * np.cos(s), '--', color='0.6', lw=0.9,
+            label='ellipse of the same extents')
+    ax.plot(rim[:, 0], rim[:, 1], color=COLOR_A, lw=1.6, gid='outline', label='lamina')
+    ax.plot([0.0], [0.0], '+', color='0.3', ms=6, label='disk centre')
+    ax.set_aspect('equal', adjustable='datalim')
+    ax.set_xlabel('x (m), across')
+    ax.set_ylabel('y (m), common axis')
+    ax.legend(loc='upper center', bbox_to_anchor=(0.5, -0.22), frameon=False, ncol=1)
+    return ax
 
 
 def _cycles(count):
     return '1 cycle' if count == 1 else f'{count} cycles'
+
+
+def _advance(displacement):
+    """The cycle's displacement in words: along X, or a step and a turn of the heading."""
+    turn = math.remainder(displacement.turn, TWO_PI)
+    if abs(turn) < 1e-9:
+        return f'{displacement.shift.real:.5g} m along X per cycle'
+    return (f'\n{abs(displacement.shift):.5g} m and a turn of {math.degrees(turn):.3g}° per '
+            'cycle: the body walks a circle')
 
 
 def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, name=None):
@@ -105,7 +153,7 @@ def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, 
     prefix = f'{name}: ' if name else ''
     ax.set_title(f'{prefix}{_describe(body)}\n{_cycles(cycles)} of the phase u (0 to '
                  f'{2 * cycles}π), one lobe of each trace per half-cycle; '
-                 f'{cycle.displacement.shift.real:.5g} m along X per cycle')
+                 f'{_advance(cycle.displacement)}')
     ax.legend(loc='upper center', bbox_to_anchor=(0.5, 0.0), borderaxespad=3.6, ncol=3,
               frameon=False)
     return ax
@@ -243,7 +291,8 @@ def plot_stability_map(ax, b_range=(0.05, 3.0), resolution=400):
 
 
 #: the files :func:`write_figures` writes, in order
-NAMES = ('figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png')
+NAMES = ('figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png',
+         'laminae_traces.png')
 
 
 def _save(fig, path):
@@ -280,6 +329,14 @@ def write_figures(out_dir):
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     plot_stability_map(ax)
     written.append(_save(fig, out / 'stability_map.png'))
+    fig, axes = plt.subplots(len(LAMINA_BODIES), 2, figsize=(10.0, 4.3 * len(LAMINA_BODIES)),
+                             gridspec_kw={'width_ratios': (1, 3.2)})
+    for (title, lamina, delta, arrangement, cycles), (left, right) in zip(LAMINA_BODIES, axes):
+        plot_outline(lamina, left)
+        left.set_title(title.split(' (')[0], fontsize=9)
+        plot_traces(LaminaBody(lamina, delta, arrangement), cycles, right, name=title)
+    fig.tight_layout()
+    written.append(_save(fig, out / 'laminae_traces.png'))
     return written
 
 
@@ -293,7 +350,8 @@ def main(argv=None):
         prog='python -m twodisk_ros.plotting.figures',
         description='Write the figures (PNG) of twodisk_ros: the paper\'s Figures 3 and 4 and '
                     'the oloid\'s traces over whole cycles, the height of G with the '
-                    'equilibria, and the stability map.',
+                    'equilibria, the stability map, and the traces of two bodies of other '
+                    'laminae (a rounded square and an egg).',
         epilog=f'Writes {", ".join(NAMES)} into DIR. Exit status: 0 written, 2 bad '
                'arguments or an output refused (one line, nothing written).')
     parser.add_argument('--out', metavar='DIR', default='docs/figures',

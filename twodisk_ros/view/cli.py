@@ -130,7 +130,7 @@ def _check_args(args):
 
 def _settings(args):
     """The node's settings of a simulated run (the view is always paced by the clock)."""
-    from ..plotting.runs import RunError, settings_from
+    from ..runs import RunError, settings_from
     values = {name: getattr(args, name) for name, *_ in SIMULATION_OPTIONS + CHOICE_OPTIONS}
     settings = settings_from(args.params_file, realtime=True, **values)
     if settings.rate > MAX_RATE:
@@ -209,7 +209,7 @@ def main(argv=None):
     try:
         args = _parser().parse_args(argv)
         _check_args(args)
-        from ..plotting.runs import RunError
+        from ..runs import RunError
         from .server import ServeError
     except _Refusal as error:
         return _refuse(error)

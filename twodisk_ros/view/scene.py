@@ -4,10 +4,11 @@ Every function takes numbers in SI units (m, N, ns) in the frames named by the n
 parameters: the world frame ``frame_id`` (Z up, the ground z = 0), the body frame
 ``body_frame`` (origin G, v_world = R v_body) and the two disk frames
 ``{body_frame}_disk_a`` / ``_disk_b`` of :func:`twodisk_ros.model.frames.disk_frames`
-(centre of the disk, z normal to its plane, x along the semi-axis a). Quaternions are
-(x, y, z, w), rotating child-frame components into parent-frame ones, as in ROS and in
-``foxglove.FrameTransform``. Colours come from :mod:`twodisk_ros.plotting.palette` (plain
-hex strings, no matplotlib): disk 1 and A blue, disk 2 and B orange, AB green.
+(centre of the disk, z normal to its plane, x along the common axis towards its far tip).
+Quaternions are (x, y, z, w), rotating child-frame components into parent-frame ones, as in
+ROS and in ``foxglove.FrameTransform``. Colours come from
+:mod:`twodisk_ros.plotting.palette` (plain hex strings, no matplotlib): disk 1 and A blue,
+disk 2 and B orange, AB green.
 """
 
 import math
@@ -18,6 +19,7 @@ from foxglove.messages import (ArrowPrimitive, Color, FrameTransform, FrameTrans
                                SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive,
                                Vector3)
 
+from ..model.outline import DEFAULT_TOLERANCE, frame_rims
 from ..plotting import palette
 
 __all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows',
@@ -29,8 +31,8 @@ LINE_WIDTH = 0.01
 SHAFT_DIAMETER, HEAD_DIAMETER, HEAD_LENGTH = 0.01, 0.02, 0.03
 #: Opacity of the body's mesh (the rims and the contact segment stay opaque).
 MESH_ALPHA = 0.55
-#: Points drawn on each disk rim.
-RIM_POINTS = 96
+#: Polygon error of the drawn rims, as a fraction of the lamina's size (model/outline.py).
+RIM_TOLERANCE = DEFAULT_TOLERANCE
 
 
 def timestamp(stamp_ns):
@@ -81,10 +83,9 @@ def frame_transforms(stamp_ns, frame_id, body_frame, position_g, quaternion, dis
     return FrameTransforms(transforms=items)
 
 
-def _rim(a, b, points=RIM_POINTS):
-    """The rim x²/a² + y²/b² = 1, z = 0 of a disk in its own frame (m): a closed loop."""
-    s = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
-    return [Point3(x=float(a * math.cos(v)), y=float(b * math.sin(v)), z=0.0) for v in s]
+def _rim(rim):
+    """A rim (n, 2) in its disk's frame (m, z = 0) as Foxglove points of a closed loop."""
+    return [Point3(x=float(x), y=float(y), z=0.0) for x, y in np.asarray(rim, dtype=float)]
 
 
 #: Colours of the mesh's parts (:func:`twodisk_ros.model.mesh.mesh_parts`), as in the URDF.
@@ -107,8 +108,9 @@ def body_update(stamp_ns, body_frame, body, parts, disks):
 
     Parameters
     ----------
-    body : TwoDiskBody
-        For the semi-axes a, b (m) of the rims.
+    body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
+        For the rims: the real outline of ``body.lamina`` (model/outline.py), to a polygon
+        error of :data:`RIM_TOLERANCE` of its size.
     parts : dict of str to Mesh
         The body's closed parts (``vertices`` (n, 3) in m, body frame; ``faces`` (m, 3)
         int), as :func:`twodisk_ros.model.mesh.mesh_parts` gives them: the plates
@@ -122,10 +124,11 @@ def body_update(stamp_ns, body_frame, body, parts, disks):
     entities = [SceneEntity(timestamp=stamp, frame_id=body_frame, id='body', frame_locked=True,
                             triangles=surfaces)]
     width = LINE_WIDTH * body.size
-    for disk, colour in zip(disks, (palette.A, palette.B)):
+    rims = frame_rims(body, RIM_TOLERANCE)
+    for disk, colour, points in zip(disks, (palette.A, palette.B), rims):
         rim = LinePrimitive(type=LinePrimitiveLineType.LineLoop,
                             pose=Pose(position=Vector3(), orientation=Quaternion(w=1.0)),
-                            thickness=width, points=_rim(body.a, body.b), color=color(colour))
+                            thickness=width, points=_rim(points), color=color(colour))
         entities.append(SceneEntity(timestamp=stamp, frame_id=disk.child_frame_id,
                                     id='rim' + disk.child_frame_id[-2:], frame_locked=True,
                                     lines=[rim]))

@@ -10,7 +10,7 @@ times (s after the show started) at which each is due. No rclpy here.
   (stamps follow the clock at ``speed`` 1); the contact forces of every sample are computed.
 - :class:`ReplaySource`: the samples of an MCAP recording of the node (``pose``,
   ``contact_a``/``contact_b``, ``wrench_a``/``wrench_b`` when recorded), values and stamps
-  exactly as recorded (:func:`twodisk_ros.plotting.runs.recorded_run`).
+  exactly as recorded (:func:`twodisk_ros.runs.recorded_run`).
 """
 
 from dataclasses import dataclass
@@ -20,7 +20,7 @@ import numpy as np
 from ..node import schedule
 from ..node.simulation import Simulation
 from ..physics.body import TwoDiskBody
-from ..plotting.runs import recorded_run
+from ..runs import recorded_run
 
 __all__ = ['BLOCK_SECONDS', 'Block', 'LiveSource', 'ReplaySource']
 
@@ -119,7 +119,7 @@ class ReplaySource:
 
     Raises
     ------
-    twodisk_ros.plotting.runs.RunError
+    twodisk_ros.runs.RunError
         If the file cannot be read or holds no run (one line).
     """
 

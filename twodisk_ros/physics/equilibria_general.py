@@ -1,0 +1,290 @@
+"""Equilibria of any rolling body: every root of dz_G/du over one cycle, with a certificate.
+
+For a :class:`~twodisk_ros.physics.body.TwoDiskBody` :func:`equilibria.equilibria` uses the
+eight fixed angles of the ellipse; every other :class:`~twodisk_ros.physics.rolling_body.
+RollingBody` comes here (docs/physics.md#equilibria-of-any-body).
+
+**The search.** f(u) = dz_G/du (m/rad, complex step of ``phase_height``) is sampled on N
+nodes, N doubled until its spectrum is resolved (upper half below 1e-13 of the peak, or at
+its noise floor). Its trigonometric interpolant f_N has coefficients c_k, so on an interval
+of half-width r about a centre c, by Taylor's theorem,
+
+    |f_N(u)| ≥ |f_N(c)| − Σ_{j=1}^{K−1} |f_N^(j)(c)| r^j / j! − B_K r^K / K!,
+    B_K = Σ_k |k|^K |c_k| ≥ max |f_N^(K)|,
+
+and |f − f_N| ≤ ε, ε = 2 Σ_{|k|>N/4} |c_k| + 64 ulp · max |f| (the unresolved spectrum is
+below its resolved upper half: geometric decay; plus the samples' rounding). An interval
+where that lower bound exceeds ε holds no root of f: **certified root-free**. Starting from
+the N intervals between nodes, every other interval is bisected until it is certified, or
+|f_N| ≤ ε at its centre (f is below its own accuracy there), or it is narrower than 1e-13 rad.
+The uncertified pieces are merged into clusters: each root of f lies in a cluster. A cluster
+with a sign change of f between its ends holds an odd number of roots (counted as one
+equilibrium, located by bisection of f's sign); one without holds none or an even number
+(reported in the certificate, not as an equilibrium). K = 4.
+
+**Stability.** At a root u* where the body turns (|ω_u| ≠ 0), d²z_G/du² is the series'
+derivative and, γ being the angle the body has turned about the contact line AB (dγ/du =
+|ω_u|), d²z_G/dγ² = (d²z_G/du²)/|ω_u|². Where |ω_u(u*)| vanishes (a degenerate phase, e.g. a
+contact on a superellipse's flat vertex) u is not a physical coordinate; z_G − z* is then
+taken as a function of γ (both by Gauss quadrature from u*, no cancellation), its order q
+from z_G − z* ~ A|γ|^q: q = 2 gives d²z_G/dγ² from a polynomial fit of (z_G − z*)/γ², q < 2
+gives stability from the sign of A and **no linear small-oscillation period**.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from .analytic import complex_step
+from .spectral import refine_grid, spectral_tail
+
+__all__ = ['RootCertificate', 'certified_roots', 'classify_root', 'max_rotation_rate',
+           'root_series_curvatures', 'TAYLOR_ORDER']
+
+TAYLOR_ORDER = 4
+#: narrowest interval bisected (rad)
+MIN_HALF_WIDTH = 5e-14
+#: |ω_u(u*)| below this fraction of its maximum: a degenerate phase (classified in γ)
+DEGENERATE_RATE = 1e-6
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
+TWO_PI = 2 * math.pi
+
+
+@dataclass(frozen=True)
+class RootCertificate:
+    """Why no root of dz_G/du over the cycle is missed (module docstring)."""
+
+    nodes: int             #: N, samples of dz_G/du over one cycle
+    order: int             #: K of the Taylor bound
+    derivative_bound: float  #: B_K = Σ |k|^K |c_k| (m/rad^(K+1))
+    error_bound: float     #: ε (m/rad): |f − f_N| assumed below it
+    intervals: int         #: intervals examined (the N initial ones and their bisections)
+    brackets: tuple        #: ((low, high), ...) clusters with a sign change (rad)
+    unsigned: tuple        #: ((low, high), ...) clusters without a sign change (rad)
+    flat: bool             #: |dz_G/du| ≤ ε everywhere: z_G constant to accuracy
+
+    @property
+    def complete(self):
+        """True: every root lies in a bracket (no unsigned cluster, not flat)."""
+        return not self.unsigned and not self.flat
+
+    def statement(self):
+        """One line: the certificate in words."""
+        if self.flat:
+            return f'dz_G/du is within its accuracy {self.error_bound:.2g} m/rad of 0: flat'
+        return (f'{len(self.brackets)} sign changes of dz_G/du, every other interval of the '
+                f'cycle certified root-free (N = {self.nodes}, Taylor order {self.order}, '
+                f'B = {self.derivative_bound:.3g}, eps = {self.error_bound:.2g}); '
+                f'{len(self.unsigned)} clusters without a sign change')
+
+
+class _Series:
+    """The trigonometric interpolant of N real samples and its derivatives anywhere."""
+
+    def __init__(self, samples):
+        n = len(samples)
+        coeffs = np.fft.fft(samples) / n
+        coeffs[n // 2] = 0.0
+        self.k = np.fft.fftfreq(n, d=1.0 / n)
+        self.c = coeffs
+
+    def jets(self, x, order):
+        """f_N^(j)(x) for j < order: array (order, len(x))."""
+        x = np.asarray(x, dtype=float)
+        out = np.empty((order, x.size))
+        for start in range(0, x.size, 256):
+            part = x[start:start + 256]
+            e = np.exp(1j * np.outer(part, self.k)) * self.c
+            for j in range(order):
+                out[j, start:start + 256] = np.real(e @ ((1j * self.k) ** j))
+        return out
+
+
+def _slope_samples(body, n):
+    u = TWO_PI * np.arange(n) / n
+    return complex_step(body.phase_height, u)
+
+
+def certified_roots(body):
+    """(roots, certificate): the phases u* ∈ [0, 2π) where dz_G/du changes sign.
+
+    Parameters
+    ----------
+    body : RollingBody
+
+    Returns
+    -------
+    roots : list of (float, float, float)
+        (u*, low, high): the root located by bisection of the sign of dz_G/du and its cluster.
+    certificate : RootCertificate
+    """
+    scale = body.size
+
+    def sample(n):
+        f = _slope_samples(body, n)
+        flat = np.max(np.abs(f)) <= 1e-14 * scale
+        return (0.0 if flat else spectral_tail(f)), f
+    n, f = refine_grid(sample, 256, 2**17, floor=1e-9)
+    series = _Series(f)
+    k_abs, c_abs = np.abs(series.k), np.abs(series.c)
+    order = TAYLOR_ORDER
+    bound = float(np.sum(k_abs**order * c_abs))
+    eps = 2 * float(np.sum(c_abs[k_abs > n // 4])) + 64 * np.finfo(float).eps * float(
+        np.max(np.abs(f)))
+    h = TWO_PI / n
+    factorials = np.array([math.factorial(j) for j in range(order + 1)], dtype=float)
+
+    def lower_bounds(centres, r):
+        jets = series.jets(centres, order)
+        powers = r ** np.arange(order)[:, None] / factorials[:order, None]
+        taylor = np.sum(np.abs(jets[1:]) * powers[1:], axis=0)
+        return np.abs(jets[0]) - taylor - bound * r**order / factorials[order], jets[0]
+
+    todo_c = (np.arange(n) + 0.5) * h
+    r = h / 2
+    leaves = []            # (low, high, certified)
+    examined = 0
+    while todo_c.size:
+        examined += todo_c.size
+        low_bound, value = lower_bounds(todo_c, r)
+        good = low_bound > eps
+        stop = ~good & ((np.abs(value) <= eps) | (r < MIN_HALF_WIDTH))
+        for c in todo_c[good]:
+            leaves.append((c - r, c + r, True))
+        for c in todo_c[stop]:
+            leaves.append((c - r, c + r, False))
+        rest = todo_c[~good & ~stop]
+        r = r / 2
+        todo_c = np.concatenate([rest - r, rest + r])
+    leaves.sort()
+    if not any(cert for _, _, cert in leaves):
+        return [], RootCertificate(n, order, bound, eps, examined, (), (), True)
+    # rotate so that the list starts with a certified interval, then merge the others
+    first = next(i for i, leaf in enumerate(leaves) if leaf[2])
+    leaves = leaves[first:] + [(lo + TWO_PI, hi + TWO_PI, c) for lo, hi, c in leaves[:first]]
+    clusters = []
+    for lo, hi, cert in leaves:
+        if cert:
+            continue
+        if clusters and abs(clusters[-1][1] - lo) <= 1e-15 * TWO_PI:
+            clusters[-1][1] = hi
+        else:
+            clusters.append([lo, hi])
+    brackets, unsigned, roots = [], [], []
+    for lo, hi in clusters:
+        ends = series.jets([lo, hi], 1)[0]
+        if ends[0] * ends[1] < 0:
+            brackets.append((lo % TWO_PI, hi % TWO_PI))
+            root = _bisect_sign(body, lo, hi, ends[0] > 0)
+            roots.append((root % TWO_PI, lo % TWO_PI, hi % TWO_PI))
+        else:
+            unsigned.append((lo % TWO_PI, hi % TWO_PI))
+    roots.sort()
+    certificate = RootCertificate(n, order, bound, eps, examined, tuple(sorted(brackets)),
+                                  tuple(sorted(unsigned)), False)
+    return roots, certificate
+
+
+def _bisect_sign(body, low, high, positive_low):
+    """A sign change of dz_G/du (the true function) between low and high (rad)."""
+    for _ in range(200):
+        mid = 0.5 * (low + high)
+        if not low < mid < high:
+            break
+        value = float(complex_step(body.phase_height, mid))
+        if value == 0.0:
+            return mid
+        if (value > 0) == positive_low:
+            low = mid
+        else:
+            high = mid
+    return 0.5 * (low + high)
+
+
+def _rotation_rate(body, u):
+    return np.linalg.norm(body.phase_angular_velocity(np.asarray(u, dtype=float)), axis=-1)
+
+
+def _local_samples(body, centre, offsets):
+    """(γ, z_G − z*) at u* + offsets by Gauss quadrature of |ω_u| and dz_G/du from u*."""
+    offsets = np.asarray(offsets, dtype=float)
+    x = 0.5 * (1 + _GAUSS_X)
+    u = centre + offsets[:, None] * x
+    w = 0.5 * _GAUSS_W * offsets[:, None]
+    gamma = np.sum(w * _rotation_rate(body, u), axis=1)
+    rise = np.sum(w * complex_step(body.phase_height, u), axis=1)
+    return gamma, rise
+
+
+def _offsets_for(body, centre, targets, reach):
+    """Offsets δ (signed, rad) with γ(u* + δ) = targets (vectorised bisection in |δ|)."""
+    targets = np.asarray(targets, dtype=float)
+    side = np.sign(targets)
+    low, high = np.zeros(targets.size), np.full(targets.size, reach)
+    for _ in range(60):
+        mid = 0.5 * (low + high)
+        gamma, _ = _local_samples(body, centre, side * mid)
+        below = np.abs(gamma) < np.abs(targets)
+        low, high = np.where(below, mid, low), np.where(below, high, mid)
+    return side * 0.5 * (low + high)
+
+
+def classify_root(body, series_curvature, centre, reach, max_rate):
+    """Local behaviour of z_G at the root u* = ``centre`` (rad).
+
+    Parameters
+    ----------
+    series_curvature : float
+        d²z_G/du² at u* (m/rad²) from the spectral series.
+    reach : float
+        Half the distance to the nearest other root (rad): the local analysis stays inside.
+    max_rate : float
+        max |ω_u| over the cycle (rad/rad).
+
+    Returns
+    -------
+    dict with order q, leading A (m/rad^q: z_G − z* ≈ A|γ|^q), gamma_curvature d²z_G/dγ²
+    (m/rad², nan if q < 2), rate |ω_u(u*)|.
+    """
+    rate = float(_rotation_rate(body, centre))
+    if rate > DEGENERATE_RATE * max_rate:
+        curvature = series_curvature / rate**2
+        return dict(order=2.0, leading=0.5 * curvature, gamma_curvature=curvature, rate=rate,
+                    degenerate=False)
+    # degenerate phase: γ as coordinate; the largest γ reached within the reach on both sides
+    g_left, _ = _local_samples(body, centre, [-reach])
+    g_right, _ = _local_samples(body, centre, [reach])
+    gamma_max = min(0.05, 0.5 * min(abs(float(g_left[0])), abs(float(g_right[0]))))
+    # order from two small levels on each side
+    probe = gamma_max * np.array([-1e-2, -2.5e-3, 2.5e-3, 1e-2])
+    delta = _offsets_for(body, centre, probe, reach)
+    gamma, rise = _local_samples(body, centre, delta)
+    orders = [math.log(abs(rise[i] / rise[j])) / math.log(abs(gamma[i] / gamma[j]))
+              for i, j in ((0, 1), (3, 2)) if rise[i] * rise[j] > 0]
+    order = float(np.mean(orders)) if orders else math.nan
+    if not abs(order - 2.0) < 0.05:
+        leading = float(np.mean(rise[[1, 2]] / np.abs(gamma[[1, 2]]) ** order))
+        return dict(order=order, leading=leading, gamma_curvature=math.nan, rate=rate,
+                    degenerate=True)
+    # quadratic: fit (z_G − z*)/γ² by a polynomial in γ on Chebyshev levels, value at 0
+    nodes = 24
+    levels = gamma_max * np.cos((2 * np.arange(nodes) + 1) * math.pi / (2 * nodes))
+    delta = _offsets_for(body, centre, levels, reach)
+    gamma, rise = _local_samples(body, centre, delta)
+    fit = np.polynomial.chebyshev.chebfit(gamma / gamma_max, rise / gamma**2, 12)
+    curvature = 2 * float(np.polynomial.chebyshev.chebval(0.0, fit))
+    return dict(order=2.0, leading=0.5 * curvature, gamma_curvature=curvature, rate=rate,
+                degenerate=True)
+
+
+def root_series_curvatures(body, roots, nodes):
+    """d²z_G/du² at the roots (rad) from the spectral series of dz_G/du on ``nodes`` nodes."""
+    series = _Series(_slope_samples(body, nodes))
+    return series.jets([u for u, _, _ in roots], 2)[1] if roots else np.zeros(0)
+
+
+def max_rotation_rate(body, nodes):
+    """max |ω_u| over the nodes (rad/rad)."""
+    u = TWO_PI * np.arange(nodes) / nodes
+    return float(np.max(_rotation_rate(body, u)))

@@ -1,0 +1,146 @@
+"""The description of a run: checked settings → lamina, body, mass model, dynamics, motion.
+
+Read by the node (:class:`~twodisk_ros.node.simulation.Simulation`, the start-up estimate),
+the inspector (:func:`~twodisk_ros.inspect.model.build_model`) and the tools that rebuild a
+run from its parameters, so that every reader builds the same body:
+
+- ``shape`` ellipse: :class:`~twodisk_ros.physics.body.TwoDiskBody` (a, b, delta), the closed
+  forms, and today's mass models of a, b, delta (``settings.mass_properties()``), bit for bit;
+- any other shape: :class:`~twodisk_ros.physics.lamina_body.LaminaBody` (lamina, delta,
+  arrangement) on the lamina of :func:`~twodisk_ros.run.shape.lamina_of`, with the mass model
+  of :func:`twodisk_ros.physics.mass_models.mass_properties_of` (imported when first needed).
+
+Bodies and mass models are cached by their lamina and parameters (a few at a time), so that
+checking settings, describing the URDF and building the simulation pay for a body once.
+"""
+
+from functools import cached_property, lru_cache
+
+from ..node.parameters import parse_recorded
+from ..physics.body import TwoDiskBody
+from ..physics.dynamics import RollingDynamics
+from ..physics.mass_models import custom
+from ..physics.motion import MotionStream
+from . import shape as shapes
+
+__all__ = ['RunDescription', 'clear_caches']
+
+
+@lru_cache(maxsize=4)
+def _lamina_body(lamina, delta, arrangement):
+    from ..physics.lamina_body import LaminaBody
+    return LaminaBody(lamina, delta, arrangement)
+
+
+@lru_cache(maxsize=8)
+def _general_mass(body, model, mass, moments):
+    try:
+        from ..physics.mass_models import mass_properties_of
+    except ImportError:
+        raise RuntimeError(f'mass_model {model} of a non-elliptic shape needs '
+                           'twodisk_ros.physics.mass_models.mass_properties_of, which this '
+                           'installation lacks') from None
+    return mass_properties_of(model, body, mass, moments)
+
+
+def clear_caches():
+    """Forget the cached bodies and mass models (and the laminae and their cycles' limits)."""
+    _lamina_body.cache_clear()
+    _general_mass.cache_clear()
+    shapes.clear_caches()
+
+
+class RunDescription:
+    """What checked settings describe (attributes are built once, when first read).
+
+    Parameters
+    ----------
+    settings : RollerSettings
+        The run's settings (checked here; ValueError, one line, if not allowed).
+    outline : Outline, optional
+        For shape points: the fitted outline (a recording's), instead of reading
+        ``shape_file``.
+
+    Attributes
+    ----------
+    settings : RollerSettings
+    lamina : Lamina
+        The shape of each disk (an Ellipse for ``ellipse``).
+    body : RollingBody
+        TwoDiskBody for ``ellipse``, LaminaBody otherwise.
+    """
+
+    def __init__(self, settings, outline=None):
+        s = self.settings = settings.checked(outline)
+        self.outline = outline if s.shape == 'points' else None
+        if s.shape == 'ellipse':
+            self.body = TwoDiskBody(s.a, s.b, s.delta)
+            self.lamina = self.body.lamina
+        else:
+            self.lamina = shapes.lamina_of(s, self.outline)
+            self.body = _lamina_body(self.lamina, s.delta, s.arrangement)
+
+    @classmethod
+    def from_recorded(cls, strings):
+        """(RunDescription or None, problems) of a recording's ``twodisk_ros`` metadata.
+
+        The parameters are read with the node's contract
+        (:func:`~twodisk_ros.node.parameters.parse_recorded`): a recording without the shape
+        parameters is an ellipse run; one of shape points is rebuilt from the outline it
+        holds, without its shape file. Problems are one line each.
+        """
+        settings, problems = parse_recorded(strings)
+        if settings is None:
+            return None, problems
+        try:
+            outline = (shapes.outline_from_metadata(strings) if settings.shape == 'points'
+                       else None)
+            return cls(settings, outline), []
+        except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
+            return None, [f'the recorded parameters define no body: '
+                          f'{" ".join(str(error).split())}']
+
+    @property
+    def shape_line(self):
+        """One line on the shape (``superellipse a = 0.1 m, ... , delta = 0.05 m, parallel``)."""
+        return shapes.describe_shape(self.settings, self.lamina)
+
+    @cached_property
+    def mass(self):
+        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of the run."""
+        s = self.settings
+        if s.shape == 'ellipse':
+            return s.mass_properties()
+        if s.mass_model == 'custom':      # the given moments about G, whatever the shape
+            return custom(s.mass, s.principal_moments)
+        return _general_mass(self.body, s.mass_model, s.mass, None)
+
+    @cached_property
+    def dynamics(self):
+        """:class:`~twodisk_ros.physics.dynamics.RollingDynamics` of body, mass and gravity."""
+        return RollingDynamics(self.body, self.mass, self.settings.gravity)
+
+    def start(self):
+        """(u0 (rad), u̇0 (rad/s)): the phase and phase rate of theta0, branch and omega0."""
+        s = self.settings
+        u0 = float(self.body.phase_from_theta(s.theta0, s.branch))
+        return u0, self.dynamics.initial_phase_rate(u0, s.omega0)
+
+    def stream(self):
+        """A new :class:`~twodisk_ros.physics.motion.MotionStream` of the run from t = 0."""
+        s = self.settings
+        u0, u_dot0 = self.start()
+        return MotionStream(self.dynamics, u0, u_dot0, mode=s.mode, method=s.method,
+                            tolerance=s.tolerance)
+
+    def metadata(self):
+        """{key: text}: the recording's ``twodisk_ros`` metadata of the run.
+
+        Every parameter (:meth:`as_strings`), and for shape points the fitted outline
+        (:func:`~twodisk_ros.run.shape.outline_metadata`), so the recording is checked
+        without the shape file.
+        """
+        values = self.settings.as_strings()
+        if self.settings.shape == 'points':
+            values.update(shapes.outline_metadata(self.lamina))
+        return values

@@ -1,0 +1,242 @@
+"""Runs to show: sampled poses and contacts, from the library or from a recording.
+
+A :class:`Run` holds everything a frame needs, in the world frame (Z up, m, s, N): G, A, B
+and the orientation at increasing times, optionally the ground forces at A and B, and the
+body, whose real outlines it draws (:mod:`~twodisk_ros.model.outline`). It comes from the
+physics (:func:`library_run`, the parameters of the node's contract) or from an MCAP
+recording of the node (:func:`recorded_run`). The animation (plotting/animation.py) and the
+Foxglove view (view/) read runs; nothing here plots. No matplotlib and no rclpy here.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from .io.errors import one_line
+from .io.reader import read_recording
+from .model.outline import DEFAULT_TOLERANCE, disk_rims
+from .node.arguments import ArgumentError, params_file_values
+from .node.parameters import BY_NAME, DEFAULTS, parse_recorded
+from .physics.body import TwoDiskBody
+from .physics.contact_forces import ContactForceModel
+from .physics.dynamics import RollingDynamics
+from .physics.motion import simulate
+
+__all__ = ['Run', 'RunError', 'library_run', 'recorded_run', 'settings_from',
+           'rotation_matrices']
+
+#: Samples per second of a library run (the traces between frames are drawn from them).
+LIBRARY_RATE = 200.0
+
+
+class RunError(ValueError):
+    """Input that defines no run (unreadable file, invalid parameters); one line."""
+
+
+@dataclass
+class Run:
+    """A sampled motion of one body (world frame, SI units), times increasing.
+
+    ``force_a``/``force_b`` are the ground forces on the body at A and B (N), or None.
+    ``quaternion`` holds the orientations as sampled or recorded (x, y, z, w, body → world),
+    ``stamp_ns`` the recorded header stamps (ns; None for a library run), ``settings`` the
+    node's settings the run was made with (for a recording: the last recorded). ``body`` is
+    any body with a ``lamina`` (TwoDiskBody, LaminaBody, GeneralTwoDiskBody).
+    """
+
+    body: object
+    t: np.ndarray              #: (n,) s
+    position_g: np.ndarray     #: (n, 3) m
+    contact_a: np.ndarray      #: (n, 3) m
+    contact_b: np.ndarray      #: (n, 3) m
+    rotation: np.ndarray       #: (n, 3, 3) body → world
+    force_a: np.ndarray | None = None
+    force_b: np.ndarray | None = None
+    weight: float = 1.0        #: M g (N), the scale of the force arrows
+    label: str = ''            #: one line describing the body and the motion
+    quaternion: np.ndarray | None = None   #: (n, 4) x, y, z, w
+    stamp_ns: np.ndarray | None = None     #: (n,) int64 ns
+    settings: object = None                #: RollerSettings
+
+    def __len__(self):
+        return len(self.t)
+
+    def span(self, start, stop):
+        """The samples with start ≤ t ≤ stop (a new Run)."""
+        keep = (self.t >= start - 1e-9) & (self.t <= stop + 1e-9)
+        pick = (lambda x: None if x is None else x[keep])
+        return Run(self.body, self.t[keep], self.position_g[keep], self.contact_a[keep],
+                   self.contact_b[keep], self.rotation[keep], pick(self.force_a),
+                   pick(self.force_b), self.weight, self.label, pick(self.quaternion),
+                   pick(self.stamp_ns), self.settings)
+
+    def outlines(self, index, tolerance=DEFAULT_TOLERANCE):
+        """World points (m) of both disk rims at sample ``index``: two closed arrays (N + 1, 3)
+        (the last point the first), each starting at its disk's far tip and reaching the near
+        tip at index N/2; the real outline of ``body.lamina`` to a polygon error of
+        ``tolerance`` × its size (:func:`~twodisk_ros.model.outline.disk_rims`)."""
+        rims = self.__dict__.setdefault('_rims', {})
+        if tolerance not in rims:
+            rims[tolerance] = disk_rims(self.body, tolerance)
+        r, g = self.rotation[index], self.position_g[index]
+        return tuple(rim @ r.T + g for rim in rims[tolerance])
+
+
+def rotation_matrices(quaternions):
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) given as x, y, z, w."""
+    q = np.asarray(quaternions, dtype=float)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)],
+        axis=-2)
+
+
+def _describe(settings):
+    s = settings
+    return (f'a = {s.a:.4g} m, b = {s.b:.4g} m, Δ = {s.delta:.4g} m, {s.mass_model}, '
+            f'{s.mode}, θ0 = {s.theta0:.3g} rad, ω0 = {s.omega0:.3g} rad/s')
+
+
+def _params_file_values(path):
+    """The ros__parameters a params file (the node's format) sets for the roller node."""
+    try:
+        values = params_file_values(path)
+    except ArgumentError as error:
+        raise RunError(one_line(error)) from None
+    if not values:
+        raise RunError(f'params file {path}: no ros__parameters for the roller node')
+    return values
+
+
+def settings_from(params_file=None, **values):
+    """Checked node settings from a params file and keyword values (None values are skipped).
+
+    Names outside the node's parameter contract are ignored (as the node ignores them).
+    Raises :class:`RunError` (one line) for an unreadable file or an invalid value.
+    """
+    merged = _params_file_values(params_file) if params_file else {}
+    merged.update({k: v for k, v in values.items() if v is not None})
+    known = {k: v for k, v in merged.items() if k in BY_NAME}
+    if isinstance(known.get('principal_moments'), list):
+        known['principal_moments'] = tuple(known['principal_moments'])
+    for name in ('a', 'b', 'delta', 'mass', 'gravity', 'theta0', 'omega0'):
+        if isinstance(known.get(name), int) and not isinstance(known[name], bool):
+            known[name] = float(known[name])
+    try:
+        return DEFAULTS.with_values(**known).checked()
+    except (ValueError, RuntimeError) as error:
+        raise RunError(one_line(error)) from None
+
+
+def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **values):
+    """Simulate a run of the node's physics over [0, stop] s, sampled at ``rate`` Hz.
+
+    Parameters
+    ----------
+    settings : RollerSettings, optional
+        The node's settings (a, b, delta, mass_model, mode, theta0, branch, omega0, ...);
+        built from ``values`` (parameter names of the node) if omitted.
+    stop : float
+        End time (s), > 0.
+    rate : float
+        Samples per second.
+    forces : bool
+        Also compute the ground forces at A and B (:class:`ContactForceModel`).
+    """
+    if settings is None:
+        settings = settings_from(**values)
+    if not (math.isfinite(stop) and stop > 0):
+        raise RunError(f'the run must end after 0 s, got stop = {stop!r} s')
+    s = settings
+    body = TwoDiskBody(s.a, s.b, s.delta)
+    dynamics = RollingDynamics(body, s.mass_properties(), s.gravity)
+    count = max(2, int(math.ceil(stop * rate)) + 1)
+    t = np.linspace(0.0, stop, count)
+    motion = simulate(dynamics, t, mode=s.mode, theta0=s.theta0, branch=s.branch,
+                      omega0=s.omega0, method=s.method, tolerance=s.tolerance)
+    poses = dynamics.cycle.poses(motion.phase)
+    run = Run(body, t, poses.position_g, poses.contact_a, poses.contact_b,
+              rotation_matrices(poses.quaternion), weight=dynamics.mass.mass * s.gravity,
+              label=_describe(s), quaternion=poses.quaternion, settings=s)
+    if forces:
+        computed = ContactForceModel(dynamics).along(motion)
+        run.force_a, run.force_b = computed.force_a, computed.force_b
+    return run
+
+
+def _topic_role(topic):
+    return topic.rstrip('/').rsplit('/', 1)[-1]
+
+
+_ROLES = ('pose', 'contact_a', 'contact_b', 'wrench_a', 'wrench_b')
+
+
+def _stamp(msg):
+    return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+
+
+def _vector(v):
+    return (float(v.x), float(v.y), float(v.z))
+
+
+def recorded_run(path):
+    """The run of an MCAP recording of the node: /pose, /contact_a, /contact_b (and
+    /wrench_a, /wrench_b if recorded), the body from the ``twodisk_ros`` metadata.
+
+    Raises :class:`RunError` (one line) if the file cannot be read or holds no run.
+    """
+    from .io.errors import RecordingError
+    try:
+        recording = read_recording(path, decode=lambda topic: _topic_role(topic) in _ROLES)
+    except RecordingError as error:
+        raise RunError(one_line(error)) from None
+    if 'twodisk_ros' not in recording.metadata:
+        raise RunError(f'{path}: no twodisk_ros metadata (not a recording of the roller node)')
+    settings, problems = parse_recorded(recording.metadata['twodisk_ros'])
+    if settings is None:
+        raise RunError(f'{path}: {problems[0]}')
+    by_role = {role: {} for role in _ROLES}
+    for message in recording.messages:
+        role = _topic_role(message.topic)
+        if role in by_role and not isinstance(message.msg, bytes):
+            msg = message.msg
+            if role == 'pose':
+                p, q = msg.pose.position, msg.pose.orientation
+                value = _vector(p) + (float(q.x), float(q.y), float(q.z), float(q.w))
+            elif role.startswith('contact'):
+                value = _vector(msg.point)
+            else:
+                value = _vector(msg.wrench.force)
+            by_role[role][_stamp(msg)] = value
+    stamps = sorted(set(by_role['pose']) & set(by_role['contact_a']) & set(by_role['contact_b']))
+    if len(stamps) < 2:
+        raise RunError(f'{path}: fewer than 2 samples with pose, contact_a and contact_b')
+    pose = np.array([by_role['pose'][k] for k in stamps])
+    quaternion = pose[:, 3:]
+    if not np.all(np.isfinite(pose)) or np.any(np.linalg.norm(quaternion, axis=1) < 0.5):
+        raise RunError(f'{path}: the recorded poses are not finite unit quaternions')
+    stamps_ns = np.array(stamps, dtype=np.int64)
+    body = TwoDiskBody(settings.a, settings.b, settings.delta)
+    run = Run(body, (stamps_ns - stamps_ns[0]) * 1e-9, pose[:, :3],
+              np.array([by_role['contact_a'][k] for k in stamps]),
+              np.array([by_role['contact_b'][k] for k in stamps]),
+              rotation_matrices(quaternion), weight=settings.mass * settings.gravity,
+              label=_describe(settings), quaternion=quaternion, stamp_ns=stamps_ns,
+              settings=settings)
+    if by_role['wrench_a'] and by_role['wrench_b']:
+        run.force_a = _resample(by_role['wrench_a'], stamps_ns)
+        run.force_b = _resample(by_role['wrench_b'], stamps_ns)
+    return run
+
+
+def _resample(values_by_stamp, stamps_ns):
+    """Vectors recorded at their own stamps, linearly interpolated at ``stamps_ns``."""
+    keys = np.array(sorted(values_by_stamp), dtype=np.int64)
+    values = np.array([values_by_stamp[k] for k in keys])
+    x = (stamps_ns - stamps_ns[0]).astype(float)
+    xp = (keys - stamps_ns[0]).astype(float)
+    return np.stack([np.interp(x, xp, values[:, j]) for j in range(3)], axis=-1)
