@@ -8,7 +8,7 @@ References, none of them the code under test:
   and its closed-form mass model for every n): its values must then be the ellipse's, which
   the batched closed forms compute by other code (arrays, fixed-angle equilibria, the
   roll-over speed from m(u*) and ω_u instead of I_AB);
-- a real n = 4 body (LaminaBody, skipped while that class is the placeholder of main) against
+- a real n = 4 body (LaminaBody; skipped where that class is still a placeholder) against
   the closed-form symmetric equilibria and the superellipse's Γ-function area moments.
 
 Dask runs in this process (threads, in-process transport, no dashboard) where the fake factory must
@@ -312,5 +312,8 @@ def test_a_real_superellipse_n4_body():
     arm = np.cross(axis, -a_pt)
     i_ab = axis @ inertia @ axis + arm @ arm
     expected = math.sqrt(2 * got['barrier'][0] / i_ab)
-    # claim: the laminae mass model exact to rounding, the contacts to 1e-11: 1e-10 relative
-    assert got['rollover_speed'][0] == pytest.approx(expected, rel=1e-10)
+    # claim: 1e-9 relative. The laminae model is exact to rounding and the barrier to
+    # ~1e-11 a, but on a flat vertex z_G is so flat that the equilibrium's contact is found
+    # 2.5e-5 a along the rim from the vertex (measured: θ = 1.570772 for π/2), which moves
+    # I_AB by 4e-10 relative and the speed by 2e-10 (measured 1.9e-10)
+    assert got['rollover_speed'][0] == pytest.approx(expected, rel=1e-9)

@@ -72,9 +72,9 @@ BYTES_PER_AXIS_VALUE = 256
 #: measured ~3 ms on the benchmark's map; thin bodies need finer tables, hence the margin.
 CORE_SECONDS_PER_BODY = 0.004
 #: Work per body of the general path (exponent n != 2: LaminaBody, its cycle, dynamics and
-#: contact-force tables; core-seconds). Measured once on a merge of the issue-20 branches
-#: (b/a = 1, Δ/a = 0.5, load average ~5 on 2 cores): 3.6 s at n = 4, 11.5 s at n = 10, 235 s
-#: at n = 2.5 and ~340 s at n = 2.0001, 80-97 % in the certified equilibrium search
+#: contact-force tables; core-seconds). Measured on main of 26 Nov (b/a = 1, Δ/a = 0.5, load
+#: average 2-3 on 2 cores): 0.56 s at n = 4, 4.2 s at n = 10, 165 s at n = 2.5 (and ~340 s
+#: at n = 2.0001 on an earlier build), 75-97 % in the certified equilibrium search
 #: (docs/sweeps.md "The exponent axis"); benchmarks/sweep_exponent.py measures it in make bench.
 GENERAL_CORE_SECONDS_PER_BODY = 10.0
 #: The exponent of the ellipse: the batched closed-form path (:mod:`~twodisk_ros.sweep.batch`).
