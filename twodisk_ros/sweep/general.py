@@ -20,8 +20,8 @@ Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exp
   lamina (:func:`~twodisk_ros.physics.symmetric_stability.symmetric_equilibria`): +1 the tips
   (θ = 0 and the turning points), −1 the side vertices (θ = ±π/2), **2 both** (what flat
   vertices give: each symmetric pose is a shallow local minimum), 0 neutral, NaN neither;
-- ``oscillation_period`` is that of the lowest stable equilibrium, NaN where it rests on a flat
-  vertex (no linear small-oscillation period there);
+- ``oscillation_period`` is the dynamics' period about the lowest stable equilibrium, NaN where
+  it has none (on a flat vertex: no linear small-oscillation period);
 - ``rollover_speed`` is √(2 M g barrier / I_AB), I_AB the moment of inertia about the contact
   line AB at the lowest stable equilibrium: the n = 2 value (½ m(u*) u̇² = M g barrier,
   |ω| = |ω_u| u̇) written without the phase, whose rate ω_u vanishes where a contact crosses
@@ -62,9 +62,9 @@ GENERAL_MEANINGS = {
                      'NaN neither',
     'barrier': 'exponent != 2: height_max - height_min over every equilibrium of the cycle '
                '(the deepest well to the highest equilibrium)',
-    'oscillation_period': 'exponent != 2: about the lowest stable equilibrium; NaN where it '
-                          'rests on a flat vertex (n > 2): V is not twice differentiable '
-                          'there, the period depends on the amplitude',
+    'oscillation_period': 'exponent != 2: the dynamics\' period about the lowest stable '
+                          'equilibrium; NaN where it has none: on a flat vertex (n > 2) V is '
+                          'not twice differentiable, the period depends on the amplitude',
     'rollover_speed': 'exponent != 2: sqrt(2 M g barrier / I_AB), I_AB the moment of inertia '
                       'about the contact line AB at the lowest stable equilibrium (the n = 2 '
                       'definition without the phase rate omega_u, which vanishes at flat '
