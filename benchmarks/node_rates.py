@@ -16,6 +16,10 @@ The cost of ``/tf``: the node builds and publishes it only for a subscriber or a
 so the same run with and without a ``/tf`` subscriber (recording off) shows what it adds:
 in real time as the node's CPU share (:func:`realtime_rate` with ``tf`` off and on), and in
 a batch run as wall time per sample (:func:`batch_tf_cost`, in process, runs alternated).
+
+Real time by shape: the same real-time run at 1 kHz for the ellipse (config/oloid.yaml) and
+non-elliptic bodies (config/rounded_square.yaml, a superellipse n = 4; config/egg.yaml), side
+by side (:func:`shape_rates`, :data:`SHAPE_SCENARIOS`).
 """
 
 from dataclasses import asdict, dataclass
@@ -197,6 +201,7 @@ class RealtimeRate:
     node_cpu: float = math.nan   #: the node's CPU seconds per wall second (1 = one core)
     tf: bool = True           #: /tf subscribed
     record: bool = True       #: recording on
+    body: str = 'oloid'       #: the scenario's name (SHAPE_SCENARIOS), the body it runs
 
     def as_dict(self):
         return asdict(self)
@@ -209,11 +214,22 @@ def _cpu_seconds(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True):
+#: Bodies of the real-time runs at 1 kHz by shape: name → (params file in config/, extra
+#: node parameters). The egg runs ``method:=direct``: in dynamic table mode the parallel egg
+#: is refused today ("the motion does not advance monotonically in u"), a physics fix pending.
+SHAPE_SCENARIOS = {
+    'oloid': ('oloid.yaml', ()),
+    'rounded_square': ('rounded_square.yaml', ()),
+    'egg (method direct)': ('egg.yaml', ('-p', 'method:=direct')),
+}
+
+
+def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True, body='oloid'):
     """Run the node at ``rate`` Hz in real time, every topic subscribed and recording on.
 
     ``tf=False`` leaves /tf unsubscribed and ``record=False`` the recording off: with both,
-    the node builds no /tf (the "off" side of the cost of /tf).
+    the node builds no /tf (the "off" side of the cost of /tf). ``body``: a name of
+    :data:`SHAPE_SCENARIOS` (its params file and parameters).
     """
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
@@ -223,10 +239,11 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True):
         env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID=DOMAIN,
                    PYTHONPATH=ROOT + os.pathsep + os.environ.get('PYTHONPATH', ''))
         recording = ['-p', f'record:={os.path.join(folder, "rt.mcap")}'] if record else []
+        params_file, extra = SHAPE_SCENARIOS[body]
         process = subprocess.Popen(
             [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
-             os.path.join(ROOT, 'config', 'oloid.yaml'), '-p', f'rate:={float(rate)}',
-             *recording], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+             os.path.join(ROOT, 'config', params_file), '-p', f'rate:={float(rate)}',
+             *extra, *recording], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         context = rclpy.Context()
         rclpy.init(context=context, domain_id=int(DOMAIN))
         node = rclpy.create_node('bench_listener', context=context)
@@ -281,22 +298,37 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True):
         node_lag_ms=float(values.get('clock_lag', 'nan')) * 1e3,
         node_achieved_hz=float(values.get('achieved_rate', 'nan')),
         dropped=int(float(values.get('samples_dropped', '0'))), level=level,
-        node_cpu=node_cpu, tf=tf, record=record)
+        node_cpu=node_cpu, tf=tf, record=record, body=body)
+
+
+def shape_rates(rate=1000.0, seconds=8.0, warmup=3.0):
+    """:func:`realtime_rate` of every body of :data:`SHAPE_SCENARIOS` at ``rate`` Hz."""
+    return [realtime_rate(rate, seconds=seconds, warmup=warmup, body=name)
+            for name in SHAPE_SCENARIOS]
 
 
 if __name__ == '__main__':
     import argparse
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] + ' Real time at '
                                      '100 Hz, 1 kHz and 10 kHz (5 s each), then the cost of '
-                                     '/tf (1 kHz, off and on).')
+                                     '/tf (1 kHz, off and on), then 1 kHz by shape.')
     parser.add_argument('--seconds', type=float, default=5.0,
                         help='wall seconds measured per real-time run (default 5)')
     parser.add_argument('--only-tf', action='store_true', help='only the cost of /tf')
+    parser.add_argument('--only-shapes', action='store_true',
+                        help='only real time at 1 kHz by shape (SHAPE_SCENARIOS)')
     options = parser.parse_args()
+    if options.only_shapes:
+        for result in shape_rates(seconds=options.seconds, warmup=2.0):
+            print(result)
+        raise SystemExit(0)
     if not options.only_tf:
         for hz in (100.0, 1000.0, 10000.0):
             print(realtime_rate(hz, seconds=options.seconds, warmup=2.0))
     for tf in (False, True):
         print(realtime_rate(1000.0, seconds=options.seconds, warmup=2.0, tf=tf, record=False))
+    if not options.only_tf:
+        for result in shape_rates(seconds=options.seconds, warmup=2.0):
+            print(result)
     print('batch, µs per sample without and with /tf:',
           batch_tf_cost(duration=max(2.0, 4 * options.seconds)))

@@ -5,6 +5,7 @@ import math
 import ros_layer
 import general_shapes
 import scene_rate
+import sweep_exponent
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
 
@@ -230,6 +231,8 @@ def write_report(path, ctx):
     out.extend(sweep_scaling.report_lines(ctx['sweep_scaling']))
     out.extend(general_shapes.report_lines(ctx['general_shapes']))
     out.extend(scene_rate.report_lines(ctx['scene_rate']))
+    if ctx.get('sweep_exponent'):
+        out.extend(sweep_exponent.report_lines(ctx['sweep_exponent']))
 
     # --- figure
     w('## Work-precision plot\n')

@@ -6,6 +6,8 @@
 - real time at 100 Hz, 1 kHz and 10 kHz, every topic subscribed and recording on
   (``node_rates.py``);
 - the cost of ``/tf``: the same runs without and with a ``/tf`` subscriber (``node_rates.py``);
+- real time at 1 kHz by shape: the ellipse beside a superellipse n = 4 and an egg
+  (``node_rates.py``, ``SHAPE_SCENARIOS``);
 - contact forces per second, and the cost of the solid mass model;
 - parameter sweeps on Dask (``sweep_rate.py``);
 - the live view without ROS, ``twodisk-view``, at 100 Hz and 1 kHz (``view_rate.py``).
@@ -19,7 +21,7 @@ import time
 
 import numpy as np
 
-from node_rates import batch_rate, batch_tf_cost, realtime_rate
+from node_rates import batch_rate, batch_tf_cost, realtime_rate, shape_rates
 import setup_cost
 from targets import poses_throughput
 import view_rate
@@ -89,6 +91,10 @@ def measure(builds, quick=False, log=print):
     log(f'   /tf cost: batch {t["batch"]["cpu_off"]:.1f} -> {t["batch"]["cpu_on"]:.1f} us CPU '
         f'per sample; 1 kHz real time node CPU {t["realtime"][0].node_cpu:.2f} -> '
         f'{t["realtime"][1].node_cpu:.2f}')
+    out['shapes'] = shape_rates(1000.0, seconds=3.0 if quick else 8.0)
+    for r in out['shapes']:
+        log(f'   realtime 1 kHz {r.body}: node {r.node_achieved_hz:.0f} Hz, lag '
+            f'{r.node_lag_ms:.2f} ms, dropped {r.dropped}, CPU {r.node_cpu:.2f}')
     out['forces'] = contact_force_rate(10**5 if quick else 10**6)
     out['solid'] = solid_hull_cost()
     log('   parameter sweeps on Dask (benchmarks/sweep_rate.py)')
@@ -110,6 +116,7 @@ def measure(builds, quick=False, log=print):
 def as_dict(out):
     return {'poses': [asdict(p) for p in out['poses']], 'batch': out['batch'].as_dict(),
             'realtime': [r.as_dict() for r in out['realtime']], 'forces': out['forces'],
+            'shapes': [r.as_dict() for r in out.get('shapes', ())],
             'tf_cost': {'batch': out['tf_cost']['batch'],
                         'realtime': [r.as_dict() for r in out['tf_cost']['realtime']]},
             'solid': out['solid'], 'sweep': out['sweep'], 'setup': out['setup'],
@@ -177,6 +184,21 @@ def report_lines(out):
           f'{levels.get(r.level, r.level)} | {r.node_cpu:.2f} | {r.p50_ms:.2f} | '
           f'{r.p99_ms:.2f} | {r.lag_ms:.1f} |')
     w('')
+    if out.get('shapes'):
+        w('## Real time by shape\n')
+        w('The same real-time run at 1 kHz (recording on, every topic subscribed) for the '
+          'ellipse (`config/oloid.yaml`, closed forms) and for non-elliptic bodies through '
+          '`LaminaBody`\'s tables: `config/rounded_square.yaml` (superellipse n = 4) and '
+          '`config/egg.yaml` (with `method:=direct`: its dynamic table mode waits for a '
+          'physics fix). Columns as in the real-time table.\n')
+        w('| body | node achieved (Hz) | node lag (ms) | dropped | diagnostics | node CPU | '
+          'listener p50 (ms) | listener p99 (ms) | listener lag (ms) |')
+        w('|---|---|---|---|---|---|---|---|---|')
+        for r in out['shapes']:
+            w(f'| {r.body} | {r.node_achieved_hz:.0f} | {r.node_lag_ms:.2f} | {r.dropped} | '
+              f'{levels.get(r.level, r.level)} | {r.node_cpu:.2f} | {r.p50_ms:.2f} | '
+              f'{r.p99_ms:.2f} | {r.lag_ms:.1f} |')
+        w('')
     t = out['tf_cost']
     b = t['batch']
     w('## The cost of /tf\n')

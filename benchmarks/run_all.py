@@ -39,6 +39,7 @@ from twodisk_ros import TwoDiskBody  # noqa: E402
 from twodisk_ros.outputs import OutputError, check_output  # noqa: E402
 from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
+import sweep_exponent  # noqa: E402
 import sweep_scaling  # noqa: E402
 import general_shapes  # noqa: E402
 import scene_rate  # noqa: E402
@@ -247,6 +248,8 @@ def main(argv=None):
     shapes = general_shapes.measure(quick=args.quick, log=log)
     log('scenes: slopes, drives and losses beside the flat free motion')
     scenes = scene_rate.measure(quick=args.quick, log=log)
+    log('the sweep along the exponent axis: n = 2 batched, n = 4 general, per body')
+    exponent = sweep_exponent.measure(quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
 
     # why a target was missed
@@ -314,6 +317,7 @@ def main(argv=None):
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
                ros_layer=ros, sweep_scaling=scaling, general_shapes=shapes, scene_rate=scenes,
+               sweep_exponent=exponent,
                commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
                elapsed=elapsed)
     write_report(args.out, ctx)
@@ -333,6 +337,7 @@ def main(argv=None):
                 sweep_scaling=scaling,
                 general_shapes=shapes,
                 scene_rate=scenes,
+                sweep_exponent=exponent,
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))

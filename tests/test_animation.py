@@ -100,7 +100,7 @@ def _cli(*args):
     (['-o', 'x.gif', '--start', '3', '--stop', '2'], 'start < stop'),
     (['-o', 'x.gif', '--stop', '-1'], 'start < stop'),
     (['-o', '/nonexistent/dir/x.gif', '--stop', '0.2'], 'does not exist'),
-    (['-o', 'x.png', '--stop', '0.2'], '.gif or .mp4'),
+    (['-o', 'x.jpg', '--stop', '0.2'], '.gif, .png (one still) or .mp4'),
     (['-o', 'x.gif', '--size', 'big'], 'WIDTHxHEIGHT'),
     (['-o', 'x.gif', '--delta', '0.5'], 'delta/a'),
     (['-o', 'x.gif', '--fps', '0'], 'fps'),

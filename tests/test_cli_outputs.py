@@ -265,8 +265,8 @@ def test_animate_overwrite_replaces_the_output(tmp_path):
 
 
 @pytest.mark.parametrize('name, words', [
-    ('run.png', '.gif or .mp4'),
-    ('run', '.gif or .mp4'),
+    ('run.jpg', '.gif, .png (one still) or .mp4'),
+    ('run', '.gif, .png (one still) or .mp4'),
     pytest.param('run.mp4', 'ffmpeg', marks=pytest.mark.skipif(
         shutil.which('ffmpeg') is not None, reason='ffmpeg is installed: .mp4 is writable')),
 ])

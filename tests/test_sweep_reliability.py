@@ -57,7 +57,7 @@ def _same(x, y):
     for name in y.data_vars:
         np.testing.assert_array_equal(x[name].values, y[name].values, err_msg=name)
         assert x[name].attrs.keys() == y[name].attrs.keys(), name
-    for name in ('b_over_a', 'delta_over_a'):
+    for name in ('exponent', 'b_over_a', 'delta_over_a'):
         np.testing.assert_array_equal(x[name].values, y[name].values)
 
 
@@ -94,17 +94,20 @@ def test_blocks_cover_the_grid_once_within_the_chunk_size(shape, chunk):
     spec = SweepSpec(np.linspace(0.5, 1.5, shape[0]) if shape[0] > 1 else np.array([1.0]),
                      np.linspace(0.1, 0.9, shape[1]) if shape[1] > 1 else np.array([0.5]),
                      chunk_size=chunk)
-    covered = np.zeros(shape, dtype=int)
+    covered = np.zeros((1, *shape), dtype=int)       # one exponent (2): the ellipse's grid
     rows, cols = block_shape(*shape, chunk)
-    b, d = spec.points()
+    assert spec.block == (1, rows, cols)
+    n, b, d = spec.points()
+    assert np.all(n == 2.0)
     for block, flat in zip(spec.blocks(), spec.chunks()):
         covered[block] += 1
         size = covered[block].size
         assert 1 <= size <= chunk
         # a regular chunk grid (Zarr): every block has the block shape, cut at the far edges
-        assert block[0].start % rows == 0 and block[1].start % cols == 0
-        assert block[0].stop - block[0].start == min(rows, shape[0] - block[0].start)
-        assert block[1].stop - block[1].start == min(cols, shape[1] - block[1].start)
+        assert block[0] == slice(0, 1) and spec.block_exponent(block) == 2.0
+        assert block[1].start % rows == 0 and block[2].start % cols == 0
+        assert block[1].stop - block[1].start == min(rows, shape[0] - block[1].start)
+        assert block[2].stop - block[2].start == min(cols, shape[1] - block[2].start)
         # the flat indices are the block's points, in the order block_points gives them
         np.testing.assert_array_equal(b[flat], spec.block_points(block)[0])
         np.testing.assert_array_equal(d[flat], spec.block_points(block)[1])
@@ -152,15 +155,16 @@ def test_a_block_killed_mid_write_is_computed_again(client, reference, tmp_path)
         run_sweep(spec, client, out=store, progress=None, on_chunk=stop_at_the_end)
     assert np.all(_flags(store) == 1)
     # block (0, 0): data written, flags not yet; block (1, 1): part of the data and no flags;
-    # block (2, 0): a torn flag object (a store that does not write objects atomically)
-    (store / 'computed/c/0/0').unlink()
-    (store / 'computed/c/1/1').unlink()
+    # block (2, 0): a torn flag object (a store that does not write objects atomically);
+    # chunk keys exponent/b/delta (one exponent: 0/)
+    (store / 'computed/c/0/0/0').unlink()
+    (store / 'computed/c/0/1/1').unlink()
     for name in ('theta_max', 'mu_required', 'failure'):
-        (store / name / 'c/1/1').unlink(missing_ok=True)
-    flag = store / 'computed/c/2/0'
+        (store / name / 'c/0/1/1').unlink(missing_ok=True)
+    flag = store / 'computed/c/0/2/0'
     flag.write_bytes(flag.read_bytes()[:5])
     kept = {p: v for p, v in _tree(store).items() if '/c/' in str(p)
-            and not any(f'/c/{k}' in str(p) for k in ('0/0', '1/1', '2/0'))}
+            and not any(f'/c/0/{k}' in str(p) for k in ('0/0', '1/1', '2/0'))}
     again = run_sweep(spec, client, out=store, progress=None, overwrite=False)
     assert (again.computed, again.resumed) == (3, total - 3)
     _same(read_sweep(store), reference)
@@ -206,7 +210,7 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
             zstore.write_block(str(path), spec.blocks()[0], spec.b_over_a, spec.delta_over_a,
                                'laminae', 0.5)
         kill_at = None
-        assert _flags(path)[0, 0] == 0, writes
+        assert _flags(path)[0, 0, 0] == 0, writes
         assert zstore.complete_blocks(path, spec) == set()
 
 

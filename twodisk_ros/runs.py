@@ -4,7 +4,9 @@ A :class:`Run` holds everything a frame needs, in the world frame (Z up, m, s, N
 and the orientation at increasing times, optionally the ground forces at A and B, and the
 body, whose real outlines it draws (:mod:`~twodisk_ros.model.outline`). It comes from the
 physics (:func:`library_run`, the parameters of the node's contract) or from an MCAP
-recording of the node (:func:`recorded_run`). The animation (plotting/animation.py) and the
+recording of the node (:func:`recorded_run`), both through the run description
+(:class:`~twodisk_ros.run.description.RunDescription`), so any shape the node runs is
+shown with the body the node moved. The animation (plotting/animation.py) and the
 Foxglove view (view/) read runs; nothing here plots. No matplotlib and no rclpy here.
 """
 
@@ -17,11 +19,10 @@ from .io.errors import one_line
 from .io.reader import read_recording
 from .model.outline import DEFAULT_TOLERANCE, disk_rims
 from .node.arguments import ArgumentError, params_file_values
-from .node.parameters import BY_NAME, DEFAULTS, parse_recorded
-from .physics.body import TwoDiskBody
+from .node.parameters import BY_NAME, DEFAULTS
 from .physics.contact_forces import ContactForceModel
-from .physics.dynamics import RollingDynamics
 from .physics.motion import simulate
+from .run.description import RunDescription
 
 __all__ = ['Run', 'RunError', 'library_run', 'recorded_run', 'settings_from',
            'rotation_matrices']
@@ -95,10 +96,31 @@ def rotation_matrices(quaternions):
         axis=-2)
 
 
-def _describe(settings):
-    s = settings
-    return (f'a = {s.a:.4g} m, b = {s.b:.4g} m, Δ = {s.delta:.4g} m, {s.mass_model}, '
-            f'{s.mode}, θ0 = {s.theta0:.3g} rad, ω0 = {s.omega0:.3g} rad/s')
+def _describe(run):
+    """One short line on the body and the motion (the animation's title)."""
+    s = run.settings
+    if s.shape == 'ellipse':
+        body = f'a = {s.a:.4g} m, b = {s.b:.4g} m'
+    elif s.shape == 'superellipse':
+        body = f'superellipse n = {s.exponent:.3g}, a = {s.a:.4g} m, b = {s.b:.4g} m'
+    elif s.shape == 'egg':
+        body = f'egg a = {s.a:.4g} m, b = {s.b:.4g} m, ε = {run.lamina.epsilon:.3g} m'
+    else:
+        body = 'outline'
+    if s.shape != 'ellipse' and s.arrangement != 'parallel':
+        body += f', {s.arrangement}'
+    return (f'{body}, Δ = {s.delta:.4g} m, {s.mass_model}, {s.mode}, '
+            f'θ0 = {s.theta0:.3g} rad, ω0 = {s.omega0:.3g} rad/s')
+
+
+def _description(settings):
+    """The :class:`RunDescription` of checked settings, or :class:`RunError` (one line)."""
+    try:
+        run = RunDescription(settings)
+        run.dynamics                      # the body and its mass model, built now
+        return run
+    except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
+        raise RunError(f'the parameters define no run: {one_line(error)}') from None
 
 
 def _params_file_values(path):
@@ -123,7 +145,8 @@ def settings_from(params_file=None, **values):
     known = {k: v for k, v in merged.items() if k in BY_NAME}
     if isinstance(known.get('principal_moments'), list):
         known['principal_moments'] = tuple(known['principal_moments'])
-    for name in ('a', 'b', 'delta', 'mass', 'gravity', 'theta0', 'omega0'):
+    for name in ('a', 'b', 'delta', 'mass', 'gravity', 'theta0', 'omega0', 'exponent',
+                 'egg_asymmetry'):
         if isinstance(known.get(name), int) and not isinstance(known[name], bool):
             known[name] = float(known[name])
     try:
@@ -151,9 +174,8 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
         settings = settings_from(**values)
     if not (math.isfinite(stop) and stop > 0):
         raise RunError(f'the run must end after 0 s, got stop = {stop!r} s')
-    s = settings
-    body = TwoDiskBody(s.a, s.b, s.delta)
-    dynamics = RollingDynamics(body, s.mass_properties(), s.gravity)
+    description = _description(settings)
+    s, body, dynamics = description.settings, description.body, description.dynamics
     count = max(2, int(math.ceil(stop * rate)) + 1)
     t = np.linspace(0.0, stop, count)
     motion = simulate(dynamics, t, mode=s.mode, theta0=s.theta0, branch=s.branch,
@@ -161,7 +183,7 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
     poses = dynamics.cycle.poses(motion.phase)
     run = Run(body, t, poses.position_g, poses.contact_a, poses.contact_b,
               rotation_matrices(poses.quaternion), weight=dynamics.mass.mass * s.gravity,
-              label=_describe(s), quaternion=poses.quaternion, settings=s)
+              label=_describe(description), quaternion=poses.quaternion, settings=s)
     if forces:
         computed = ContactForceModel(dynamics).along(motion)
         run.force_a, run.force_b = computed.force_a, computed.force_b
@@ -196,9 +218,10 @@ def recorded_run(path):
         raise RunError(one_line(error)) from None
     if 'twodisk_ros' not in recording.metadata:
         raise RunError(f'{path}: no twodisk_ros metadata (not a recording of the roller node)')
-    settings, problems = parse_recorded(recording.metadata['twodisk_ros'])
-    if settings is None:
+    description, problems = RunDescription.from_recorded(recording.metadata['twodisk_ros'])
+    if description is None:
         raise RunError(f'{path}: {problems[0]}')
+    settings = description.settings
     by_role = {role: {} for role in _ROLES}
     for message in recording.messages:
         role = _topic_role(message.topic)
@@ -220,12 +243,16 @@ def recorded_run(path):
     if not np.all(np.isfinite(pose)) or np.any(np.linalg.norm(quaternion, axis=1) < 0.5):
         raise RunError(f'{path}: the recorded poses are not finite unit quaternions')
     stamps_ns = np.array(stamps, dtype=np.int64)
-    body = TwoDiskBody(settings.a, settings.b, settings.delta)
+    try:
+        body = description.body        # the body the node moved (its origin the recorded pose)
+    except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
+        raise RunError(f'{path}: the recorded parameters define no body: '
+                       f'{one_line(error)}') from None
     run = Run(body, (stamps_ns - stamps_ns[0]) * 1e-9, pose[:, :3],
               np.array([by_role['contact_a'][k] for k in stamps]),
               np.array([by_role['contact_b'][k] for k in stamps]),
               rotation_matrices(quaternion), weight=settings.mass * settings.gravity,
-              label=_describe(settings), quaternion=quaternion, stamp_ns=stamps_ns,
+              label=_describe(description), quaternion=quaternion, stamp_ns=stamps_ns,
               settings=settings)
     if by_role['wrench_a'] and by_role['wrench_b']:
         run.force_a = _resample(by_role['wrench_a'], stamps_ns)

@@ -23,7 +23,10 @@ and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
 G is the laminae's centroid seen from the midpoint of the centres
 (:attr:`GeneralTwoDiskBody.centroid <twodisk_ros.physics.general_body.GeneralTwoDiskBody>`,
 along e2): zero for laminae symmetric along the common axis (ellipses, superellipses), not
-for an egg in the 'parallel' arrangement. The two rotations are exact (quaternion components
+for an egg in the 'parallel' arrangement. A body moved by
+:meth:`LaminaBody.about <twodisk_ros.physics.lamina_body.LaminaBody.about>` (the solid egg,
+centred on its centre of mass) has its origin at P = ``body.origin`` instead, and G above
+reads P (the centres at ∓Δ e2 − P). The two rotations are exact (quaternion components
 0, ±1/2, ±√½) and the same for every body; only the translations depend on it.
 """
 
@@ -72,7 +75,8 @@ class DiskFrame:
         ``f'{body_frame}_disk_a'`` (disk 1, contact A) or ``f'{body_frame}_disk_b'``
         (disk 2, contact B).
     translation : numpy.ndarray, shape (3,)
-        The disk's centre in the body frame (m): (0, ∓Δ − g, 0), g = G's offset along e2.
+        The disk's centre in the body frame (m): (0, ∓Δ − g, 0), g = the body origin's (G's
+        or P's) offset from O along e2.
     quaternion : numpy.ndarray, shape (4,)
         (x, y, z, w), unit, w > 0: rotates disk-frame components into body-frame ones.
     parent_frame_id : str

@@ -20,7 +20,10 @@ the lamina (``lamina.point``). :func:`resolution_tolerance` converts a mesh reso
 **In the body.** Body frame G e1 e2 e3 (m). With general_body.py's placement, disk 1's
 lamina point (x, y) sits at (x, y − Δ, 0) − G and disk 2's at (0, Δ + σy, x) − G, σ = ±1 the
 arrangement ('parallel', 'swapped'); G = GeneralTwoDiskBody(lamina, Δ, arrangement).centroid,
-the midpoint of the centres for laminae symmetric along y (ellipses, superellipses). In the
+the midpoint of the centres for laminae symmetric along y (ellipses, superellipses). A body
+moved by :meth:`LaminaBody.about <twodisk_ros.physics.lamina_body.LaminaBody.about>` (its
+origin P = ``body.origin``, the centre of mass of a solid egg) is drawn about P: every
+point above minus ``body.offset`` e2, so that the world pose of P places the laminae. In the
 disk frames of :mod:`~twodisk_ros.model.frames` (x towards the disk's far tip along e2, z
 normal to the disk) the same points are (−y, x, 0) on disk 1 and (σy, −x, 0) on disk 2.
 """
@@ -118,7 +121,8 @@ class BodyShape:
     delta: float            #: half the distance between the centres (m)
     arrangement: str        #: 'parallel' or 'swapped'
     sigma: float            #: +1 or −1: disk 2's lamina y runs along ±e2
-    centroid: np.ndarray    #: G from the midpoint O of the centres (m, along e2)
+    centroid: np.ndarray    #: the body-frame origin from the midpoint O of the centres (m,
+    #: along e2): G, or P = ``body.origin`` for a body moved by LaminaBody.about
 
 
 def general_body(body):
@@ -137,7 +141,9 @@ def body_shape(body):
     if arrangement not in ARRANGEMENTS:
         raise ValueError(f'arrangement must be one of {sorted(ARRANGEMENTS)}, '
                          f'got {arrangement!r}')
-    centroid = getattr(body, 'centroid', None)
+    centroid = getattr(body, 'origin', None)        # a moved LaminaBody: P = G + offset e2
+    if centroid is None:
+        centroid = getattr(body, 'centroid', None)
     if centroid is None:
         centroid = (np.zeros(3) if isinstance(body, TwoDiskBody)
                     else general_body(body).centroid)
@@ -167,7 +173,7 @@ def frame_rims(body, tolerance=DEFAULT_TOLERANCE, outline=None):
 
 
 def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
-    """Both rims in the body frame (m, from G): (rim of disk 1, rim of disk 2), arrays
+    """Both rims in the body frame (m, from the body's origin G or P): (rim of disk 1, rim of disk 2), arrays
     (N + 1, 3) with the last point the first (``closed``) or (N, 3).
 
     Disk 1 lies in x3 = 0, disk 2 in x1 = 0; each starts at its far tip along e2 (−e2 for

@@ -86,7 +86,8 @@ def _too_coarse(lamina, ends, lamina_points, step, limit):
 
 
 def hull_rulings(body, resolution):
-    """The rulings of a quarter cycle: (A, B), arrays (m + 1, 3) (m, body frame from G).
+    """The rulings of a quarter cycle: (A, B), arrays (m + 1, 3) (m, body frame from the
+    body's origin: G, or P = G + ``body.offset`` e2 of a moved LaminaBody).
 
     Ruling j joins A[j] and B[j], branch +1, θ increasing from 0 (j = 0) to θ_max (j = m),
     sampled as the module docstring says; :func:`ruled_hull` mirrors them into the cycle.
@@ -108,7 +109,9 @@ def hull_rulings(body, resolution):
         p = np.concatenate([p, new_p])[order]
         a, b, a_l, b_l = (np.concatenate([old, added])[order]
                           for old, added in zip((a, b, a_l, b_l), new))
-    return a, b
+    # from the body's origin: P = G + offset e2 for a body moved by LaminaBody.about
+    shift = np.array([0.0, float(getattr(body, 'offset', 0.0)), 0.0])
+    return a - shift, b - shift
 
 
 def ruled_hull(body, resolution):

@@ -1,14 +1,17 @@
 """``twodisk-animate``: a run as an animated GIF (or MP4 with ffmpeg), 3D or from above.
 
 A run of the library (the node's parameters: flags, or ``--params-file`` like
-config/oloid.yaml) or of an MCAP recording of the node::
+config/oloid.yaml; any shape, through the run description) or of an MCAP recording of the
+node (of any shape: the recording holds it)::
 
     twodisk-animate -o oloid.gif --params-file config/oloid.yaml --stop 4
     twodisk-animate run.mcap -o run.gif --start 2 --stop 8 --fps 15 --size 480x360
     twodisk-animate -o top.gif --a 0.2 --b 0.1 --delta 0.1 --view top --forces
+    twodisk-animate -o square.png --params-file config/rounded_square.yaml --stop 3
 
-Outputs follow :mod:`twodisk_ros.outputs`: ``-o`` must end in ``.gif`` (``.mp4`` only when
-ffmpeg is installed); an existing file is refused unless ``--overwrite``; the file is written
+A ``.png`` output is one still: the body at ``--stop`` (default the run's end) with the
+traces from ``--start``. Outputs follow :mod:`twodisk_ros.outputs`: ``-o`` must end in
+``.gif`` or ``.png`` (``.mp4`` only when ffmpeg is installed); an existing file is refused unless ``--overwrite``; the file is written
 through a hidden temporary name and renamed, so an interrupted or failed run leaves it as it
 was. The request is sized before anything is simulated or drawn: at most :data:`MAX_FRAMES`
 frames, a simulated run of at most :data:`MAX_SIMULATED_SECONDS`, and no more memory than
@@ -32,6 +35,12 @@ from ..io.errors import one_line
 __all__ = ['main', 'estimate_memory', 'MAX_FRAMES', 'MAX_SIMULATED_SECONDS']
 
 PROG = 'twodisk-animate'
+#: The node's shapes (twodisk_ros.run.shape.SHAPES; not imported: --help loads no physics).
+SHAPES = ('ellipse', 'superellipse', 'egg', 'points')
+#: The node's parameters a simulated run takes from options (after --params-file).
+RUN_OPTIONS = ('a', 'b', 'delta', 'theta0', 'branch', 'omega0', 'mass', 'gravity', 'mode',
+               'mass_model', 'shape', 'exponent', 'egg_asymmetry', 'shape_file',
+               'arrangement', 'method')
 #: At most this many frames (4 min at 15 fps; ~0.09 s of drawing each at 640x480 here).
 MAX_FRAMES = 3600
 #: A simulated run is computed from 0 s up to at most this time (s): 720 001 samples.
@@ -71,8 +80,8 @@ def _parser():
     parser.add_argument('recording', nargs='?', help='an MCAP recording of the roller node '
                         '(omit to simulate with the parameters below)')
     parser.add_argument('-o', '--output', required=True,
-                        help='the file to write: .gif, or .mp4 (needs ffmpeg); an existing '
-                             'file is refused unless --overwrite')
+                        help='the file to write: .gif, .png (one still at --stop) or .mp4 '
+                             '(needs ffmpeg); an existing file is refused unless --overwrite')
     parser.add_argument('--overwrite', action='store_true',
                         help='replace an existing output (only once the new one is complete)')
     parser.add_argument('--start', type=float, default=0.0, help='first time shown (s)')
@@ -97,19 +106,27 @@ def _parser():
         body.add_argument(f'--{name}', type=kind)
     body.add_argument('--mode', choices=('dynamic', 'kinematic'))
     body.add_argument('--mass-model', dest='mass_model', choices=('laminae', 'solid', 'custom'))
+    body.add_argument('--shape', choices=SHAPES, help='the laminae (default ellipse)')
+    body.add_argument('--exponent', type=float, help='superellipse exponent n >= 2')
+    body.add_argument('--egg-asymmetry', dest='egg_asymmetry', type=float,
+                      help='egg: share of the largest convex asymmetry, |.| <= 0.95')
+    body.add_argument('--shape-file', dest='shape_file',
+                      help='points: a CSV or YAML outline (x, y in m, in order)')
+    body.add_argument('--arrangement', choices=('parallel', 'swapped'))
+    body.add_argument('--method', choices=('direct', 'table'))
     return parser
 
 
 def _check_output(path, overwrite):
     """The output's suffix (.gif; .mp4 only with ffmpeg) and :func:`check_output`."""
     suffix = os.path.splitext(os.fspath(path))[1].lower()
-    if suffix not in ('.gif', '.mp4'):
-        raise OutputError(f'cannot write {path}: the file name must end in .gif or .mp4 '
-                          f'(.mp4 needs ffmpeg)')
+    if suffix not in ('.gif', '.mp4', '.png'):
+        raise OutputError(f'cannot write {path}: the file name must end in .gif, .png (one '
+                          f'still) or .mp4 (needs ffmpeg)')
     if suffix == '.mp4' and shutil.which('ffmpeg') is None:
         raise OutputError(f'cannot write {path}: MP4 needs ffmpeg, which is not installed '
                           '(write a .gif instead)')
-    check_output(path, overwrite=overwrite, suffixes=('.gif', '.mp4'))
+    check_output(path, overwrite=overwrite, suffixes=('.gif', '.mp4', '.png'))
 
 
 def _frame_count(start, stop, fps):
@@ -145,7 +162,7 @@ def _check_numbers(args):
 def _check_size(args, stop, samples):
     """Refuse more than MAX_FRAMES frames or more memory than the machine allows (the run's
     ``samples`` included)."""
-    frames = _frame_count(args.start, stop, args.fps)
+    frames = 1 if _is_still(args) else _frame_count(args.start, stop, args.fps)
     width, height = args.size
     what = (f'--start {args.start:g} --stop {stop:g} at --fps {args.fps:g} is {frames} frames '
             f'of {width}x{height}')
@@ -154,6 +171,10 @@ def _check_size(args, stop, samples):
         raise LimitError(f'{what} (~{describe_bytes(need)} of memory); allowed: at most '
                          f'{MAX_FRAMES} frames (shorten the span or lower --fps)')
     check_memory(estimate_memory(frames, args.size, samples), what)
+
+
+def _is_still(args):
+    return os.fspath(args.output).lower().endswith('.png')
 
 
 def _check_request(args):
@@ -171,9 +192,7 @@ def _check_request(args):
 def _run_of(args):
     from ..runs import LIBRARY_RATE, RunError, library_run, recorded_run, settings_from
     if args.recording:
-        given = [f'--{n.replace("_", "-")}' for n in ('params_file', 'a', 'b', 'delta',
-                                                       'theta0', 'branch', 'omega0', 'mass',
-                                                       'gravity', 'mode', 'mass_model')
+        given = [f'--{n.replace("_", "-")}' for n in ('params_file',) + RUN_OPTIONS
                  if getattr(args, n) is not None]
         if given:
             raise RunError(f'{given[0]} applies to simulated runs, not to a recording')
@@ -182,9 +201,7 @@ def _run_of(args):
         return run
     stop = 6.0 if args.stop is None else args.stop
     _check_size(args, stop, max(2, int(math.ceil(stop * LIBRARY_RATE)) + 1))
-    settings = settings_from(args.params_file, **{
-        n: getattr(args, n) for n in ('a', 'b', 'delta', 'theta0', 'branch', 'omega0',
-                                      'mass', 'gravity', 'mode', 'mass_model')})
+    settings = settings_from(args.params_file, **{n: getattr(args, n) for n in RUN_OPTIONS})
     return library_run(settings, stop=stop, forces=args.forces)
 
 
@@ -205,11 +222,17 @@ def main(argv=None):
     from ..runs import RunError
     try:
         run = _run_of(args)
-        from .animation import animate
+        from .animation import animate, still
         with replacing(args.output) as temporary:
-            count = animate(run, temporary, start=args.start, stop=args.stop, fps=args.fps,
-                            view=args.view, size=args.size, forces=args.forces,
-                            camera=args.camera)
+            if _is_still(args):
+                still(run, temporary, at=args.stop, start=args.start, view=args.view,
+                      size=args.size, forces=args.forces,
+                      camera='fit' if args.camera == 'auto' else args.camera)
+                count = 1
+            else:
+                count = animate(run, temporary, start=args.start, stop=args.stop,
+                                fps=args.fps, view=args.view, size=args.size,
+                                forces=args.forces, camera=args.camera)
     except (RunError, OutputError, LimitError) as error:
         return _refuse(error)
     except KeyboardInterrupt:
@@ -224,7 +247,7 @@ def main(argv=None):
     if args.forces and run.force_a is None:
         print(f'{PROG}: note: the recording has no /wrench_a, /wrench_b: no forces drawn',
               file=sys.stderr)
-    print(f'{args.output}: {count} frames')
+    print(f'{args.output}: {count} frame{"s" if count != 1 else ""}')
     return 0
 
 

@@ -85,6 +85,10 @@ def inspection_figure(inspection):
         axes.grid(True, lw=0.3)
     title = os.path.basename(summary['file'])
     if params:
+        shape = params.get('shape', 'ellipse')
+        if shape != 'ellipse':
+            title += f' — {shape}' + (f" n = {_number(params.get('exponent'))}"
+                                      if shape == 'superellipse' else '')
         title += (f" — a = {_number(params.get('a'))} m, b = {_number(params.get('b'))} m, "
                   f"Δ = {_number(params.get('delta'))} m, {params.get('mass_model')}, "
                   f"{params.get('mode')}")
@@ -230,14 +234,14 @@ def invariant_drift(inspection):
 
 
 def _speed_drift(inspection, params):
-    from ..node.parameters import parse_recorded
-    from ..physics.body import TwoDiskBody
-    settings, _ = parse_recorded(params)
+    from ..run.description import RunDescription
+    run, _ = RunDescription.from_recorded(params)      # any shape, as the node built it
     state = _recorded_state(inspection)
-    if settings is None or state is None or not abs(settings.omega0) > 0:
+    if run is None or state is None or not abs(run.settings.omega0) > 0:
         return None
+    settings = run.settings
     t, phase, rate = state
-    body = TwoDiskBody(settings.a, settings.b, settings.delta)
+    body = run.laminae_body         # ω_u(u) does not depend on the body's origin
     target = abs(settings.omega0)
     speed = np.abs(rate) * np.linalg.norm(body.phase_angular_velocity(phase), axis=-1)
     return {'curves': [(t, (speed - target) / target,

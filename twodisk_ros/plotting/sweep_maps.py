@@ -6,6 +6,11 @@ bodies (oloid, Two-Circle-Roller, the paper's Figure 3 and 4 bodies) are marked.
 (a failed body, Δ/a ≥ 1) are light grey; infinite values (a lift-off speed that is never
 reached, μ_required above the lift-off speed) are black, beyond the colour bar's end.
 Quantities whose positive values span a factor above 20 get a logarithmic scale.
+
+A sweep with several superellipse exponents n (its third axis) gets one panel per exponent in
+each PNG (at most :data:`MAX_PANELS`, evenly chosen, the rest named in the title), all on one
+colour scale; the neutral curve and the named bodies belong to the ellipse and are drawn on
+the n = 2 panel only.
 """
 
 import math
@@ -22,7 +27,11 @@ from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm, Normalize  
 from ..outputs import replacing  # noqa: E402
 from .figures import FIGURE3, FIGURE4  # noqa: E402
 
-__all__ = ['NAMED_BODIES', 'plot_map', 'symbols', 'write_maps']
+__all__ = ['NAMED_BODIES', 'MAX_PANELS', 'plot_map', 'plot_panels', 'symbols', 'write_maps',
+           'exponent_plane', 'shown_exponents']
+
+#: At most this many exponents are drawn in one map (evenly chosen over the axis).
+MAX_PANELS = 12
 
 #: (label, b/a, Δ/a) of the marked bodies.
 NAMED_BODIES = [
@@ -32,7 +41,8 @@ NAMED_BODIES = [
     ('Fig. 4', FIGURE4[1] / FIGURE4[0], FIGURE4[2] / FIGURE4[0]),
 ]
 DPI = 130
-_FAMILY_LABELS = {-1: 'θ = ±π/2', 0: 'neutral', 1: 'θ = 0 and\nturning points'}
+_FAMILY_LABELS = {-1: 'θ = ±π/2', 0: 'neutral', 1: 'θ = 0 and\nturning points',
+                  2: 'both\n(flat vertices)'}
 
 
 def _edges(values, low=None, high=None):
@@ -69,6 +79,10 @@ def symbols(text):
 def _norm_and_cmap(name, values):
     """(norm, cmap, extend, ticks) for a variable's finite values."""
     if name == 'stable_family':
+        if np.any(values == 2):      # flat vertices: both families stable (exponent > 2)
+            cmap = ListedColormap(['#f3b38a', '#f7f7f7', '#8db7de', '#9fd39a'])
+            return (BoundaryNorm([-1.5, -0.5, 0.5, 1.5, 2.5], cmap.N),
+                    cmap.with_extremes(bad='0.85'), 'neither', [-1, 0, 1, 2])
         cmap = ListedColormap(['#f3b38a', '#f7f7f7', '#8db7de']).with_extremes(bad='0.85')
         return BoundaryNorm([-1.5, -0.5, 0.5, 1.5], cmap.N), cmap, 'neither', [-1, 0, 1]
     cmap = plt.get_cmap('viridis').with_extremes(bad='0.85', over='black')
@@ -88,13 +102,43 @@ def _norm_and_cmap(name, values):
     return Normalize(low, high), cmap, extend, None
 
 
-def plot_map(dataset, name, ax):
-    """Draw variable ``name`` of a sweep Dataset on ``ax``; returns the colour bar."""
-    var = dataset[name]
-    b = dataset['b_over_a'].values
-    d = dataset['delta_over_a'].values
+def exponent_plane(dataset, exponent=None):
+    """The (b/a, Δ/a) plane of a sweep Dataset at ``exponent`` (default: its only one); a
+    Dataset without the exponent axis (written before it existed) as it is."""
+    if 'exponent' not in dataset.dims:
+        return dataset
+    if exponent is None:
+        if dataset.sizes['exponent'] != 1:
+            raise ValueError(f'the sweep has {dataset.sizes["exponent"]} exponents: name one')
+        return dataset.isel(exponent=0)
+    return dataset.sel(exponent=exponent)
+
+
+def shown_exponents(dataset):
+    """The exponents drawn in a map: all, or :data:`MAX_PANELS` evenly chosen (ends kept)."""
+    if 'exponent' not in dataset.dims:
+        return [None]
+    values = [float(x) for x in dataset['exponent'].values]
+    if len(values) <= MAX_PANELS:
+        return values
+    keep = np.unique(np.round(np.linspace(0, len(values) - 1, MAX_PANELS)).astype(int))
+    return [values[k] for k in keep]
+
+
+def plot_map(dataset, name, ax, exponent=None, norm_values=None, colorbar=True):
+    """Draw variable ``name`` of a sweep Dataset on ``ax`` (the plane of ``exponent``,
+    default the only one); returns the colour bar (None without ``colorbar``).
+
+    ``norm_values`` (array) sets the colour scale (default: this plane's values): the panels
+    of one map share it."""
+    plane = exponent_plane(dataset, exponent)
+    var = plane[name]
+    n = float(plane['exponent']) if 'exponent' in plane.coords else 2.0
+    b = plane['b_over_a'].values
+    d = plane['delta_over_a'].values
     values = np.asarray(var.values, dtype=float)            # (b/a, Δ/a)
-    norm, cmap, extend, ticks = _norm_and_cmap(name, values)
+    norm, cmap, extend, ticks = _norm_and_cmap(
+        name, values if norm_values is None else np.asarray(norm_values, dtype=float))
     shown = np.where(np.isposinf(values), np.inf, values)
     b_edges, d_edges = _edges(b, low=0.0), _edges(d, low=0.0, high=1.0)
     mesh = ax.pcolormesh(b_edges, d_edges, np.ma.masked_invalid(
@@ -104,31 +148,70 @@ def plot_map(dataset, name, ax):
         over = np.ma.masked_where(~np.isposinf(values), np.ones_like(values))
         ax.pcolormesh(b_edges, d_edges, over.T,
                       cmap=ListedColormap(['black']), rasterized=True)
-    bar = ax.figure.colorbar(mesh, ax=ax, extend=extend, ticks=ticks)
-    units = symbols(var.attrs.get('units', ''))
-    bar.set_label(f'{name} [{units}]' + ('   (black: ∞)' if extend == 'max' else ''))
-    if name == 'stable_family':
-        bar.set_ticklabels([_FAMILY_LABELS[k] for k in ticks])
+    bar = None
+    if colorbar:
+        bar = _colorbar(ax.figure, mesh, ax, name, var, extend, ticks)
     xlim = (b_edges[0], b_edges[-1])
     ylim = (d_edges[0], d_edges[-1])
-    b_line = np.linspace(max(xlim[0], 1e-9), min(xlim[1], math.sqrt(2.0)), 400)
-    ax.plot(b_line, np.sqrt(np.clip(1.0 - b_line**2 / 2, 0.0, None)), color='k', lw=1.2,
-            ls='--', label='neutral: b² = 2(a² − Δ²)')
-    for label, x, y in NAMED_BODIES:
-        inside = xlim[0] <= x <= xlim[1] and ylim[0] <= y <= ylim[1]
-        if inside:
-            ax.plot(x, y, 'o', mfc='white', mec='k', ms=5, zorder=4)
-            ax.annotate(label, (x, y), xytext=(5, 4), textcoords='offset points', fontsize=7,
-                        bbox={'boxstyle': 'round,pad=0.15', 'fc': 'white', 'ec': 'none',
-                              'alpha': 0.7})
+    if n == 2.0:                       # the ellipse's neutral curve and named bodies
+        b_line = np.linspace(max(xlim[0], 1e-9), min(xlim[1], math.sqrt(2.0)), 400)
+        ax.plot(b_line, np.sqrt(np.clip(1.0 - b_line**2 / 2, 0.0, None)), color='k', lw=1.2,
+                ls='--', label='neutral: b² = 2(a² − Δ²)')
+        for label, x, y in NAMED_BODIES:
+            inside = xlim[0] <= x <= xlim[1] and ylim[0] <= y <= ylim[1]
+            if inside:
+                ax.plot(x, y, 'o', mfc='white', mec='k', ms=5, zorder=4)
+                ax.annotate(label, (x, y), xytext=(5, 4), textcoords='offset points',
+                            fontsize=7, bbox={'boxstyle': 'round,pad=0.15', 'fc': 'white',
+                                              'ec': 'none', 'alpha': 0.7})
+        ax.legend(loc='lower left', fontsize=7, framealpha=0.8)
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     ax.set_xlabel('b / a  [1]  (a = 1)')
     ax.set_ylabel('Δ / a  [1]')
-    ax.set_title(f'{name}: {symbols(var.attrs.get("description", ""))}', fontsize=8,
-                 wrap=True)
-    ax.legend(loc='lower left', fontsize=7, framealpha=0.8)
+    if exponent is None:
+        ax.set_title(f'{name}: {symbols(var.attrs.get("description", ""))}', fontsize=8,
+                     wrap=True)
+    else:
+        ax.set_title(f'n = {n:g}' + (' (ellipse)' if n == 2.0 else ''), fontsize=9)
     return bar
+
+
+def _colorbar(fig, mesh, ax, name, var, extend, ticks):
+    bar = fig.colorbar(mesh, ax=ax, extend=extend, ticks=ticks)
+    units = symbols(var.attrs.get('units', ''))
+    bar.set_label(f'{name} [{units}]' + ('   (black: ∞)' if extend == 'max' else ''))
+    if name == 'stable_family':
+        bar.set_ticklabels([_FAMILY_LABELS[k] for k in ticks])
+    return bar
+
+
+def plot_panels(dataset, name):
+    """A figure of variable ``name`` with one panel per exponent (:func:`shown_exponents`),
+    on one colour scale; returns the figure (the caller closes it)."""
+    exponents = shown_exponents(dataset)
+    count = len(exponents)
+    cols = min(count, 4)
+    rows = math.ceil(count / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.6 * cols + 1.2, 3.2 * rows + 0.8),
+                             squeeze=False, constrained_layout=True)
+    chosen = np.asarray(dataset[name].sel(exponent=exponents).values, dtype=float)
+    try:
+        for ax, n in zip(axes.flat, exponents):
+            plot_map(dataset, name, ax, exponent=n, norm_values=chosen, colorbar=False)
+        for ax in axes.flat[count:]:
+            ax.set_visible(False)
+        _, _, extend, ticks = _norm_and_cmap(name, chosen)
+        mesh = axes.flat[0].collections[0]         # the first panel's values (shared norm)
+        _colorbar(fig, mesh, list(axes.flat[:count]), name, dataset[name], extend, ticks)
+        total = dataset.sizes['exponent']
+        more = '' if total == count else f' ({count} of {total} exponents shown)'
+        fig.suptitle(f'{name}: {symbols(dataset[name].attrs.get("description", ""))}{more}',
+                     fontsize=9, wrap=True)
+    except BaseException:
+        plt.close(fig)
+        raise
+    return fig
 
 
 def write_maps(dataset, folder):
@@ -148,9 +231,11 @@ def write_maps(dataset, folder):
     for name, var in dataset.data_vars.items():
         if var.dtype.kind != 'f':
             continue
-        fig, ax = plt.subplots(figsize=(6.4, 4.6))
+        panels = 'exponent' in dataset.dims and dataset.sizes['exponent'] > 1
+        fig = plot_panels(dataset, name) if panels else plt.figure(figsize=(6.4, 4.6))
         try:
-            plot_map(dataset, name, ax)
+            if not panels:
+                plot_map(dataset, name, fig.add_subplot())
             path = out / f'{name}.png'
             with replacing(path) as temporary:      # never a half-written map
                 fig.savefig(temporary, dpi=DPI, bbox_inches='tight')

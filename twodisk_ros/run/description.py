@@ -8,7 +8,11 @@ run from its parameters, so that every reader builds the same body:
   forms, and today's mass models of a, b, delta (``settings.mass_properties()``), bit for bit;
 - any other shape: :class:`~twodisk_ros.physics.lamina_body.LaminaBody` (lamina, delta,
   arrangement) on the lamina of :func:`~twodisk_ros.run.shape.lamina_of`, with the mass model
-  of :func:`twodisk_ros.physics.mass_models.mass_properties_of` (imported when first needed).
+  of :func:`twodisk_ros.physics.mass_models.centred_on_mass` (imported when first needed):
+  the body is moved (``LaminaBody.about``) so that its origin is the mass model's centre of
+  mass, as RollingDynamics needs. Only the solid hull of an egg in the parallel arrangement
+  has its centre of mass off the laminae's centroid G (2.7e-3 m for config/egg.yaml's
+  shape); its run's pose, recording and drawing are those of that point P = ``body.origin``.
 
 Bodies and mass models are cached by their lamina and parameters (a few at a time), so that
 checking settings, describing the URDF and building the simulation pay for a body once.
@@ -19,7 +23,6 @@ from functools import cached_property, lru_cache
 from ..node.parameters import parse_recorded
 from ..physics.body import TwoDiskBody
 from ..physics.dynamics import RollingDynamics
-from ..physics.mass_models import custom
 from ..physics.motion import MotionStream
 from . import shape as shapes
 
@@ -33,20 +36,15 @@ def _lamina_body(lamina, delta, arrangement):
 
 
 @lru_cache(maxsize=8)
-def _general_mass(body, model, mass, moments):
-    try:
-        from ..physics.mass_models import mass_properties_of
-    except ImportError:
-        raise RuntimeError(f'mass_model {model} of a non-elliptic shape needs '
-                           'twodisk_ros.physics.mass_models.mass_properties_of, which this '
-                           'installation lacks') from None
-    return mass_properties_of(model, body, mass, moments)
+def _centred(body, model, mass, moments):
+    from ..physics.mass_models import centred_on_mass
+    return centred_on_mass(model, body, mass, moments)
 
 
 def clear_caches():
     """Forget the cached bodies and mass models (and the laminae and their cycles' limits)."""
     _lamina_body.cache_clear()
-    _general_mass.cache_clear()
+    _centred.cache_clear()
     shapes.clear_caches()
 
 
@@ -66,19 +64,25 @@ class RunDescription:
     settings : RollerSettings
     lamina : Lamina
         The shape of each disk (an Ellipse for ``ellipse``).
+    laminae_body : RollingBody
+        The body with its origin at the laminae's centroid G: TwoDiskBody for ``ellipse``,
+        LaminaBody otherwise (built here, so a shape that defines no body is refused here).
     body : RollingBody
-        TwoDiskBody for ``ellipse``, LaminaBody otherwise.
+        The body the run moves: ``laminae_body`` moved to the mass model's centre of mass
+        (the same object unless that lies off G; built with the mass model, when first read).
+    mass : MassProperties
+        The mass model, centre of mass at the body's origin.
     """
 
     def __init__(self, settings, outline=None):
         s = self.settings = settings.checked(outline)
         self.outline = outline if s.shape == 'points' else None
         if s.shape == 'ellipse':
-            self.body = TwoDiskBody(s.a, s.b, s.delta)
-            self.lamina = self.body.lamina
+            self.laminae_body = TwoDiskBody(s.a, s.b, s.delta)
+            self.lamina = self.laminae_body.lamina
         else:
             self.lamina = shapes.lamina_of(s, self.outline)
-            self.body = _lamina_body(self.lamina, s.delta, s.arrangement)
+            self.laminae_body = _lamina_body(self.lamina, s.delta, s.arrangement)
 
     @classmethod
     def from_recorded(cls, strings):
@@ -106,14 +110,24 @@ class RunDescription:
         return shapes.describe_shape(self.settings, self.lamina)
 
     @cached_property
-    def mass(self):
-        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of the run."""
+    def _body_and_mass(self):
         s = self.settings
-        if s.shape == 'ellipse':
-            return s.mass_properties()
-        if s.mass_model == 'custom':      # the given moments about G, whatever the shape
-            return custom(s.mass, s.principal_moments)
-        return _general_mass(self.body, s.mass_model, s.mass, None)
+        if s.shape == 'ellipse':      # the centre of mass is G by the ellipses' symmetries
+            return self.laminae_body, s.mass_properties()
+        moments = s.principal_moments if s.mass_model == 'custom' else None
+        return _centred(self.laminae_body, s.mass_model, s.mass, moments)
+
+    @property
+    def body(self):
+        """The run's :class:`~twodisk_ros.physics.rolling_body.RollingBody`, its origin at
+        the centre of mass (G, or P = ``body.origin`` for the solid parallel egg)."""
+        return self._body_and_mass[0]
+
+    @property
+    def mass(self):
+        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of the run (centre of
+        mass at the body's origin)."""
+        return self._body_and_mass[1]
 
     @cached_property
     def dynamics(self):

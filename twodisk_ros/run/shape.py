@@ -28,6 +28,7 @@ import math
 import os
 import stat
 
+from ..physics.body import TwoDiskBody
 from ..physics.general_body import GeneralTwoDiskBody
 from ..physics.lamina import Egg, Ellipse, Superellipse
 from ..physics.lamina_fit import Outline, read_outline
@@ -171,7 +172,13 @@ def clear_caches():
 
 
 def theta_max_of(lamina, delta, arrangement):
-    """θ_max (rad) of two such laminae at Δ in the arrangement (ValueError if no cycle)."""
+    """θ_max (rad) of two such laminae at Δ in the arrangement (ValueError if no cycle).
+
+    An :class:`~twodisk_ros.physics.lamina.Ellipse` takes the closed form of
+    :class:`~twodisk_ros.physics.body.TwoDiskBody` (both arrangements are the same body).
+    """
+    if type(lamina) is Ellipse:
+        return TwoDiskBody(lamina.a, lamina.b, delta).theta_max
     return _general(lamina, delta, arrangement).theta_max
 
 

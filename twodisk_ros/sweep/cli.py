@@ -3,14 +3,18 @@
 Usage::
 
     twodisk-sweep --b-over-a START STOP N --delta-over-a START STOP N --out FILE.nc|FILE.zarr
+                  [--exponent N1 [N2 ...] | --exponent-range START STOP N]
                   [--mass-model laminae|solid] [--reference-speed W] [--scheduler ADDRESS]
                   [--workers N] [--chunk-size K] [--plot DIR] [--overwrite] [--fresh]
                   [--keep-parts] [--quiet]
 
 The whole command line is checked first (numbers, the size of the grid against the memory of
 the machine, the outputs), before Dask or xarray is imported: a mistake costs a fraction of a
-second. Outputs follow :mod:`twodisk_ros.outputs`: ``--out`` ends in ``.nc`` (a NetCDF file
-written by the client) or ``.zarr`` (a Zarr store written by the workers); an existing output
+second. The third axis is the superellipse exponent n of both laminae (|x/b|^n + |y/a|^n
+<= 1, 2 <= n <= 100; default 2 alone, the ellipse): n = 2 takes the batched closed forms, any
+other n the per-body general path (docs/sweeps.md "The exponent axis"). Outputs follow
+:mod:`twodisk_ros.outputs`: ``--out`` ends in ``.nc`` (a NetCDF file written by the client) or
+``.zarr`` (a Zarr store written by the workers); an existing output
 (``FILE.nc``, a finished ``FILE.zarr``, or a ``DIR/NAME.png`` of ``--plot``) is refused unless
 ``--overwrite``; files are written through hidden temporary names and renamed, so an
 interrupted or failed sweep leaves them as they were. The resume state (``FILE.nc.parts/``,
@@ -30,10 +34,13 @@ import shutil
 import sys
 import tempfile
 
+import numpy as np
+
 from ..outputs import OutputError, check_output, check_output_dir
-from .request import (DEFAULT_CHUNK_SIZE, DEFAULT_STORE_CHUNK_SIZE, FORMATS, MAX_BODIES,
-                      SweepError, check_size, check_some_valid, default_chunk_size, grid_range,
-                      linspace_grid, output_format, store_plan)
+from .request import (DEFAULT_CHUNK_SIZE, DEFAULT_STORE_CHUNK_SIZE, ELLIPSE_EXPONENT,
+                      EXPONENT_RANGE, FORMATS, GENERAL_CHUNK_SIZE, MAX_BODIES, SweepError,
+                      check_size, check_some_valid, default_chunk_size, exponent_values,
+                      grid_range, linspace_grid, output_format, store_plan)
 
 __all__ = ['main', 'PROG', 'MAX_WORKERS_PER_CORE']
 
@@ -58,7 +65,8 @@ def _parser():
     parser = _Parser(
         prog=PROG,
         description='Compute maps of the rolling two-disk bodies over b/a and Delta/a '
-                    '(a = g = M = 1) on Dask and save them as NetCDF (.nc) or Zarr (.zarr).',
+                    '(a = g = M = 1), and over the superellipse exponent n of the laminae, on '
+                    'Dask and save them as NetCDF (.nc) or Zarr (.zarr).',
         epilog='Exit status: 0 done, 1 a task failed, 2 bad input / grid too large or without '
                'a valid body / unreachable scheduler / unwritable output, 130 interrupted '
                '(run again to resume).')
@@ -67,6 +75,16 @@ def _parser():
     parser.add_argument('--delta-over-a', nargs=3, required=True,
                         metavar=('START', 'STOP', 'N'),
                         help='grid of Delta/a, inclusive; points with Delta/a >= 1 are masked')
+    low, high = EXPONENT_RANGE
+    exponent = parser.add_mutually_exclusive_group()
+    exponent.add_argument('--exponent', nargs='+', metavar='N',
+                          help=f'superellipse exponents n of both laminae, |x/b|^n + |y/a|^n '
+                               f'<= 1, strictly increasing, {low:g} <= n <= {high:g} (default '
+                               f'2: the ellipse, batched; any other n: the per-body general '
+                               f'path, far costlier per body)')
+    exponent.add_argument('--exponent-range', nargs=3, metavar=('START', 'STOP', 'N'),
+                          help='exponents numpy.linspace(START, STOP, N), inclusive, within '
+                               f'[{low:g}, {high:g}]')
     parser.add_argument('--out', required=True, metavar='FILE.nc|FILE.zarr',
                         help='output: a NetCDF file (.nc, small maps) or a Zarr store (.zarr, '
                              'large maps, written by the workers, its own resume state); an '
@@ -84,7 +102,8 @@ def _parser():
                         help='worker processes of the local cluster (default: every core)')
     parser.add_argument('--chunk-size', default=None, metavar='K',
                         help=f'the most bodies per task (default {DEFAULT_CHUNK_SIZE} for .nc, '
-                             f'{DEFAULT_STORE_CHUNK_SIZE} for .zarr; fewer on small grids)')
+                             f'{DEFAULT_STORE_CHUNK_SIZE} for .zarr, {GENERAL_CHUNK_SIZE} with an '
+                             f'exponent other than 2; fewer on small grids)')
     parser.add_argument('--plot', metavar='DIR',
                         help='write one PNG map per variable to DIR/NAME.png (DIR is created '
                              'if its parent exists)')
@@ -124,6 +143,17 @@ def _grid_range(name, values):
     return grid_range(name, start, stop, _integer(f'{name} N', values[2]))
 
 
+def _exponents(args):
+    """The exponent axis of the command line (SweepError or _Usage, one line)."""
+    if args.exponent_range is not None:
+        start, stop, n = _grid_range('--exponent-range', args.exponent_range)
+        exponent_values('--exponent-range', sorted({start, stop}))    # the ends named
+        return exponent_values('--exponent-range', np.linspace(start, stop, n))
+    if args.exponent is None:
+        return np.array([ELLIPSE_EXPONENT])
+    return exponent_values('--exponent', [_number('--exponent', v) for v in args.exponent])
+
+
 def _plot_names():
     """The files ``--plot DIR`` writes: one PNG per float variable of the Dataset."""
     from .quantities import VARIABLES    # numpy/scipy only
@@ -150,12 +180,14 @@ def _checked(args):
         raise _Usage(f'--b-over-a {b[0]:g} {b[1]:g}: b/a must be within [{B_OVER_A[0]:g}, '
                      f'{B_OVER_A[1]:g}] (the range the physics is stated for)')
     d = _grid_range('--delta-over-a', args.delta_over_a)
+    exponents = _exponents(args)
+    general = int(np.count_nonzero(exponents != ELLIPSE_EXPONENT))
     speed = _number('--reference-speed', args.reference_speed)
     if not 0 <= speed <= MAX_REFERENCE_SPEED:
         raise _Usage(f'--reference-speed must be finite, 0 <= W <= {MAX_REFERENCE_SPEED:g}, '
                      f'got {args.reference_speed!r}')
     fmt = output_format(args.out)
-    chunk = (default_chunk_size(b[2] * d[2], fmt) if args.chunk_size is None
+    chunk = (default_chunk_size(b[2] * d[2], fmt, general > 0) if args.chunk_size is None
              else _integer('--chunk-size', args.chunk_size))
     if chunk > MAX_BODIES:
         raise _Usage(f'--chunk-size must be an integer from 1 to {MAX_BODIES} (the most '
@@ -165,14 +197,14 @@ def _checked(args):
                           f'store')
     if fmt is None:
         check_output(args.out, suffixes=tuple(FORMATS))    # the refusal of the suffix
-    check_size(b[2], d[2], chunk, fmt)
+    check_size(b[2], d[2], chunk, fmt, exponents.size, general)
     check_some_valid(d[0])
     if fmt == 'zarr' and args.keep_parts:
         raise _Usage('--keep-parts is for a .nc output only (a .zarr store is its own resume '
                      'state)')
     from .spec import SweepSpec     # (the names of the quantities: scipy, no Dask)
     spec = SweepSpec(linspace_grid('--b-over-a', *b), linspace_grid('--delta-over-a', *d),
-                     args.mass_model, speed, chunk)
+                     args.mass_model, speed, chunk, exponents)
     if fmt == 'zarr':
         store_plan(args.out, spec.manifest(), overwrite=args.overwrite, fresh=args.fresh)
     else:

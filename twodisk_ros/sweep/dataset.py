@@ -1,9 +1,12 @@
 """The result of a sweep as an xarray Dataset, its NetCDF file, and the layout of its Zarr store.
 
-Coordinates ``b_over_a`` and ``delta_over_a`` (dimensionless, a = 1); one float64 variable per
+Coordinates ``exponent`` (the superellipse exponent n; 2 is the ellipse), ``b_over_a`` and
+``delta_over_a`` (dimensionless, a = 1), the dimensions in that order; one float64 variable per
 name of :data:`~twodisk_ros.sweep.quantities.VARIABLES` with ``units`` and ``description``
-attributes, NaN where a body failed; ``failure`` (str, '' on success) says why. The package
-version and the sweep's parameters are global attributes. NetCDF files are NetCDF3 (scipy
+attributes (and, when the grid has an exponent n != 2, ``general_path``: what the variable
+means there, or why it is NaN), NaN where a body failed; ``failure`` (str, '' on success)
+says why. The package version and the sweep's parameters are global attributes. NetCDF files
+are NetCDF3 (scipy
 backend), written to a hidden temporary name and renamed. A Zarr store
 (:mod:`~twodisk_ros.sweep.store`) has the same variables, chunked, and ``computed``.
 """
@@ -14,6 +17,7 @@ import numpy as np
 import xarray as xr
 
 from ..outputs import replacing
+from .general import GENERAL_FAMILIES, GENERAL_MEANINGS
 from .quantities import FAMILIES, VARIABLES
 
 __all__ = ['build_dataset', 'template_dataset', 'write_netcdf', 'read_netcdf', 'read_sweep',
@@ -21,23 +25,32 @@ __all__ = ['build_dataset', 'template_dataset', 'write_netcdf', 'read_netcdf', '
 
 #: The completion flags of a Zarr store (int8 per point; store.py).
 COMPUTED = 'computed'
-DIMS = ('b_over_a', 'delta_over_a')
+DIMS = ('exponent', 'b_over_a', 'delta_over_a')
 
 
-def _variable_attrs():
-    """name → attributes of every variable of the output (``failure`` included)."""
+def _variable_attrs(general=False):
+    """name → attributes of every variable of the output (``failure`` included); with
+    ``general`` (some exponent n != 2) each variable also says what it means on the per-body
+    path (``general_path``) and ``stable_family`` has the flag of both families."""
     attrs = {name: {'units': units, 'description': description}
              for name, (units, description) in VARIABLES.items()}
+    families = GENERAL_FAMILIES if general else FAMILIES
     attrs['stable_family'].update({
-        'flag_values': np.array(sorted(FAMILIES), dtype=np.int32),
-        'flag_meanings': ' '.join(FAMILIES[k].replace(' ', '_') for k in sorted(FAMILIES))})
+        'flag_values': np.array(sorted(families), dtype=np.int32),
+        'flag_meanings': ' '.join(families[k].replace(' ', '_') for k in sorted(families))})
+    if general:
+        for name, meaning in GENERAL_MEANINGS.items():
+            attrs[name]['general_path'] = meaning
     attrs['failure'] = {'units': '1', 'description': "why the point is masked (NaN); '' if "
                                                      "computed"}
     return attrs
 
 
-def _coords(b, d):
+def _coords(b, d, n):
     return {
+        'exponent': ('exponent', n, {'units': '1', 'long_name': 'n',
+                                     'description': 'superellipse exponent of both laminae, '
+                                                    '|x/b|^n + |y/a|^n <= 1 (2: the ellipse)'}),
         'b_over_a': ('b_over_a', b, {'units': '1', 'long_name': 'b/a',
                                      'description': 'semi-axis b over the semi-axis a along '
                                                     'the common axis (a = 1)'}),
@@ -47,7 +60,11 @@ def _coords(b, d):
     }
 
 
-def build_dataset(b_over_a, delta_over_a, arrays, attrs):
+def _exponents(exponent):
+    return np.atleast_1d(np.asarray(2.0 if exponent is None else exponent, dtype=float))
+
+
+def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None):
     """The sweep's Dataset from flat per-point arrays.
 
     Parameters
@@ -55,10 +72,13 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
     b_over_a, delta_over_a : 1-D array_like
         Grid coordinates (dimensionless).
     arrays : dict
-        name → array of ``len(b_over_a) * len(delta_over_a)`` values, flat in C order (b/a
-        major) or of the grid's shape, for every name of ``VARIABLES`` and ``failure``.
+        name → array of ``len(exponent) * len(b_over_a) * len(delta_over_a)`` values, flat in
+        C order (exponent major) or of the grid's shape, for every name of ``VARIABLES`` and
+        ``failure``.
     attrs : dict
         Global attributes (str, int or float values).
+    exponent : 1-D array_like, optional
+        The exponents n (default: 2 alone, the ellipse).
 
     Returns
     -------
@@ -66,19 +86,21 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs):
     """
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
-    shape = (b.size, d.size)
-    attrs_of = _variable_attrs()
+    n = _exponents(exponent)
+    shape = (n.size, b.size, d.size)
+    attrs_of = _variable_attrs(bool(np.any(n != 2.0)))
     data = {name: (DIMS, np.asarray(arrays[name], dtype=float).reshape(shape), attrs_of[name])
             for name in VARIABLES}
     failure = np.asarray(arrays['failure'], dtype=str).reshape(shape)
     data['failure'] = (DIMS, failure, attrs_of['failure'])
-    return xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+    return xr.Dataset(data, coords=_coords(b, d, n), attrs=dict(attrs))
 
 
-def template_dataset(b_over_a, delta_over_a, block, attrs):
+def template_dataset(b_over_a, delta_over_a, block, attrs, exponent=None):
     """The sweep's Dataset with lazy (Dask) variables, and the encoding that chunks them in
-    ``block`` = (rows, columns): what ``to_zarr(compute=False, encoding=...)`` lays out as an
-    empty store. Floats NaN, ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
+    ``block`` = (1, rows, columns) (exponents ``exponent``, default 2 alone): what
+    ``to_zarr(compute=False, encoding=...)`` lays out as an empty store. Floats NaN,
+    ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
     (int8; 1 once a block is complete). Returns (Dataset, encoding).
 
     Each variable is one Dask chunk (a graph of one task per variable, however many blocks:
@@ -86,8 +108,9 @@ def template_dataset(b_over_a, delta_over_a, block, attrs):
     import dask.array as da
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
-    shape, chunks = (b.size, d.size), tuple(int(x) for x in block)
-    attrs_of = _variable_attrs()
+    n = _exponents(exponent)
+    shape, chunks = (n.size, b.size, d.size), tuple(int(x) for x in block)
+    attrs_of = _variable_attrs(bool(np.any(n != 2.0)))
     data = {name: (DIMS, da.full(shape, np.nan, chunks=-1), attrs_of[name])
             for name in VARIABLES}
     data['failure'] = (DIMS, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=-1),
@@ -95,7 +118,7 @@ def template_dataset(b_over_a, delta_over_a, block, attrs):
     data[COMPUTED] = (DIMS, da.zeros(shape, dtype=np.int8, chunks=-1), {
         'units': '1', 'description': '1 where the point was computed and written (its chunk '
                                      'complete), 0 where not yet (an interrupted sweep)'})
-    dataset = xr.Dataset(data, coords=_coords(b, d), attrs=dict(attrs))
+    dataset = xr.Dataset(data, coords=_coords(b, d, n), attrs=dict(attrs))
     return dataset, {name: {'chunks': chunks} for name in dataset.data_vars}
 
 

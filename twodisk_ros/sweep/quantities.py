@@ -10,6 +10,9 @@ once as arrays (:mod:`~twodisk_ros.sweep.batch`), to ≤ 1e-10 relative of the s
 
 A body that cannot be built or whose computation fails is not an error of the sweep: its
 quantities from the failing stage on are NaN and ``failure`` says why, in one line.
+
+A chunk of exponent n != 2 (superellipse laminae) goes through the per-body general path
+(:mod:`~twodisk_ros.sweep.general`); n = 2 is the ellipse and the paths above, unchanged.
 """
 
 import math
@@ -25,9 +28,10 @@ from ..physics.cycle import RollingCycle, TWO_PI
 from ..physics.dynamics import RollingDynamics
 from ..physics.equilibria import NEUTRAL, STABLE
 from ..physics.mass_models import mass_properties
+from .request import ELLIPSE_EXPONENT
 
 __all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities',
-           'chunk_quantities', 'timed_chunk', 'contact_length_range', 'cycle_time']
+           'chunk_quantities', 'timed_chunk', 'contact_length_range', 'cycle_time', 'one_line']
 
 #: name → (units, description), in the order of the output; units with a = g = M = 1.
 VARIABLES = {
@@ -74,7 +78,8 @@ STAGES = ('body', 'cycle', 'equilibria', 'cycle_time', 'contact_length', 'contac
 MASS_MODELS = ('laminae', 'solid')
 
 
-def _one_line(text, limit=200):
+def one_line(text, limit=200):
+    """``text`` on one line, at most ``limit`` characters (a ``failure`` value)."""
     text = ' '.join(str(text).split())
     return text if len(text) <= limit else text[:limit - 3] + '...'
 
@@ -180,7 +185,7 @@ def body_quantities(b_over_a, delta_over_a, mass_model='laminae', reference_spee
         try:
             run(stage)
         except Exception as error:  # noqa: BLE001 (a failing body is data, not a crash)
-            return values, _one_line(f'{stage}: {type(error).__name__}: {error}')
+            return values, one_line(f'{stage}: {type(error).__name__}: {error}')
         finally:
             if timings is not None:
                 timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
@@ -214,7 +219,8 @@ def _equilibria_stage(state, values, mass_model, b, d):
 
 
 def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
-                     timings=None, method='batch'):
+                     timings=None, method='batch', exponent=ELLIPSE_EXPONENT,
+                     body_factory=None, mass_factory=None):
     """:func:`body_quantities` over paired 1-D arrays of b/a and Δ/a (one task of a sweep).
 
     Parameters
@@ -224,6 +230,16 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
         ≤ 1e-10 relative from the scalar path, docs/sweeps.md); 'scalar':
         :func:`body_quantities` body by body (the reference). ``timings`` gets the stages of
         the chosen path (:data:`~twodisk_ros.sweep.batch.BATCH_STAGES` or :data:`STAGES`).
+        Ignored for an exponent other than 2 or with a ``body_factory``.
+    exponent : float
+        Superellipse exponent n of every body of the chunk: 2 (the ellipse, default) takes
+        ``method``; any other n, or a ``body_factory``, the per-body general path
+        (:func:`~twodisk_ros.sweep.general.general_body_quantities`, its stages in
+        ``timings``).
+    body_factory, mass_factory : callable, optional
+        ``body_factory(b, delta, n)`` → RollingBody and ``mass_factory(model, body)`` →
+        MassProperties (M = 1) of the general path (default: superellipse laminae,
+        ``LaminaBody``; tests pass their own).
 
     Returns
     -------
@@ -231,6 +247,9 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
         name → float64 array for every name of :data:`VARIABLES`, and ``failure`` → list of
         str, all of the length of the inputs.
     """
+    if exponent != ELLIPSE_EXPONENT or body_factory is not None:
+        return _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed,
+                              timings, body_factory, mass_factory)
     if method == 'batch':
         from .batch import batch_quantities     # batch builds on this module (its fallback)
         return batch_quantities(b_values, delta_values, mass_model, reference_speed, timings)
@@ -249,8 +268,29 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
     return out
 
 
-def timed_chunk(b_values, delta_values, mass_model='laminae', reference_speed=0.5):
-    """(:func:`chunk_quantities` (...), wall time, CPU time of the process in s): one task."""
+def _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed, timings,
+                   body_factory, mass_factory):
+    """:func:`chunk_quantities` on the per-body general path (one body after the other)."""
+    from .general import general_body_quantities
+    b_values = np.asarray(b_values, dtype=float).ravel()
+    delta_values = np.asarray(delta_values, dtype=float).ravel()
+    out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
+    failures = []
+    for k, (b, d) in enumerate(zip(b_values, delta_values)):
+        values, failure = general_body_quantities(b, d, exponent, mass_model, reference_speed,
+                                                  timings, body_factory, mass_factory)
+        for name, value in values.items():
+            out[name][k] = value
+        failures.append(failure)
+    out['failure'] = failures
+    return out
+
+
+def timed_chunk(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
+                exponent=ELLIPSE_EXPONENT):
+    """(:func:`chunk_quantities` (...), wall time, CPU time of the process in s): one task
+    (one exponent n)."""
     start, cpu = time.perf_counter(), time.process_time()
-    result = chunk_quantities(b_values, delta_values, mass_model, reference_speed)
+    result = chunk_quantities(b_values, delta_values, mass_model, reference_speed,
+                              exponent=exponent)
     return result, time.perf_counter() - start, time.process_time() - cpu

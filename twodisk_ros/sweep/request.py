@@ -7,6 +7,7 @@ line here, so a typo costs the start of Python, not the start of Dask.
   :func:`linspace_grid` builds it;
 - :func:`check_size` estimates the memory and work of a grid and refuses a runaway one;
 - :func:`check_some_valid` refuses a grid in which no body can be valid (every Δ/a ≥ 1);
+- :func:`exponent_values` checks the superellipse exponents of the third axis (2 ≤ n ≤ 100);
 - :func:`output_format` tells the output's format by its suffix, :func:`store_info` what an
   existing Zarr store holds (its JSON metadata only, without zarr).
 
@@ -31,7 +32,8 @@ from ..limits import LimitError, check_memory, describe_bytes
 __all__ = ['SweepError', 'linspace_grid', 'grid_range', 'estimate', 'check_size',
            'check_some_valid', 'default_chunk_size', 'output_format', 'store_info',
            'StoreInfo', 'FORMATS', 'DEFAULT_CHUNK_SIZE', 'DEFAULT_STORE_CHUNK_SIZE',
-           'MIN_CHUNKS', 'MAX_BODIES',
+           'MIN_CHUNKS', 'MAX_BODIES', 'ELLIPSE_EXPONENT', 'EXPONENT_RANGE',
+           'GENERAL_CHUNK_SIZE', 'GENERAL_CORE_SECONDS_PER_BODY', 'exponent_values',
            'BYTES_PER_BODY', 'BYTES_PER_BODY_ZARR', 'BYTES_PER_TASK', 'BYTES_PER_AXIS_VALUE',
            'CORE_SECONDS_PER_BODY', 'STORE_MANIFEST', 'STORE_STATE']
 
@@ -44,6 +46,11 @@ DEFAULT_CHUNK_SIZE = 128
 #: fewer files, tasks and client reads (~0.3 ms per chunk) than 16-body chunks on the large
 #: maps Zarr is for (docs/sweeps.md "Scaling"; benchmarks/sweep_scaling.py).
 DEFAULT_STORE_CHUNK_SIZE = 1024
+#: Bodies per task when the grid has an exponent n != 2 (the per-body general path, seconds
+#: to minutes a body: GENERAL_CORE_SECONDS_PER_BODY), so that a task stays short enough to
+#: resume from and a small map still spreads over the cores. Blocks have one shape over the whole grid (Zarr's regular
+#: chunks), so the n = 2 plane of a mixed grid is cut as finely.
+GENERAL_CHUNK_SIZE = 8
 #: Without --chunk-size a grid is cut into at least this many tasks (smaller chunks on small
 #: grids), so that a small map still spreads over the cores.
 MIN_CHUNKS = 16
@@ -64,6 +71,16 @@ BYTES_PER_AXIS_VALUE = 256
 #: Work per body in a Dask worker (core-seconds; docs/sweeps.md "Cost"): the batched path
 #: measured ~3 ms on the benchmark's map; thin bodies need finer tables, hence the margin.
 CORE_SECONDS_PER_BODY = 0.004
+#: Work per body of the general path (exponent n != 2: LaminaBody, its cycle, dynamics and
+#: contact-force tables; core-seconds). Measured on main of 26 Nov (b/a = 1, Δ/a = 0.5, load
+#: average 2-3 on 2 cores): 0.56 s at n = 4, 4.2 s at n = 10, 165 s at n = 2.5 (and ~340 s
+#: at n = 2.0001 on an earlier build), 75-97 % in the certified equilibrium search
+#: (docs/sweeps.md "The exponent axis"); benchmarks/sweep_exponent.py measures it in make bench.
+GENERAL_CORE_SECONDS_PER_BODY = 10.0
+#: The exponent of the ellipse: the batched closed-form path (:mod:`~twodisk_ros.sweep.batch`).
+ELLIPSE_EXPONENT = 2.0
+#: Allowed superellipse exponents n (|x/b|^n + |y/a|^n <= 1), inclusive.
+EXPONENT_RANGE = (2.0, 100.0)
 
 
 class SweepError(Exception):
@@ -111,24 +128,59 @@ def linspace_grid(name, start, stop, n):
     return np.linspace(start, stop, n)
 
 
-def default_chunk_size(bodies, fmt='netcdf'):
+def exponent_values(name, values):
+    """The exponents of the third axis as a float array: each finite, within
+    :data:`EXPONENT_RANGE`, strictly increasing (so each is one plane of the grid).
+
+    Raises
+    ------
+    SweepError
+        One line naming the bad value and what is allowed.
+    """
+    low, high = EXPONENT_RANGE
+    out = []
+    for value in values:
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise SweepError(f'{name}: exponents must be numbers, got {value!r}') from None
+        if not (math.isfinite(number) and low <= number <= high):
+            raise SweepError(f'{name}: the superellipse exponent must be finite and within '
+                             f'[{low:g}, {high:g}] (2 is the ellipse), got {number!r}')
+        out.append(number)
+    if not out:
+        raise SweepError(f'{name}: give at least one exponent')
+    if any(later <= earlier for earlier, later in zip(out, out[1:])):
+        raise SweepError(f'{name}: exponents must be strictly increasing, got '
+                         f'{" ".join(repr(float(x)) for x in out)}')
+    return np.array(out, dtype=float)
+
+
+def default_chunk_size(bodies, fmt='netcdf', general=False):
     """Bodies per task when --chunk-size is not given: :data:`DEFAULT_CHUNK_SIZE` (NetCDF) or
-    :data:`DEFAULT_STORE_CHUNK_SIZE` (Zarr), smaller on a small grid so that it has at least
+    :data:`DEFAULT_STORE_CHUNK_SIZE` (Zarr), :data:`GENERAL_CHUNK_SIZE` when the grid has an
+    exponent n != 2 (``general``), smaller on a small grid so that it has at least
     :data:`MIN_CHUNKS` tasks. Depends on the grid only, so the same command resumes."""
     base = DEFAULT_STORE_CHUNK_SIZE if fmt == 'zarr' else DEFAULT_CHUNK_SIZE
+    if general:
+        base = GENERAL_CHUNK_SIZE
     return max(1, min(base, math.ceil(bodies / MIN_CHUNKS)))
 
 
-def estimate(n_b, n_delta, chunk_size, fmt='netcdf'):
-    """(bytes of client memory, core-seconds of work) of a sweep of ``n_b`` × ``n_delta``
-    bodies written as ``fmt`` ('netcdf' or 'zarr'); tasks counted as if the grid were cut
-    into runs of ``chunk_size`` (rectangular blocks give at most twice as many)."""
-    bodies = n_b * n_delta
-    tasks = 2 * -(-bodies // max(1, int(chunk_size)))
+def estimate(n_b, n_delta, chunk_size, fmt='netcdf', n_exponent=1, n_general=0):
+    """(bytes of client memory, core-seconds of work) of a sweep of ``n_exponent`` ×
+    ``n_b`` × ``n_delta`` bodies (``n_general`` of the exponents not 2: the per-body path)
+    written as ``fmt`` ('netcdf' or 'zarr'); tasks counted as if the grid were cut into runs
+    of ``chunk_size`` (rectangular blocks give at most twice as many)."""
+    plane = n_b * n_delta
+    bodies = n_exponent * plane
+    tasks = 2 * n_exponent * -(-plane // max(1, int(chunk_size)))
     per_body = BYTES_PER_BODY_ZARR if fmt == 'zarr' else BYTES_PER_BODY
     memory = (bodies * per_body + tasks * BYTES_PER_TASK
-              + (n_b + n_delta) * BYTES_PER_AXIS_VALUE)
-    return memory, bodies * CORE_SECONDS_PER_BODY
+              + (n_b + n_delta + n_exponent) * BYTES_PER_AXIS_VALUE)
+    work = ((n_exponent - n_general) * plane * CORE_SECONDS_PER_BODY
+            + n_general * plane * GENERAL_CORE_SECONDS_PER_BODY)
+    return memory, work
 
 
 def _hours(seconds):
@@ -136,12 +188,14 @@ def _hours(seconds):
     return f'{hours:.3g} core-hours' if hours >= 0.1 else f'{seconds:.3g} core-seconds'
 
 
-def check_size(n_b, n_delta, chunk_size, fmt='netcdf'):
+def check_size(n_b, n_delta, chunk_size, fmt='netcdf', n_exponent=1, n_general=0):
     """Refuse a sweep that needs more than :data:`MAX_BODIES` bodies or more memory than
-    :func:`~twodisk_ros.limits.memory_limit` allows (SweepError, one line)."""
-    bodies = n_b * n_delta
-    memory, work = estimate(n_b, n_delta, chunk_size, fmt)
-    what = (f'the grid of {n_b} x {n_delta} = {bodies} bodies in tasks of {chunk_size} '
+    :func:`~twodisk_ros.limits.memory_limit` allows (SweepError, one line); the arguments
+    are those of :func:`estimate`."""
+    bodies = n_exponent * n_b * n_delta
+    memory, work = estimate(n_b, n_delta, chunk_size, fmt, n_exponent, n_general)
+    grid = f'{n_b} x {n_delta}' if n_exponent == 1 else f'{n_exponent} x {n_b} x {n_delta}'
+    what = (f'the grid of {grid} = {bodies} bodies in tasks of {chunk_size} '
             f'(~{_hours(work)} of work)')
     if bodies > MAX_BODIES:
         raise SweepError(f'{what} would need ~{describe_bytes(memory)} of memory; allowed: '

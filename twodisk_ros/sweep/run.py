@@ -1,7 +1,9 @@
 """A sweep over the family of bodies on Dask: tasks, results, progress and resume.
 
-The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`); each block is one
-Dask task on a worker. Where the results go depends on the output's suffix:
+The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`), each of one
+exponent n; each block is one Dask task on a worker (the batched path for n = 2, the per-body
+general path otherwise: :func:`~twodisk_ros.sweep.quantities.chunk_quantities`). Where the
+results go depends on the output's suffix:
 
 - ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.quantities.timed_chunk`) sends
   its block's values back to the client, which saves each finished block in the resume cache
@@ -154,10 +156,12 @@ def _collect(client, futures, bar, on_chunk, handle):
 
 
 def _all_masked(spec, first_failure):
-    b, d = spec.b_over_a[0], spec.delta_over_a[0]
+    b, d, n = spec.b_over_a[0], spec.delta_over_a[0], spec.exponent[0]
+    where = f'b/a = {float(b)!r}, Delta/a = {float(d)!r}'
+    if spec.general:
+        where = f'n = {float(n)!r}, {where}'
     return SweepError(f'no body of the grid could be computed: all {spec.size} points are '
-                      f'masked (e.g. b/a = {float(b)!r}, Delta/a = {float(d)!r}: '
-                      f'{first_failure}); nothing written')
+                      f'masked (e.g. {where}: {first_failure}); nothing written')
 
 
 def run_sweep(spec, client, out=None, progress=sys.stderr, on_chunk=None, fresh=False,
@@ -250,7 +254,8 @@ def _run_in_memory(spec, client, out, progress, on_chunk, fresh, keep_parts, ove
         return bodies
 
     futures = {client.submit(timed_chunk, *spec.block_points(blocks[index]), spec.mass_model,
-                             spec.reference_speed, pure=False): index
+                             spec.reference_speed, spec.block_exponent(blocks[index]),
+                             pure=False): index
                for index in range(len(blocks)) if index not in done}
     bar = SweepProgress(progress, spec.size, sum(arrays['failure'][blocks[i]].size
                                                  for i in done))
@@ -262,7 +267,8 @@ def _run_in_memory(spec, client, out, progress, on_chunk, fresh, keep_parts, ove
         if cache is not None and not keep_parts:
             cache.remove()      # nothing worth resuming: the same grid fails the same way
         raise _all_masked(spec, failure.flat[0])
-    run.dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs())
+    run.dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs(),
+                                exponent=spec.exponent)
     if out:
         try:
             check_output(out, overwrite=overwrite)
@@ -302,12 +308,13 @@ def _run_zarr(spec, client, path, progress, on_chunk, fresh, overwrite):
         return result['bodies']
 
     def size(block):
-        return (block[0].stop - block[0].start) * (block[1].stop - block[1].start)
+        return math.prod(part.stop - part.start for part in block)
 
     futures = {client.submit(zstore.write_block, os.fspath(path), blocks[index],
-                             spec.b_over_a[blocks[index][0]],
-                             spec.delta_over_a[blocks[index][1]], spec.mass_model,
-                             spec.reference_speed, pure=False): index
+                             spec.b_over_a[blocks[index][1]],
+                             spec.delta_over_a[blocks[index][2]], spec.mass_model,
+                             spec.reference_speed, spec.block_exponent(blocks[index]),
+                             pure=False): index
                for index in range(len(blocks)) if index not in done}
     bar = SweepProgress(progress, spec.size, sum(size(blocks[i]) for i in done))
     run.computed = _collect(client, futures, bar, on_chunk, handle)

@@ -1,8 +1,12 @@
 """What a sweep computes: the grid, the options and how the grid is cut into tasks (numpy only).
 
-The grid is b/a × Δ/a (inclusive, as :func:`numpy.linspace`), b/a the first (slow) axis. It is
-cut into rectangular **blocks** of at most ``chunk_size`` bodies: whole rows of Δ/a when a row
-fits (several rows per block), else pieces of one row of near-equal length. One block is one
+The grid is exponent × b/a × Δ/a: the superellipse exponents n (2, the ellipse, by default; a
+list of values or an inclusive linspace) are the first (slowest) axis, then b/a and Δ/a
+(inclusive, as :func:`numpy.linspace`). Each exponent's plane is cut into rectangular
+**blocks** of at most ``chunk_size`` bodies: whole rows of Δ/a when a row fits (several rows
+per block), else pieces of one row of near-equal length; a block never spans two exponents, so
+one task computes one path (batched for n = 2, per body otherwise) and a grid of n = 2 alone is
+cut exactly as before the exponent axis existed. One block is one
 Dask task and, in a Zarr store, one chunk of every variable, so that no two tasks ever write
 the same chunk (what makes the workers' parallel writes safe). Every block has the same shape
 except at the far edges of the grid (Zarr's regular chunk grid).
@@ -11,19 +15,24 @@ No Dask, no xarray here (numpy, and the names of the quantities): the command li
 spec and compares it with the manifest of an existing store before Dask is started.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 
 import numpy as np
 
 from .. import __version__
 from .quantities import MASS_MODELS, VARIABLES
-from .request import DEFAULT_CHUNK_SIZE, SweepError
+from .request import DEFAULT_CHUNK_SIZE, ELLIPSE_EXPONENT, SweepError, exponent_values
 
 __all__ = ['SweepSpec', 'MANIFEST_FORMAT', 'block_shape']
 
-#: Version of :meth:`SweepSpec.manifest` (2: rectangular blocks; 1 was runs of the flat grid).
-MANIFEST_FORMAT = 2
+#: Version of :meth:`SweepSpec.manifest` (3: the exponent axis; 2: rectangular blocks; 1 was
+#: runs of the flat grid).
+MANIFEST_FORMAT = 3
+
+
+def _ellipse_only():
+    return np.array([ELLIPSE_EXPONENT])
 
 
 def block_shape(n_b, n_delta, chunk_size):
@@ -39,15 +48,20 @@ def block_shape(n_b, n_delta, chunk_size):
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """What to compute: the grid (b/a, Δ/a), the mass model, μ's reference speed, chunking."""
+    """What to compute: the grid (exponent, b/a, Δ/a), the mass model, μ's reference speed,
+    chunking. ``exponent`` (the superellipse exponents n, 2 ≤ n ≤ 100, strictly increasing)
+    comes last so that ``SweepSpec(b, d, ...)`` is the ellipse sweep (n = 2)."""
 
     b_over_a: np.ndarray
     delta_over_a: np.ndarray
     mass_model: str = 'laminae'
     reference_speed: float = 0.5     #: kinematic |ω| for mu_required (units √(g/a))
     chunk_size: int = DEFAULT_CHUNK_SIZE   #: the most bodies of one task
+    exponent: np.ndarray = field(default_factory=_ellipse_only)   #: superellipse n (1)
 
     def __post_init__(self):
+        object.__setattr__(self, 'exponent', exponent_values('exponent', np.atleast_1d(
+            np.asarray(self.exponent, dtype=float))))
         if self.mass_model not in MASS_MODELS:
             raise SweepError(f'mass model must be one of {", ".join(MASS_MODELS)}, got '
                              f'{self.mass_model!r}')
@@ -59,33 +73,44 @@ class SweepSpec:
 
     @property
     def shape(self):
-        """(number of b/a values, number of Δ/a values)."""
-        return (len(self.b_over_a), len(self.delta_over_a))
+        """(number of exponents, of b/a values, of Δ/a values)."""
+        return (len(self.exponent), len(self.b_over_a), len(self.delta_over_a))
 
     @property
     def size(self):
         """Number of bodies."""
-        return self.shape[0] * self.shape[1]
+        return math.prod(self.shape)
+
+    @property
+    def general(self):
+        """True when some exponent is not 2: the grid has bodies of the per-body path."""
+        return bool(np.any(self.exponent != ELLIPSE_EXPONENT))
 
     @property
     def block(self):
-        """(rows, columns) of one block (:func:`block_shape`)."""
-        return block_shape(*self.shape, self.chunk_size)
+        """(1, rows, columns) of one block (:func:`block_shape` in one exponent's plane)."""
+        return (1, *block_shape(*self.shape[1:], self.chunk_size))
 
     def points(self):
-        """(b/a, Δ/a) of every grid point, flat, C order (b/a major)."""
-        b, d = np.meshgrid(self.b_over_a, self.delta_over_a, indexing='ij')
-        return b.ravel(), d.ravel()
+        """(exponent, b/a, Δ/a) of every grid point, flat, C order (exponent major)."""
+        n, b, d = np.meshgrid(self.exponent, self.b_over_a, self.delta_over_a, indexing='ij')
+        return n.ravel(), b.ravel(), d.ravel()
 
     def blocks(self):
-        """The blocks, each ``(rows, columns)`` as two slices of the grid, b/a-major order."""
-        (n_b, n_d), (rows, cols) = self.shape, self.block
-        return [(slice(i, min(i + rows, n_b)), slice(j, min(j + cols, n_d)))
-                for i in range(0, n_b, rows) for j in range(0, n_d, cols)]
+        """The blocks, each ``(exponent, rows, columns)`` as three slices of the grid (one
+        exponent each), in C order of the grid."""
+        (n_e, n_b, n_d), (_, rows, cols) = self.shape, self.block
+        return [(slice(k, k + 1), slice(i, min(i + rows, n_b)), slice(j, min(j + cols, n_d)))
+                for k in range(n_e) for i in range(0, n_b, rows) for j in range(0, n_d, cols)]
+
+    def block_exponent(self, block):
+        """The exponent n of a block (every block has one)."""
+        return float(self.exponent[block[0]][0])
 
     def block_points(self, block):
-        """(b/a, Δ/a) of the bodies of one block, flat, C order (as :meth:`points`)."""
-        b, d = np.meshgrid(self.b_over_a[block[0]], self.delta_over_a[block[1]], indexing='ij')
+        """(b/a, Δ/a) of the bodies of one block, flat, C order (as :meth:`points`); its
+        exponent is :meth:`block_exponent`."""
+        b, d = np.meshgrid(self.b_over_a[block[1]], self.delta_over_a[block[2]], indexing='ij')
         return b.ravel(), d.ravel()
 
     def chunks(self):
@@ -97,6 +122,7 @@ class SweepSpec:
         """JSON description of the sweep (floats as ``float.hex``: exact); two sweeps share
         resume state only under equal manifests."""
         return {'format': MANIFEST_FORMAT, 'package_version': __version__,
+                'exponent': [float(x).hex() for x in self.exponent],
                 'b_over_a': [float(x).hex() for x in self.b_over_a],
                 'delta_over_a': [float(x).hex() for x in self.delta_over_a],
                 'mass_model': self.mass_model,
@@ -106,9 +132,13 @@ class SweepSpec:
 
     def attrs(self):
         """Global attributes of the output."""
-        b, d = self.b_over_a, self.delta_over_a
+        b, d, n = self.b_over_a, self.delta_over_a, self.exponent
+        title = ('Quantities of the rolling two-disk bodies over b/a and Delta/a'
+                 if not self.general else
+                 'Quantities of the rolling bodies of two superellipse laminae '
+                 '|x/b|^n + |y/a|^n <= 1 over the exponent n, b/a and Delta/a')
         return {
-            'title': 'Quantities of the rolling two-disk bodies over b/a and Delta/a',
+            'title': title,
             'source': f'twodisk_ros {__version__} (twodisk_ros.sweep)',
             'package_version': __version__,
             'units_convention': 'a = 1, g = 1, M = 1: lengths in a, times in sqrt(a/g), '
@@ -118,5 +148,6 @@ class SweepSpec:
             'reference_speed_units': 'sqrt(g/a)',
             'b_over_a_grid': f'linspace({float(b[0])!r}, {float(b[-1])!r}, {len(b)})',
             'delta_over_a_grid': f'linspace({float(d[0])!r}, {float(d[-1])!r}, {len(d)})',
+            'exponent_values': ' '.join(repr(float(x)) for x in n),
             'chunk_size': int(self.chunk_size),
         }

@@ -58,7 +58,7 @@ def create_store(path, spec):
                                     dir=path.parent))
     try:
         template, encoding = template_dataset(spec.b_over_a, spec.delta_over_a, spec.block,
-                                              spec.attrs())
+                                              spec.attrs(), exponent=spec.exponent)
         template.attrs.update({STORE_MANIFEST: json.dumps(spec.manifest()),
                                STORE_STATE: 'incomplete'})
         with _quiet_zarr():
@@ -77,10 +77,9 @@ def remove_store(path):
 
 def _block_minima(values, spec):
     """The smallest value of each block (flat, in the order of ``spec.blocks()``)."""
-    rows, cols = spec.block
-    starts = (np.arange(0, values.shape[0], rows), np.arange(0, values.shape[1], cols))
-    return np.minimum.reduceat(np.minimum.reduceat(values, starts[0], axis=0), starts[1],
-                               axis=1).ravel()
+    for axis, step in enumerate(spec.block):
+        values = np.minimum.reduceat(values, np.arange(0, values.shape[axis], step), axis=axis)
+    return values.ravel()
 
 
 def complete_blocks(path, spec):
@@ -100,7 +99,8 @@ def complete_blocks(path, spec):
         return found
 
 
-def write_block(path, block, b_values, delta_values, mass_model, reference_speed):
+def write_block(path, block, b_values, delta_values, mass_model, reference_speed,
+                exponent=2.0):
     """Compute one block and write it into the store at ``path`` (a Dask task; see the module
     docstring for the order of the writes).
 
@@ -108,12 +108,13 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     ----------
     path : str
         Absolute path of the store, as every worker sees it.
-    block : (slice, slice)
-        The block's rows (b/a) and columns (Δ/a) in the grid.
+    block : (slice, slice, slice)
+        The block's exponent (one), rows (b/a) and columns (Δ/a) in the grid.
     b_values, delta_values : 1-D arrays
         The grid values of those rows and columns.
-    mass_model, reference_speed
-        As :func:`~twodisk_ros.sweep.quantities.chunk_quantities`.
+    mass_model, reference_speed, exponent
+        As :func:`~twodisk_ros.sweep.quantities.chunk_quantities` (``exponent``: the block's
+        n).
 
     Returns
     -------
@@ -123,15 +124,17 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     """
     import zarr
     b, d = np.meshgrid(b_values, delta_values, indexing='ij')
-    result, seconds, cpu = timed_chunk(b.ravel(), d.ravel(), mass_model, reference_speed)
+    result, seconds, cpu = timed_chunk(b.ravel(), d.ravel(), mass_model, reference_speed,
+                                       exponent)
     start = time.perf_counter()
     block = tuple(block)
-    failure = np.asarray(result['failure'], dtype=object).reshape(b.shape)
+    shape = (1, *b.shape)
+    failure = np.asarray(result['failure'], dtype=object).reshape(shape)
     group = zarr.open_group(path, mode='r+')       # the layout, from the consolidated metadata
     for name in VARIABLES:
-        group[name][block] = np.asarray(result[name], dtype=float).reshape(b.shape)
+        group[name][block] = np.asarray(result[name], dtype=float).reshape(shape)
     group['failure'][block] = failure.astype(np.dtypes.StringDType())
-    group[COMPUTED][block] = np.ones(b.shape, dtype=np.int8)      # last: the block is complete
+    group[COMPUTED][block] = np.ones(shape, dtype=np.int8)      # last: the block is complete
     return {'bodies': int(b.size), 'masked': int(np.count_nonzero(failure != '')),
             'seconds': seconds, 'cpu_seconds': cpu,
             'write_seconds': time.perf_counter() - start}

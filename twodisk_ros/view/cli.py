@@ -39,8 +39,13 @@ SIMULATION_OPTIONS = (('a', float, 'm'), ('b', float, 'm'), ('delta', float, 'm'
                       ('omega0', float, 'rad/s'), ('mass', float, 'kg'),
                       ('gravity', float, 'm/s^2'), ('friction', float, 'mu; .inf: no limit'),
                       ('rate', float, 'Hz'), ('duration', float, 's; 0: until stopped'),
-                      ('path_length', int, 'samples in each trace'))
-CHOICE_OPTIONS = (('mode', ('dynamic', 'kinematic')),
+                      ('path_length', int, 'samples in each trace'),
+                      ('exponent', float, 'superellipse exponent n >= 2'),
+                      ('egg_asymmetry', float, 'egg: share of the largest convex asymmetry'),
+                      ('shape_file', str, 'points: CSV or YAML outline (m)'))
+CHOICE_OPTIONS = (('shape', ('ellipse', 'superellipse', 'egg', 'points')),
+                  ('arrangement', ('parallel', 'swapped')),
+                  ('mode', ('dynamic', 'kinematic')),
                   ('mass_model', ('laminae', 'solid', 'custom')),
                   ('method', ('direct', 'table')))
 

@@ -19,7 +19,6 @@ import numpy as np
 
 from ..node import schedule
 from ..node.simulation import Simulation
-from ..physics.body import TwoDiskBody
 from ..runs import recorded_run
 
 __all__ = ['BLOCK_SECONDS', 'Block', 'LiveSource', 'ReplaySource']
@@ -127,7 +126,7 @@ class ReplaySource:
         run = recorded_run(path)
         self.description = f'the recording {path}'
         self.settings = run.settings
-        self.body = TwoDiskBody(run.settings.a, run.settings.b, run.settings.delta)
+        self.body = run.body           # the recorded run's body, any shape (run description)
         self.weight = run.weight
         self.speed = float(speed)
         self.run = run

@@ -1,0 +1,191 @@
+"""The per-body path of a sweep for an exponent n != 2: superellipse laminae, any RollingBody.
+
+A body of exponent n is two congruent superellipse laminae |x/b|ⁿ + |y/a|ⁿ ≤ 1 (a = 1 along
+the common axis, b = b/a across it) with centres at ∓Δ:
+``LaminaBody(Superellipse(1.0, b, n), Δ)`` (:mod:`~twodisk_ros.physics.lamina_body`). It has
+no closed forms, so it is computed one body at a time through the
+:class:`~twodisk_ros.physics.rolling_body.RollingBody` protocol: its
+:class:`~twodisk_ros.physics.cycle.RollingCycle`, :class:`~twodisk_ros.physics.dynamics.
+RollingDynamics` with the mass model of :func:`~twodisk_ros.physics.mass_models.
+mass_properties_of`, the equilibria the dynamics finds (every root of dz_G/du over the cycle)
+and :class:`~twodisk_ros.physics.contact_forces.ContactForceModel`. The stages and the failure
+lines are those of :func:`~twodisk_ros.sweep.quantities.body_quantities`.
+
+Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exponent axis";
+:data:`GENERAL_MEANINGS` is written into each variable's ``general_path`` attribute):
+
+- ``stability_margin`` is NaN: b² − 2a² + 2Δ² is the ellipse's criterion; a superellipse with
+  n > 2 has flat vertices (zero curvature) where no quadratic criterion exists;
+- ``stable_family`` comes from the closed-form stability of the symmetric equilibria of any
+  lamina (:func:`~twodisk_ros.physics.symmetric_stability.symmetric_equilibria`): +1 the tips
+  (θ = 0 and the turning points), −1 the side vertices (θ = ±π/2), **2 both** (what flat
+  vertices give: each symmetric pose is a shallow local minimum), 0 neutral, NaN neither;
+- ``oscillation_period`` is the dynamics' period about the lowest stable equilibrium, NaN where
+  it has none (on a flat vertex: no linear small-oscillation period);
+- ``rollover_speed`` is √(2 M g barrier / I_AB), I_AB the moment of inertia about the contact
+  line AB at the lowest stable equilibrium: the n = 2 value (½ m(u*) u̇² = M g barrier,
+  |ω| = |ω_u| u̇) written without the phase, whose rate ω_u vanishes where a contact crosses
+  a flat vertex.
+
+The body and its mass model are made by two callables that a caller may replace
+(``body_factory(b, delta, exponent)`` and ``mass_factory(model, body)``), so that this path is
+tested before :class:`~twodisk_ros.physics.lamina_body.LaminaBody` exists.
+"""
+
+import math
+import time
+
+import numpy as np
+
+from ..physics.contact_forces import ContactForceModel
+from ..physics.contact_validity import liftoff_speed, mu_required_kinematic
+from ..physics.cycle import RollingCycle
+from ..physics.dynamics import RollingDynamics
+from ..physics.equilibria import NEUTRAL, STABLE
+
+__all__ = ['GENERAL_FAMILIES', 'GENERAL_MEANINGS', 'superellipse_body', 'lamina_mass',
+           'general_body_quantities', 'axis_inertia', 'symmetric_family']
+
+#: stable_family value → the stable equilibria, on the general path (2: both families).
+GENERAL_FAMILIES = {1: 'theta=0 and turning points', -1: 'theta=+-pi/2', 0: 'neutral',
+                    2: 'both (flat vertices)'}
+
+#: name → what the variable means on the per-body path (exponent n != 2), where it differs.
+GENERAL_MEANINGS = {
+    'stability_margin': 'exponent != 2: NaN. b^2 - 2 a^2 + 2 Delta^2 is the ellipse criterion; '
+                        'for n > 2 the vertices are flat (zero curvature) and no quadratic '
+                        'criterion exists: stable_family says which symmetric equilibria are '
+                        'stable',
+    'stable_family': 'exponent != 2: from the closed-form stability of the symmetric '
+                     'equilibria of any lamina: +1 theta = 0 and the turning points, -1 the '
+                     'side vertices (theta = +-pi/2), 2 both (flat vertices, n > 2), 0 neutral, '
+                     'NaN neither',
+    'barrier': 'exponent != 2: height_max - height_min over every equilibrium of the cycle '
+               '(the deepest well to the highest equilibrium)',
+    'oscillation_period': 'exponent != 2: the dynamics\' period about the lowest stable '
+                          'equilibrium; NaN where it has none: on a flat vertex (n > 2) V is '
+                          'not twice differentiable, the period depends on the amplitude',
+    'rollover_speed': 'exponent != 2: sqrt(2 M g barrier / I_AB), I_AB the moment of inertia '
+                      'about the contact line AB at the lowest stable equilibrium (the n = 2 '
+                      'definition without the phase rate omega_u, which vanishes at flat '
+                      'vertices)',
+}
+
+
+def superellipse_body(b_over_a, delta_over_a, exponent):
+    """``LaminaBody(Superellipse(1.0, b/a, n), Δ/a)``: the body of one grid point."""
+    from ..physics.lamina import Superellipse
+    from ..physics.lamina_body import LaminaBody
+    return LaminaBody(Superellipse(1.0, b_over_a, exponent), delta_over_a)
+
+
+def lamina_mass(mass_model, body):
+    """The mass model ``mass_model`` of ``body`` with M = 1 (``mass_properties_of``)."""
+    from ..physics.mass_models import mass_properties_of     # (issue 20: any RollingBody)
+    return mass_properties_of(mass_model, body, 1.0)
+
+
+def axis_inertia(body, props, u):
+    """I_AB (kg m² with M = 1): the moment of inertia about the line through the contacts A
+    and B at phase ``u``, about which a rolling body turns (both contacts at rest).
+
+    ê = (r2 − r1)/|r2 − r1|, I_AB = êᵀ I_c ê + M |ê × (c − r1)|², I_c the inertia about the
+    centre of mass c (``props.center_of_mass``, body frame)."""
+    geo = body.phase_geometry(np.asarray(float(u)))
+    r1 = np.asarray(geo.contact_a, dtype=float).reshape(3)
+    r2 = np.asarray(geo.contact_b, dtype=float).reshape(3)
+    axis = (r2 - r1) / np.linalg.norm(r2 - r1)
+    arm = np.cross(axis, np.asarray(props.center_of_mass, dtype=float) - r1)
+    return float(axis @ np.asarray(props.inertia, dtype=float) @ axis
+                 + props.mass * float(arm @ arm))
+
+
+def symmetric_family(body):
+    """stable_family of ``body`` from its symmetric equilibria (:data:`GENERAL_FAMILIES`):
+    +1 a tip (θ = 0 or the turning point) stable, −1 the side vertices, 2 both, NaN neither."""
+    from ..physics.symmetric_stability import symmetric_equilibria
+    first, turning, side = symmetric_equilibria(body.lamina, body.delta, body.arrangement)
+    tips = STABLE in (first.stability, turning.stability)
+    sides = side.stability == STABLE
+    if tips and sides:
+        return 2.0
+    return 1.0 if tips else -1.0 if sides else math.nan
+
+
+def _equilibria_stage(state, values, mass_model, mass_factory):
+    """Dynamics (M = g = 1), the stable family, heights, barrier, period, roll-over speed."""
+    body = state['body']
+    props = mass_factory(mass_model, body)
+    state['dynamics'] = dynamics = RollingDynamics(body, props, 1.0, cycle=state['cycle'])
+    found = dynamics.equilibria_with_periods()
+    heights = [float(eq.height) for eq, _ in found]
+    values['height_min'], values['height_max'] = min(heights), max(heights)
+    if all(eq.stability == NEUTRAL for eq, _ in found):
+        values['stable_family'], values['barrier'], values['rollover_speed'] = 0.0, 0.0, 0.0
+        return
+    values['stable_family'] = symmetric_family(body)
+    barrier = values['height_max'] - values['height_min']
+    values['barrier'] = barrier
+    stable = [(eq, period) for eq, period in found if eq.stability == STABLE]
+    if not stable:
+        raise RuntimeError('no stable equilibrium found although the body is not neutral')
+    eq, period = min(stable, key=lambda pair: float(pair[0].height))   # first of the lowest
+    values['oscillation_period'] = (float(period) if period is not None
+                                    and math.isfinite(float(period)) else math.nan)
+    values['rollover_speed'] = math.sqrt(2.0 * barrier / axis_inertia(body, props, eq.phase))
+
+
+def general_body_quantities(b_over_a, delta_over_a, exponent, mass_model='laminae',
+                            reference_speed=0.5, timings=None, body_factory=None,
+                            mass_factory=None):
+    """All sweep quantities of the body of exponent n (module docstring), M = g = 1.
+
+    Parameters and results as :func:`~twodisk_ros.sweep.quantities.body_quantities`, plus
+    ``exponent`` (n) and the two factories (default :func:`superellipse_body` and
+    :func:`lamina_mass`).
+    """
+    from .quantities import STAGES, VARIABLES, contact_length_range, cycle_time, one_line
+    body_factory = body_factory or superellipse_body
+    mass_factory = mass_factory or lamina_mass
+    values = dict.fromkeys(VARIABLES, math.nan)
+    b, d, n = float(b_over_a), float(delta_over_a), float(exponent)
+    if not (math.isfinite(b) and math.isfinite(d)):
+        return values, f'body: b/a = {b!r} and delta/a = {d!r} must be finite'
+    if d >= 1.0:
+        return values, (f'body: delta/a = {d!r} >= 1, the disks do not interlock '
+                        f'(needs 0 < delta/a < 1)')
+    state = {}
+
+    def run(stage):
+        if stage == 'body':
+            state['body'] = body = body_factory(b, d, n)
+            values['theta_max'] = float(body.theta_max)
+        elif stage == 'cycle':
+            state['cycle'] = cycle = RollingCycle(state['body'])
+            values['cycle_advance'] = abs(cycle.displacement.shift)
+            values['cycle_heading'] = cycle.displacement.turn
+        elif stage == 'equilibria':
+            _equilibria_stage(state, values, mass_model, mass_factory)
+        elif stage == 'cycle_time':
+            values['cycle_time'] = cycle_time(state['dynamics'])
+        elif stage == 'contact_length':
+            low, high = contact_length_range(state['body'], state['dynamics'].table_size)
+            values['contact_length_min'], values['contact_length_max'] = low, high
+        elif stage == 'contact_tables':
+            state['model'] = ContactForceModel(state['dynamics'])
+        elif stage == 'liftoff_speed':
+            values['liftoff_speed'] = liftoff_speed(state['model'])[0]
+        else:
+            values['mu_required'] = float(mu_required_kinematic(state['model'],
+                                                                reference_speed))
+
+    for stage in STAGES:
+        start = time.perf_counter()
+        try:
+            run(stage)
+        except Exception as error:  # noqa: BLE001 (a failing body is data, not a crash)
+            return values, one_line(f'{stage}: {type(error).__name__}: {error}')
+        finally:
+            if timings is not None:
+                timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
+    return values, ''
