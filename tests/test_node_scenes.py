@@ -266,13 +266,13 @@ def test_driven_from_a_second_node(tmp_path):
         live.command(live.torque, 0.1)                  # the other drive: ignored
         live.event('timeout')
         live.node.set_parameters([Parameter('drive', value='torque')])
-        live.event('scene drive=torque')
+        live.event('scene drive speed -> torque')
         for _ in range(3):                               # a torque pulse of 0.05 N m
             live.command(live.torque, 0.05)
             live.spin(0.05)
         live.event('timeout', count=2)
         live.node.set_parameters([Parameter('drive', value='speed')])   # the start's again
-        live.event('scene drive=speed')
+        live.event('scene drive torque -> speed')
         live.spin(0.2)
         live.call(live.reset, live.Empty.Request())
         live.event('reset')
@@ -326,3 +326,14 @@ def test_driven_from_a_second_node(tmp_path):
     pause = index[[s for s, e in events if e == 'pause'][0]]
     assert [s for s, e in events if e == 'resume'][0] == t_ns[pause]
     assert abs(u[pause] - u[pause - 1] - 0.5 * (u_dot[pause] + u_dot[pause - 1]) * h) < 1e-4
+    # the inspector checks each stretch on its own (no stencil across an event)
+    from twodisk_ros.inspect import inspect_recording
+    inspection = inspect_recording(path)
+    verdicts = {c.name: c.passed for c in inspection.checks}
+    print({c.name: (c.passed, c.value, c.detail[:1]) for c in inspection.checks})
+    assert [e['event'] for e in inspection.summary['events']] == [e for _, e in events]
+    for name in ('ground', 'contact_points', 'tangent_plane', 'no_slip', 'contact_forces',
+                 'force_split', 'timestamps', 'stamps'):
+        assert verdicts[name], name
+    assert verdicts['energy_balance'], [c.detail for c in inspection.checks
+                                        if c.name == 'energy_balance']

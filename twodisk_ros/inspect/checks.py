@@ -10,14 +10,15 @@ scale, so that round-off far from the origin is allowed for):
     define a body, a mass model and a mode (tolerance 0 problems; the diagnostics, only
     reported and plotted, may be missing).
 ``ground``
-    A and B on the ground: max |z| ≤ 1e-9 X.
+    A and B on the ground: max |n·p| ≤ 1e-9 X, n the ground normal (ez; on a slope β
+    (sin β, 0, cos β), the ground through the origin).
 ``contact_points``
     A and B where the body puts them: |A − (G + R r1(u))| and |B − (G + R r2(u))| ≤ 1e-8 X,
     r1, r2 from :meth:`TwoDiskBody.phase_geometry` at the recorded phase u.  The recorded
     values are float64 from closed forms and tables accurate to ~1e-13 L, so anything above
     the tolerance is an inconsistency, not round-off.
 ``tangent_plane``
-    the ground is the tangent plane: angle between R n(u) and the world's up ≤ 1e-8 rad.
+    the ground is the tangent plane: angle between R n(u) and the ground normal ≤ 1e-8 rad.
 ``theta``
     recorded θ equals θ(u): ≤ 1e-8 rad.
 ``psi``
@@ -57,9 +58,10 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
 from .results import Check, json_ready
-from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES
+from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES, WRENCHES, values_at
 
 __all__ = ['TITLES', 'run_checks']
 
@@ -75,14 +77,16 @@ SOLVER_FLOOR = 1e-9           # relative energy or speed drift always allowed to
 #: What each check verifies, in words.
 TITLES = {
     'inputs': 'topics and parameters present and valid',
-    'ground': 'contact points A and B on the ground (max |z|)',
+    'ground': 'contact points A and B on the ground (max |n·p|, n its normal)',
     'contact_points': 'A and B where the body puts them: G + R r1(u), G + R r2(u)',
-    'tangent_plane': 'the ground is the tangent plane: R n(u) is vertical',
+    'tangent_plane': 'the ground is the tangent plane: R n(u) is its normal',
     'theta': 'recorded θ equals θ(u) of the recorded phase u',
     'psi': 'recorded ψ equals ψ(θ, branch), branch = sign(cos u)',
     'no_slip': 'no slip at A and B (velocities by central differences of poses)',
     'energy': 'energy conserved (from the recorded poses alone)',
     'angular_speed': 'kinematic mode: angular speed |ω| constant = |omega0|',
+    'energy_balance': 'drive or dissipation: E + W − W_d = E0 on each stretch (from the '
+                      'recording alone)',
     'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
     'stamps': 'consistent stamps across messages and topics',
 }
@@ -122,12 +126,13 @@ def _check_inputs(problems, chosen, model):
     return _check('inputs', len(detail), 0, 'problems', detail)
 
 
-def _check_ground(series, scale):
+def _check_ground(series, scale, normal=None):
     points = [series[role].values['point'] for role in ('contact_a', 'contact_b')
               if role in series and len(series[role])]
     if not points:
         return _not_evaluated('ground', 'no contact points recorded', 'm')
-    heights = np.abs(np.concatenate(points)[:, 2])
+    normal = np.array([0.0, 0.0, 1.0]) if normal is None else normal
+    heights = np.abs(np.concatenate(points) @ normal)
     tolerance = GROUND_TOLERANCE * scale
     return _check('ground', float(np.max(heights)), tolerance, 'm', [
         f'{heights.size} points, {int(np.sum(heights > tolerance))} above the tolerance '
@@ -150,12 +155,18 @@ def _check_contact_points(samples, geometry, scale):
         f'tolerance 1e-8 × coordinate scale {scale:.3g} m'])
 
 
-def _check_tangent_plane(samples, geometry):
+def _check_tangent_plane(samples, geometry, ground=None):
     up = samples.rotation.apply(geometry.ground_normal)
-    angle = np.arctan2(np.hypot(up[:, 0], up[:, 1]), up[:, 2])
+    ground = np.array([0.0, 0.0, 1.0]) if ground is None else ground
+    angle = np.arctan2(np.linalg.norm(np.cross(up, ground), axis=1), up @ ground)
     k = int(np.argmax(angle))
     return _check('tangent_plane', float(angle[k]), ANGLE_TOLERANCE, 'rad', [
-        f'largest angle between R n(u) and the up direction, {_where(samples, k)}'])
+        f'largest angle between R n(u) and the ground\'s normal {_vector(ground)}, '
+        f'{_where(samples, k)}'])
+
+
+def _vector(v):
+    return '(' + ', '.join(f'{x:.6g}' for x in v) + ')'
 
 
 def _wrap(angle):
@@ -365,7 +376,7 @@ def _run(checks, name, function, *args):
                                            f'{" ".join(str(error).split())}'))
 
 
-def run_checks(recording, problems, chosen, series, samples, model, parameters):
+def run_checks(recording, problems, chosen, series, samples, model, parameters, events=()):
     """Every check of a recording, in report order; returns (checks, Motion or None).
 
     An error while evaluating a check makes that check fail with the reason: never an
@@ -374,15 +385,18 @@ def run_checks(recording, problems, chosen, series, samples, model, parameters):
     checks = []
     scale = _coordinate_scale(model, series)
     _run(checks, 'inputs', _check_inputs, problems, chosen, model)
-    _run(checks, 'ground', _check_ground, series, scale)
+    _run(checks, 'ground', _check_ground, series, scale,
+         None if model is None else model.ground_normal)
     step_ns, source = _nominal_step_ns(series, model)
-    motion = _physics_checks(checks, samples, model, step_ns, scale, parameters)
+    motion = _physics_checks(checks, samples, model, step_ns, scale, parameters, events,
+                             series)
     _run(checks, 'timestamps', _check_timestamps, series, step_ns, source)
     _run(checks, 'stamps', _check_stamps, series, recording.truncated)
     return checks, motion
 
 
-def _physics_checks(checks, samples, model, step_ns, scale, parameters):
+def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(),
+                    series=None):
     """Append the checks that need the model; return the finite differences (or None)."""
     speed_check = 'angular_speed' if parameters.get('mode') == 'kinematic' else 'energy'
     if model is None or samples is None:
@@ -399,24 +413,63 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters):
         _not_evaluated_all(checks, ('contact_points', 'tangent_plane', 'theta'), reason)
     else:
         _run(checks, 'contact_points', _check_contact_points, samples, geometry, scale)
-        _run(checks, 'tangent_plane', _check_tangent_plane, samples, geometry)
+        _run(checks, 'tangent_plane', _check_tangent_plane, samples, geometry,
+             model.ground_normal)
         _run(checks, 'theta', _check_theta, samples, geometry)
     _run(checks, 'psi', _check_psi, samples, model.body)
     motion, reason = None, 'no stamp interval'
     if step_ns is not None:
         try:
-            motion = motion_of(samples, model, step_ns * 1e-9)
+            motion = motion_of(samples, model, step_ns * 1e-9,
+                               [stamp for stamp, _ in events])
         except Exception as error:  # noqa: BLE001 - reported as failed checks
             reason = f'{type(error).__name__}: {" ".join(str(error).split())}'
     if motion is None:
         _not_evaluated_all(checks, ('no_slip', speed_check), f'no finite differences: {reason}')
         return None
     _run(checks, 'no_slip', _check_no_slip, samples, motion, scale)
-    if model.mode == 'kinematic':
+    if model.mode == 'kinematic' and not model.scene:
         _run(checks, 'angular_speed', _check_angular_speed, samples, motion, model)
+    elif model.scene and not _conservative(parameters):
+        _run(checks, 'energy_balance', _check_energy_balance, samples, motion, model,
+             parameters, events, series)
     else:
         _run(checks, 'energy', _check_energy, samples, motion, model)
     return motion
+
+
+def _check_energy_balance(samples, motion, model, parameters, events, series):
+    """E + W − W_d = E(t₀) on each stretch whose drive's work is known (:mod:`.balance`)."""
+    if motion.index.size == 0:
+        return _not_evaluated('energy_balance', _NO_DIFFERENCES)
+    (force_a, found_a), (force_b, found_b) = (
+        values_at(series.get(role), 'force', samples.stamp_ns) for role in WRENCHES)
+    normal = ((force_a + force_b) @ model.ground_normal
+              if np.all(found_a & found_b) else None)
+    scale = model.dynamics.energy_scale
+    residuals, skipped, quadrature = balance_stretches(
+        samples, motion, model, scene_timeline(parameters, events), normal)
+    if not residuals:
+        return _not_evaluated('energy_balance', 'no stretch whose drive\'s work is known: '
+                              + '; '.join(skipped[:3]))
+    _, model_fd, exact = _energies(samples, motion, model)
+    fd_error = float(np.max(np.abs(model_fd - exact))) / scale
+    tolerance = 2 * FD_MARGIN * fd_error + 2 * quadrature / scale + _solver_allowance(model)
+    value = max(float(np.max(r)) for _, r in residuals) / scale
+    return _check('energy_balance', value, tolerance, '', [
+        f'max |E + W − W_d − E(t0)| / (M g L) over {len(residuals)} stretch(es), M g L = '
+        f'{scale:.4g} J; E from the poses, W and W_d from the powers of damping, rolling '
+        f'resistance (recorded N) and the torque commanded (events)',
+        f'tolerance 2 × {FD_MARGIN:g} × the FD error of E ({fd_error:.3g}) + 2 × the '
+        f'trapezoid error ({quadrature / scale:.3g}) + solver'] + [
+        f'not checked: {line}' for line in skipped[:5]])
+
+
+def _conservative(parameters):
+    """True if the recorded scene conserves E = T + V: no drive, no dissipation."""
+    return (parameters.get('drive', 'none') == 'none' and parameters.get('mode') != 'kinematic'
+            and float(parameters.get('rolling_resistance', 0)) == 0
+            and float(parameters.get('damping', 0)) == 0)
 
 
 def _not_evaluated_all(checks, names, reason):

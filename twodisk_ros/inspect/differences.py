@@ -146,8 +146,13 @@ class Motion:
     model_angular_acceleration: np.ndarray = None
 
 
-def motion_of(samples, model, step):
-    """Finite differences of the recorded poses and of the model's poses at the same phases."""
+def motion_of(samples, model, step, breaks=()):
+    """Finite differences of the recorded poses and of the model's poses at the same phases.
+
+    ``breaks``: stamps (int ns) at which a new stretch of the run begins (the node's events:
+    a reset, a command, a pause); no stencil reaches across one, so each stretch is
+    differenced on its own.
+    """
     phase = np.unwrap(samples.angles[:, 2])
     state = model.dynamics.cycle.state(phase)
     index, velocity, omega = finite_differences(samples.t, samples.position_g,
@@ -159,8 +164,22 @@ def motion_of(samples, model, step):
                                                         model_rotation, step)
     _, model_acceleration, model_omega_dot = second_differences(
         samples.t, state.position_g, model_rotation, step)
-    return Motion(index, velocity, omega, model_velocity, model_omega, state, step,
-                  acceleration, omega_dot, model_acceleration, model_omega_dot)
+    keep = _within_stretches(samples.stamp_ns, index, breaks)
+    return Motion(index[keep], velocity[keep], omega[keep], model_velocity[keep],
+                  model_omega[keep], state, step, acceleration[keep], omega_dot[keep],
+                  model_acceleration[keep], model_omega_dot[keep])
+
+
+def _within_stretches(stamps, index, breaks):
+    """True for the samples whose stencil (i − 2 … i + 2) lies inside one stretch: no break
+    stamp b with stamp[i − 2] < b ≤ stamp[i + 2]."""
+    keep = np.ones(index.shape, dtype=bool)
+    if index.size == 0:
+        return keep
+    low, high = stamps[index - 2], stamps[index + 2]
+    for b in breaks:
+        keep &= ~((low < b) & (b <= high))
+    return keep
 
 
 def kinetic_energy(mass, velocity, omega, rotation):

@@ -102,7 +102,7 @@ def _components(samples, motion, model, k, recorded):
         return newton_euler(mass, gravity, samples.position_g[k], samples.rotation[k],
                             samples.contact_a[k], samples.contact_b[k],
                             motion.acceleration[rows], motion.angular_velocity[rows],
-                            motion.angular_acceleration[rows])
+                            motion.angular_acceleration[rows], model.ground_normal)
     state = motion.model_state
     return newton_euler(mass, gravity, state.position_g[k],
                         Rotation.from_matrix(state.rotation[k]), state.contact_a[k],
@@ -152,10 +152,10 @@ def _check_contact_forces(samples, motion, model, wrenches, weight, scale):
                                                 'FD error cannot be estimated')
     fd = _components(samples, motion, model, k, recorded=True)
     recorded = recorded_components(force_a[k], force_b[k], samples.contact_a[k],
-                                   samples.contact_b[k])
+                                   samples.contact_b[k], model.ground_normal)
     errors = _differences(recorded, fd, weight)
     phase = np.unwrap(samples.angles[:, 2])[k]
-    exact = exact_components(model, phase, rates)
+    exact = exact_components(model, phase, rates, _scene_acceleration(samples, model, k))
     fd_errors = _differences(_components(samples, motion, model, k, recorded=False), exact,
                              weight)
     fd_error = max(float(np.max(v)) for v in fd_errors.values())
@@ -186,13 +186,21 @@ def _check_contact_forces(samples, motion, model, wrenches, weight, scale):
     return _check('contact_forces', value, tolerance, '', detail)
 
 
-def _check_split(samples, wrenches, weight):
+def _scene_acceleration(samples, model, k):
+    """ü (rad/s²) at samples k from the recorded u̇ (second-order differences) in a scene
+    other than the flat free one (whose ü the model gives), else None."""
+    if not model.scene:
+        return None
+    return np.gradient(samples.rates[:, 2], samples.t)[k]
+
+
+def _check_split(samples, wrenches, weight, model):
     force_a, force_b, found, _, torque = wrenches
     k = np.nonzero(found)[0]
     if k.size == 0:
         return _not_evaluated('force_split', 'no sample with both wrenches')
     recorded = recorded_components(force_a[k], force_b[k], samples.contact_a[k],
-                                   samples.contact_b[k])
+                                   samples.contact_b[k], model.ground_normal)
     compared = np.minimum(np.abs(recorded.normal_a), np.abs(recorded.normal_b)) > (
         SPLIT_GUARD * weight)
     error = np.where(compared, np.abs(recorded.along_a - recorded.rule_split), 0.0) / weight
@@ -214,8 +222,9 @@ def _validity_forces(samples, motion, model, wrenches):
     if wrenches is not None and np.any(wrenches[2]):
         force_a, force_b, found = wrenches[:3]
         k = np.nonzero(found)[0]
-        return samples.t[k], recorded_components(force_a[k], force_b[k], samples.contact_a[k],
-                                                 samples.contact_b[k]), 'the recorded wrenches'
+        return samples.t[k], recorded_components(
+            force_a[k], force_b[k], samples.contact_a[k], samples.contact_b[k],
+            model.ground_normal), 'the recorded wrenches'
     if motion is None or motion.index.size == 0 or motion.acceleration is None:
         return None, None, 'no forces: no wrenches and no central differences'
     k = motion.index
@@ -312,7 +321,8 @@ def force_checks(series, samples, motion, model, parameters, truncated):
         checks.append(_run_safely('contact_forces', _check_contact_forces, samples, motion,
                                   model, wrenches, weight, _coordinate_scale(model, samples)))
     if wrenches is not None:
-        checks.append(_run_safely('force_split', _check_split, samples, wrenches, weight))
+        checks.append(_run_safely('force_split', _check_split, samples, wrenches, weight,
+                                      model))
     mu, mu_note, problem = _friction(parameters)
     t, forces, source = _validity_forces(samples, motion, model, wrenches)
     plot = {}

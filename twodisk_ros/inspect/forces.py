@@ -67,16 +67,17 @@ class ForceComponents:
                              self.tangential_b, self.along_ab)[0]
 
 
-def _directions(contact_a, contact_b):
-    """ê (horizontal unit vector from A to B) and p = e_z × ê, world frame."""
+def _directions(contact_a, contact_b, normal=_UP):
+    """ê (unit vector from A to B in the ground) and p = n × ê, world frame; ``normal`` n is
+    the ground's unit normal (e_z on flat ground)."""
     d = np.asarray(contact_b, dtype=float) - np.asarray(contact_a, dtype=float)
-    e = d * np.array([1.0, 1.0, 0.0])
+    e = d - _dot(d, normal)[..., None] * normal
     e = e / np.linalg.norm(e, axis=-1, keepdims=True)
-    return e, np.cross(_UP, e)
+    return e, np.cross(normal, e)
 
 
 def newton_euler(mass, gravity, position_g, rotation, contact_a, contact_b, acceleration,
-                 omega, omega_dot):
+                 omega, omega_dot, normal=_UP):
     """The determinate ground forces that a rigid motion needs (module docstring).
 
     Parameters
@@ -91,6 +92,8 @@ def newton_euler(mass, gravity, position_g, rotation, contact_a, contact_b, acce
         Body → world.
     acceleration, omega, omega_dot : numpy.ndarray, shape (K, 3)
         a_G (m/s²), ω (rad/s), ω̇ (rad/s²), world frame.
+    normal : numpy.ndarray, shape (3,)
+        The ground's unit normal (e_z on flat ground; gravity stays along −e_z).
 
     Returns
     -------
@@ -106,28 +109,34 @@ def newton_euler(mass, gravity, position_g, rotation, contact_a, contact_b, acce
     moment_a = moment_g - np.cross(contact_a - position_g, total)
     d = contact_b - contact_a
     force_b = np.cross(moment_a, d) / _dot(d, d)[:, None]       # F_B⊥
-    e, p = _directions(contact_a, contact_b)
-    return ForceComponents(total, total[:, 2] - force_b[:, 2], force_b[:, 2],
+    e, p = _directions(contact_a, contact_b, normal)
+    return ForceComponents(total, _dot(total - force_b, normal), _dot(force_b, normal),
                            _dot(total - force_b, p), _dot(force_b, p), _dot(total, e),
                            drive_torque=_dot(moment_a, e))
 
 
-def recorded_components(force_a, force_b, contact_a, contact_b):
-    """The components of recorded forces at A and at B (world, N), with their split."""
-    e, p = _directions(contact_a, contact_b)
+def recorded_components(force_a, force_b, contact_a, contact_b, normal=_UP):
+    """The components of recorded forces at A and at B (world, N), with their split;
+    ``normal``: the ground's unit normal."""
+    e, p = _directions(contact_a, contact_b, normal)
     total = force_a + force_b
-    return ForceComponents(total, force_a[:, 2], force_b[:, 2], _dot(force_a, p),
-                           _dot(force_b, p), _dot(total, e), along_a=_dot(force_a, e))
+    return ForceComponents(total, _dot(force_a, normal), _dot(force_b, normal),
+                           _dot(force_a, p), _dot(force_b, p), _dot(total, e),
+                           along_a=_dot(force_a, e))
 
 
-def exact_components(model, phase, phase_rate):
+def exact_components(model, phase, phase_rate, phase_acceleration=None):
     """The model's forces at the phases u (rad) and rates u̇ (rad/s) of a recording.
 
     Dynamic mode: the free motion through (u, u̇); kinematic mode: the drive holding
-    |ω| = |omega0|. ``model`` is a :class:`~twodisk_ros.inspect.model.RecordedModel`.
+    |ω| = |omega0|; with ``phase_acceleration`` ü (rad/s², a scene's), the forces on flat
+    ground that this ü needs (in the frame of the model's poses: for the FD error).
+    ``model`` is a :class:`~twodisk_ros.inspect.model.RecordedModel`.
     """
     forces_model = ContactForceModel(model.dynamics)
-    if model.mode == 'kinematic':
+    if phase_acceleration is not None:
+        forces = forces_model.forces(phase, phase_rate, phase_acceleration)
+    elif model.mode == 'kinematic':
         forces = forces_model.kinematic(phase, abs(model.omega0))
     else:
         forces = forces_model.dynamic(phase, phase_rate)

@@ -32,6 +32,8 @@ from .tf_check import reads_topic, tf_check
 __all__ = ['inspect_recording']
 
 _DECODED = frozenset(TOPIC_TYPES)
+#: the node's events (reset, pause, commands: node/scene_control.py); each begins a stretch
+EVENTS = 'events'
 _DAMAGE_LISTED = 5      # damaged parts named in the inputs check; the rest are counted
 
 
@@ -123,7 +125,8 @@ def inspect_recording(path):
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
     """
     recording = read_recording(
-        path, decode=lambda topic: topic_role(topic) in _DECODED or reads_topic(topic))
+        path, decode=lambda topic: topic_role(topic) in _DECODED or reads_topic(topic)
+        or topic.rsplit('/', 1)[-1] == EVENTS)
     if recording.empty:
         raise RecordingError(f'cannot read recording {recording.path}: '
                              f'{_nothing_recovered(recording)}')
@@ -144,8 +147,10 @@ def inspect_recording(path):
         samples = join_samples(series, stamp0)
     except ValueError as error:  # e.g. a zero quaternion
         problems.append(f'cannot use the poses: {" ".join(str(error).split())}')
+    events = [(message.log_time_ns, str(getattr(message.msg, 'data', '')))
+              for message in recording.messages if message.topic.rsplit('/', 1)[-1] == EVENTS]
     checks, motion = run_checks(recording, problems, chosen, series, samples, model,
-                                parameters)
+                                parameters, events)
     more, forces, force_series = _force_checks(series, samples, motion, model, parameters,
                                                recording.truncated)
     checks.extend(more)
@@ -155,6 +160,8 @@ def inspect_recording(path):
     summary['tf'] = tf_summary
     summary['diagnostics'] = _diagnostics_summary(series)
     summary['contact_forces'] = forces
+    summary['events'] = [{'t_s': (stamp - stamp0) * 1e-9, 'event': text}
+                         for stamp, text in events]
     diagnostics = series.get('diagnostics')
     summary['run'] = json_ready(run_completeness(
         recording, parameters, None if samples is None else samples.t,

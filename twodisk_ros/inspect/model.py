@@ -7,10 +7,13 @@ shape parameters (made before them) is an ellipse run, and one of shape points i
 the fitted outline it holds, not from its shape file.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from ..physics.dynamics import RollingDynamics
 from ..physics.rolling_body import RollingBody
+from ..node.scene_simulation import flat_free, ground_normal
 from ..run.description import RunDescription
 
 __all__ = ['RecordedModel', 'build_model']
@@ -27,6 +30,10 @@ class RecordedModel:
     rate: float | None
     solver_tolerance: float
     shape: str = ''          #: one line on the shape, for the report
+    #: the ground's unit normal in frame_id: (sin slope, 0, cos slope), z up on flat ground
+    ground_normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    #: True if the recorded scene is not today's flat, free, conservative one
+    scene: bool = False
 
 
 def build_model(parameters, problems):
@@ -46,4 +53,5 @@ def build_model(parameters, problems):
         return None
     rate = settings.rate if 'rate' in parameters else None
     return RecordedModel(run.body, dynamics, settings.mode, settings.omega0, rate,
-                         settings.tolerance, run.shape_line)
+                         settings.tolerance, run.shape_line, ground_normal(settings.slope),
+                         not flat_free(settings))

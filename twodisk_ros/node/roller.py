@@ -223,8 +223,9 @@ class Roller(Node):
             self.continue_motion(*self.control.drive_state())
             changed = [p.name for p in PARAMETERS if p.scene
                        and getattr(candidate, p.name) != getattr(previous, p.name)]
-            self.control.event('scene ' + ' '.join(
-                f'{name}={getattr(candidate, name)}' for name in changed), self._tick)
+            self.control.event('scene ' + ', '.join(
+                f'{name} {getattr(previous, name)} -> {getattr(candidate, name)}'
+                for name in changed), self._tick)
         else:   # the same motion; friction, frame or path length may have changed
             self.simulation.update(candidate)
             if self._block is not None:     # the prepared samples, encoded again

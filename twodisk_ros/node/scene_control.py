@@ -21,7 +21,7 @@ next sample: a command or a time-out continues the motion from the state of the 
 published sample (it does not restart it). Each change is published once on ``events``
 (std_msgs/String, reliable, recorded), stamped with the first sample it applies to (the
 tick it takes effect at): ``reset``, ``pause``, ``resume``, ``command speed <value>``,
-``command torque <value>``, ``timeout``, ``scene <parameter changes>``, ``restart``
+``command torque <value>``, ``timeout``, ``scene <name> <old> -> <new>, ...``, ``restart``
 (parameters that restart the motion). ``twodisk-inspect`` checks the stretches between
 them on their own. Only realtime runs take commands and calls (a batch run is never idle).
 """
