@@ -15,9 +15,10 @@ samples from their powers:
 * torque drive τ: τ Ω, Ω = |ω| sgn(u̇) (u̇ from rolling_state), τ the command in force (from the
   ``events``: 0 until the first command, 0 again after a ``timeout``).
 
-The stretches are those between the node's events (:mod:`twodisk_ros.node.scene_control`),
-and the parameters of each come from the recorded parameters with the ``scene`` events
-(``scene <name> <old> -> <new>``) undone back to the start. The speed drive's work is whatever
+The stretches are those between the node's events
+(:mod:`twodisk_ros.node.scene_control`), and the parameters of each come from the recorded
+parameters with the ``scene`` events (``scene <name> <old> -> <new>``) undone back to the
+start. The speed drive's work is whatever
 its rule needs: stretches under it are not checked here (the node's own balance is in
 /diagnostics). Tolerance: twice the FD error of the energy (as the ``energy`` check) plus the
 trapezoid rule's error estimate (h/12 Σ|Δ²P| per stretch).

@@ -82,8 +82,8 @@ def frame_metadata(settings):
                              ' (quaternion x, y, z, w)',
         'ground_normal': repr([float(x) for x in ground_normal(settings.slope)]),
         'events_topic': 'events (std_msgs/String: reset, pause, resume, command <drive> '
-                        '<value>, timeout, scene <name> <old> -> <new>, restart; stamped with the first '
-                        'sample each applies to)',
+                        '<value>, timeout, scene <name> <old> -> <new>, restart; stamped '
+                        'with the first sample each applies to)',
     }
 
 
