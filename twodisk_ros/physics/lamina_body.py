@@ -9,6 +9,12 @@ until the spectral tail of every sampled function is below
 a grid :data:`OVERSAMPLING` times finer, where values, first and second derivatives
 (spectral) feed one quintic Hermite table; any real u is evaluated from it.
 
+The phase is built on each lamina's phase parameter (:mod:`~twodisk_ros.physics.phase_map`:
+for superellipses it stops at the vertices or dwells at the corners). :meth:`LaminaBody.
+flat_vertex_phases` is the hook for the equilibria search: the exact phases where a contact
+sits on a flat vertex (z_G flat to high order there), onto which a root of dz_G/du found
+nearby should be snapped.
+
 Complex-step contract (rolling_body.py): at u + i h the table returns f(u) + i h f′(u) with
 f′ the interpolant's derivative, so callers' complex steps give the spectral derivative.
 
