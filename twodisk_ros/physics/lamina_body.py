@@ -9,6 +9,12 @@ until the spectral tail of every sampled function is below
 a grid :data:`OVERSAMPLING` times finer, where values, first and second derivatives
 (spectral) feed one quintic Hermite table; any real u is evaluated from it.
 
+The phase is built on each lamina's phase parameter (:mod:`~twodisk_ros.physics.phase_map`:
+for superellipses it stops at the vertices or dwells at the corners). :meth:`LaminaBody.
+flat_vertex_phases` is the hook for the equilibria search: the exact phases where a contact
+sits on a flat vertex (z_G flat to high order there), onto which a root of dz_G/du found
+nearby should be snapped.
+
 Complex-step contract (rolling_body.py): at u + i h the table returns f(u) + i h f′(u) with
 f′ the interpolant's derivative, so callers' complex steps give the spectral derivative.
 
@@ -29,6 +35,7 @@ import numpy as np
 from .analytic import COMPLEX_STEP
 from .body import PhaseGeometry
 from .general_body import ARRANGEMENTS, GeneralTwoDiskBody
+from .lamina import VERTEX_AXES
 from .lamina_phase import BRANCH_FLIP, COLUMNS, PhaseSolver, THETA_FLIP, unfold
 from .rolling_body import RollingBody
 from .spectral import TAIL_TOLERANCE, real_spectral_derivative, spectral_tails, upsample
@@ -84,6 +91,21 @@ def _rates(samples):
     ds = t1x * d[:, 0] + t1y * d[:, 1]
     dalpha = samples[:, 6] * (t1x * d[:, 3] - t1y * d[:, 2])
     return np.column_stack([samples, ds, dalpha])
+
+
+def _flat_vertex_parameters(lamina):
+    """Lamina parameters (rad) of the lamina's flat vertices (zero curvature: Vertex.radius
+    infinite, or a lamina that refuses to describe one as flat), '+x' also mirrored to −x."""
+    found = []
+    for axis in VERTEX_AXES:
+        try:
+            flat = math.isinf(lamina.vertex(axis).radius)
+        except ValueError as error:        # Lamina.vertex: flat, no order of contact given
+            flat = 'flat' in str(error)
+        if flat:
+            s = float(lamina.support(np.array(VERTEX_AXES[axis])).parameter)
+            found.extend([s, -s] if axis == '+x' else [s])
+    return found
 
 
 class LaminaBody(RollingBody):
@@ -272,6 +294,27 @@ class LaminaBody(RollingBody):
         base = np.where(theta < 0, -1.0, 1.0) * np.arctan2(p, q)
         return np.where(branch > 0, base, np.pi - base)
 
+    def flat_vertex_phases(self):
+        """The phases u ∈ [0, 2π) (rad, sorted) where a contact sits on a flat vertex of its
+        lamina (zero curvature: a superellipse's four vertices for n > 2), exact to rounding.
+
+        A hook for the equilibria search: z_G is flat to high order there (the body barely
+        turns, |ω_u| = 0), so a root of dz_G/du found numerically near one of these phases
+        is one of them and should be snapped to it. Each phase comes from the phase charts
+        at the vertex's exact lamina parameter (A on disk 1: its polar angle in the
+        (p, q) plane; B on disk 2 likewise), not from a root of dz_G/du, and the body's two
+        mirrors give the rest (u, −u, π − u, π + u). Empty for laminae without flat vertices.
+        """
+        cached = self.__dict__.get('_flat_vertex_phases')
+        if cached is None:
+            flat = _flat_vertex_parameters(self.lamina)
+            quarter = self._solver.quarter_phases(flat, flat)
+            images = np.concatenate([quarter, -quarter, math.pi - quarter, math.pi + quarter])
+            cached = np.unique(np.mod(images, TWO_PI))
+            cached.flags.writeable = False
+            self.__dict__['_flat_vertex_phases'] = cached
+        return cached
+
     def contact_angle_psi(self, theta, branch=1):
         """ψ(θ) (rad) on a branch (the exact θ chart of general_body.py)."""
         return self.general.contact_angle_psi(theta, branch)
@@ -310,6 +353,12 @@ class LaminaBody(RollingBody):
         """G, the laminae's centroid, from the midpoint O of the centres (m, body frame):
         (1 + σ) ȳ/2 e2 (also for a moved body: see ``origin``)."""
         return self.general.centroid
+
+    @property
+    def phase_map(self):
+        """The :class:`~twodisk_ros.physics.phase_map.PhaseMap` s = w(t) of the contacts'
+        lamina parameters on which the phase is built (identity but for superellipses)."""
+        return self._solver.map
 
     @property
     def offset(self):

@@ -4,24 +4,27 @@ docs/physics.md#the-phase-of-a-general-body. Quarter-cycle u ∈ [0, π/2] (θ �
 is solved here; the rest of the cycle follows from the body's two mirror symmetries
 (:func:`unfold`).
 
-**The phase.** Along the cycle, A's lamina parameter s_A and B's parameter β_B measured from
-disk 2's far tip (the tip B touches at the turning points) trace a closed curve. In the
-normalised plane (p, q) = (s_A/s_max, β_B/β_0), β_0 being β_B at θ = 0 on branch +1, it
-passes through (0, 1) at θ = 0 (branch +1), (1, 0) at the turning point +θ_max, (0, −1) at
-θ = 0 on branch −1 and (−1, 0) at −θ_max, winding once around the origin like (sin u, cos u).
-u is the polar angle in that plane: p cos u − q sin u = 0, p sin u + q cos u > 0. Both
-parameters are smooth functions of the *points* (the eccentric anomaly, the superellipse's
-projected anomaly for even n, the normal angle of a strictly convex support-function lamina),
-and the curve G(s_A, s_B) = 0 of the common tangent plane (the triple product of the tangents
-at A and B and A − B) is regular in them, also where a contact crosses a flat vertex. So
-everything is smooth in u; in θ, ψ or the normal angles it is not (B moves like τ^(1/(n−1))
-near a superellipse's flat tip).
+**The phase.** Along the cycle, A's phase parameter t_A and B's phase parameter β_B measured
+from disk 2's far tip (the tip B touches at the turning points) trace a closed curve. The
+phase parameter t of a lamina is its boundary parameter s re-spaced, s = w(t)
+(:mod:`~twodisk_ros.physics.phase_map`; t = s but for superellipses, whose vertices and
+corners it smooths). In the normalised plane (p, q) = (t_A/t_max, β_B/β_0), β_0 being β_B
+at θ = 0 on branch +1, the curve passes through (0, 1) at θ = 0 (branch +1), (1, 0) at the
+turning point +θ_max, (0, −1) at θ = 0 on branch −1 and (−1, 0) at −θ_max, winding once
+around the origin like (sin u, cos u). u is the polar angle in that plane:
+p cos u − q sin u = 0, p sin u + q cos u > 0. The lamina parameters are smooth functions of
+the *points* (the eccentric anomaly, the superellipse's projected anomaly away from its
+vertices, the normal angle of a strictly convex support-function lamina), and the curve
+G(s_A, s_B) = 0 of the common tangent plane (the triple product of the tangents at A and B
+and A − B) is regular in them, also where a contact crosses a flat vertex. So everything is
+as smooth in u as the points are in t; in θ, ψ or the normal angles it is not (B moves like
+τ^(1/(n−1)) near a superellipse's flat tip).
 
 **The solve.** Given u, the point on the ray is found by a bracketing root finder (scipy's
 elementwise Chandrupatla) on the signed distance p cos u − q sin u from the ray, in the chart
-that is well conditioned there: A's parameter for u ≤ π/4 (q from the convex elevation
+that is well conditioned there: A's phase parameter for u ≤ π/4 (q from the convex elevation
 equation of :meth:`~twodisk_ros.physics.general_body.GeneralTwoDiskBody.elevation_of_parameter`
-and the support point of disk 2), B's parameter for u > π/4
+and the support point of disk 2), B's phase parameter for u > π/4
 (:meth:`~twodisk_ros.physics.general_body.GeneralTwoDiskBody.chart_from_b`, regular at the
 turning points where ψ(θ) ~ √(θ_max − θ) is not).
 """
@@ -30,6 +33,8 @@ import math
 
 import numpy as np
 from scipy.optimize import elementwise
+
+from .phase_map import phase_map
 
 __all__ = ['BRANCH_FLIP', 'COLUMNS', 'PhaseSolver', 'THETA_FLIP', 'unfold']
 
@@ -58,16 +63,19 @@ class PhaseSolver:
 
     def __init__(self, general):
         self.general = general
+        self.map = phase_map(general.lamina)
         self.s_max = general.s_max
+        self.t_max = float(self.map.inverse(self.s_max))
         self.tip = general.far_tip
+        self.tip_t = float(self.map.inverse(self.tip))
         tau0 = general.elevation_of_parameter(0.0)
-        self.beta0 = float(_wrap(self._parameter_b(np.array(0.0), tau0) - self.tip))
+        self.beta0 = 1.0
+        self.beta0 = float(self._beta(self._parameter_b(np.array(0.0), tau0)))
         if not abs(self.beta0) > 0:
             raise ValueError(f'{general!r}: B sits at disk 2\'s far tip at theta = 0; no '
                              'regular phase')
         # star-shapedness: the polar angle must increase along the chart-A samples
-        s = self.s_max * np.linspace(0.0, 1.0, 1025)
-        p, q = self.chart_a(s)
+        p, q = self.chart_t(self.t_max * np.linspace(0.0, 1.0, 1025))
         if not (np.all(np.diff(np.arctan2(p, q)) > 0) and np.all(q[:-1] > 0)):
             raise ValueError(f'{general!r}: the contact parameters do not wind once around '
                              'the cycle (no regular phase); choose another delta')
@@ -78,16 +86,24 @@ class PhaseSolver:
         nu = g.lamina.normal(s_a)
         return g.lamina.support(np.stack([-tau_abs, g.sigma * nu[..., 1]], axis=-1)).parameter
 
-    def chart_a(self, s_a):
-        """(p, q) from A's parameter s_a ∈ [0, s_max] (branch +1)."""
+    def _beta(self, s_b):
+        """q = β/β_0 of B's lamina parameter s_b: β its phase parameter from the far tip."""
+        return _wrap(self.map.inverse(_wrap(s_b)) - self.tip_t) / self.beta0
+
+    def chart_t(self, t_a):
+        """(p, q) from A's phase parameter t_a ∈ [0, t_max] (branch +1)."""
+        s_a = self.map(t_a)
         tau = self.general.elevation_of_parameter(s_a)
-        beta = _wrap(self._parameter_b(s_a, tau) - self.tip)
-        return s_a / self.s_max, beta / self.beta0
+        return t_a / self.t_max, self._beta(self._parameter_b(s_a, tau))
+
+    def chart_a(self, s_a):
+        """(p, q) from A's lamina parameter s_a ∈ [0, s_max] (branch +1)."""
+        return self.chart_t(self.map.inverse(s_a))
 
     def _chart_b(self, q):
         """(p, q, s_A, |τ|) from q = β/β_0 ∈ [0, 1] (branch +1)."""
-        s_a, tau = self.general.chart_from_b(_wrap(self.tip + q * self.beta0))
-        return s_a / self.s_max, q, s_a, tau
+        s_a, tau = self.general.chart_from_b(_wrap(self.map(self.tip_t + q * self.beta0)))
+        return self.map.inverse(s_a) / self.t_max, q, s_a, tau
 
     def solve(self, u):
         """(s_A, |τ|) at phases u ∈ [0, π/2] (rad, 1-D array), to the last bits."""
@@ -104,11 +120,12 @@ class PhaseSolver:
             c, s = np.cos(u[near_a]), np.sin(u[near_a])
 
             def distance_a(x, c, s):
-                p, q = self.chart_a(x)
+                p, q = self.chart_t(x)
                 return p * c - q * s
-            found = elementwise.find_root(distance_a, (np.zeros_like(c), np.full_like(c, self.s_max)),
-                                          args=(c, s), tolerances=_TOLERANCES)
-            s_a[near_a] = found.x
+            bracket = (np.zeros_like(c), np.full_like(c, self.t_max))
+            found = elementwise.find_root(distance_a, bracket, args=(c, s),
+                                          tolerances=_TOLERANCES)
+            s_a[near_a] = self.map(found.x)
         if np.any(near_b):
             c, s = np.cos(u[near_b]), np.sin(u[near_b])
 
@@ -121,6 +138,25 @@ class PhaseSolver:
         done_a = first | near_a
         tau[done_a] = self.general.elevation_of_parameter(s_a[done_a])
         return s_a, tau
+
+    def quarter_phases(self, a_parameters=(), b_parameters=()):
+        """The phases u ∈ [0, π/2] where A sits at one of the lamina parameters
+        ``a_parameters`` (of disk 1) or B at one of ``b_parameters`` (of disk 2), from the
+        charts at those exact parameters (no root finding in u); parameters not met in the
+        quarter (|s_A| > s_max, |β| > |β_0|) are left out. Sorted, without repeats.
+        """
+        found = []
+        for s_a in a_parameters:
+            p = float(self.map.inverse(abs(float(_wrap(s_a))))) / self.t_max
+            if p <= 1.0:
+                q = self.chart_t(p * self.t_max)[1] if 0.0 < p < 1.0 else 1.0 - p
+                found.append(math.atan2(p, float(q)))
+        for s_b in b_parameters:
+            q = abs(float(self._beta(s_b)))
+            if q <= 1.0:
+                p = self._chart_b(q)[0] if 0.0 < q < 1.0 else 1.0 - q
+                found.append(math.atan2(float(p), q))
+        return np.unique(np.clip(found, 0.0, 0.5 * math.pi))
 
     def samples(self, u):
         """The :data:`COLUMNS` at phases u ∈ [0, π/2], shape u.shape + (12,)."""
