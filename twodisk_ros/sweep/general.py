@@ -33,13 +33,9 @@ tested before :class:`~twodisk_ros.physics.lamina_body.LaminaBody` exists.
 """
 
 import math
-import time
 
 import numpy as np
 
-from ..physics.contact_forces import ContactForceModel
-from ..physics.contact_validity import liftoff_speed, mu_required_kinematic
-from ..physics.cycle import RollingCycle
 from ..physics.dynamics import RollingDynamics
 from ..physics.equilibria import NEUTRAL, STABLE
 
@@ -144,48 +140,20 @@ def general_body_quantities(b_over_a, delta_over_a, exponent, mass_model='lamina
     ``exponent`` (n) and the two factories (default :func:`superellipse_body` and
     :func:`lamina_mass`).
     """
-    from .quantities import STAGES, VARIABLES, contact_length_range, cycle_time, one_line
+    from .quantities import VARIABLES, run_stages, shape_failure
     body_factory = body_factory or superellipse_body
     mass_factory = mass_factory or lamina_mass
     values = dict.fromkeys(VARIABLES, math.nan)
     b, d, n = float(b_over_a), float(delta_over_a), float(exponent)
-    if not (math.isfinite(b) and math.isfinite(d)):
-        return values, f'body: b/a = {b!r} and delta/a = {d!r} must be finite'
-    if d >= 1.0:
-        return values, (f'body: delta/a = {d!r} >= 1, the disks do not interlock '
-                        f'(needs 0 < delta/a < 1)')
-    state = {}
+    failure = shape_failure(b, d)
+    if failure:
+        return values, failure
 
-    def run(stage):
-        if stage == 'body':
-            state['body'] = body = body_factory(b, d, n)
-            values['theta_max'] = float(body.theta_max)
-        elif stage == 'cycle':
-            state['cycle'] = cycle = RollingCycle(state['body'])
-            values['cycle_advance'] = abs(cycle.displacement.shift)
-            values['cycle_heading'] = cycle.displacement.turn
-        elif stage == 'equilibria':
-            _equilibria_stage(state, values, mass_model, mass_factory)
-        elif stage == 'cycle_time':
-            values['cycle_time'] = cycle_time(state['dynamics'])
-        elif stage == 'contact_length':
-            low, high = contact_length_range(state['body'], state['dynamics'].table_size)
-            values['contact_length_min'], values['contact_length_max'] = low, high
-        elif stage == 'contact_tables':
-            state['model'] = ContactForceModel(state['dynamics'])
-        elif stage == 'liftoff_speed':
-            values['liftoff_speed'] = liftoff_speed(state['model'])[0]
-        else:
-            values['mu_required'] = float(mu_required_kinematic(state['model'],
-                                                                reference_speed))
+    def body_stage(state, values):
+        state['body'] = body = body_factory(b, d, n)
+        values['theta_max'] = float(body.theta_max)
 
-    for stage in STAGES:
-        start = time.perf_counter()
-        try:
-            run(stage)
-        except Exception as error:  # noqa: BLE001 (a failing body is data, not a crash)
-            return values, one_line(f'{stage}: {type(error).__name__}: {error}')
-        finally:
-            if timings is not None:
-                timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
-    return values, ''
+    return run_stages(values, body_stage,
+                      lambda state, values: _equilibria_stage(state, values, mass_model,
+                                                              mass_factory),
+                      reference_speed, timings)

@@ -30,8 +30,9 @@ from ..physics.equilibria import NEUTRAL, STABLE
 from ..physics.mass_models import mass_properties
 from .request import ELLIPSE_EXPONENT
 
-__all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities',
-           'chunk_quantities', 'timed_chunk', 'contact_length_range', 'cycle_time', 'one_line']
+__all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities', 'run_stages',
+           'shape_failure', 'chunk_quantities', 'timed_chunk', 'contact_length_range',
+           'cycle_time', 'one_line']
 
 #: name → (units, description), in the order of the output; units with a = g = M = 1.
 VARIABLES = {
@@ -149,24 +150,48 @@ def body_quantities(b_over_a, delta_over_a, mass_model='laminae', reference_spee
     """
     values = dict.fromkeys(VARIABLES, math.nan)
     b, d = float(b_over_a), float(delta_over_a)
+    failure = shape_failure(b, d)
+    if failure:
+        return values, failure
+
+    def body_stage(state, values):
+        state['body'] = body = TwoDiskBody(1.0, b, d)
+        values['theta_max'] = body.theta_max
+        values['stability_margin'] = body.stability_margin
+
+    return run_stages(values, body_stage,
+                      lambda state, values: _equilibria_stage(state, values, mass_model, b, d),
+                      reference_speed, timings)
+
+
+def shape_failure(b, d):
+    """The failure line of a body (1, b/a, Δ/a) that cannot be built, else ''."""
     if not (math.isfinite(b) and math.isfinite(d)):
-        return values, f'body: b/a = {b!r} and delta/a = {d!r} must be finite'
+        return f'body: b/a = {b!r} and delta/a = {d!r} must be finite'
     if d >= 1.0:
-        return values, (f'body: delta/a = {d!r} >= 1, the disks do not interlock '
-                        f'(needs 0 < delta/a < 1)')
+        return (f'body: delta/a = {d!r} >= 1, the disks do not interlock '
+                f'(needs 0 < delta/a < 1)')
+    return ''
+
+
+def run_stages(values, body_stage, equilibria_stage, reference_speed, timings):
+    """Run :data:`STAGES` in order, filling ``values``; (values, failure line or '').
+
+    ``body_stage(state, values)`` puts the body in ``state['body']``; ``equilibria_stage(state,
+    values)`` the dynamics in ``state['dynamics']``; the other stages are the same for every
+    body. A stage that raises ends the run: the body's failure is data, not a crash.
+    """
     state = {}
 
     def run(stage):
         if stage == 'body':
-            state['body'] = body = TwoDiskBody(1.0, b, d)
-            values['theta_max'] = body.theta_max
-            values['stability_margin'] = body.stability_margin
+            body_stage(state, values)
         elif stage == 'cycle':
             state['cycle'] = cycle = RollingCycle(state['body'])
             values['cycle_advance'] = abs(cycle.displacement.shift)
             values['cycle_heading'] = cycle.displacement.turn
         elif stage == 'equilibria':
-            _equilibria_stage(state, values, mass_model, b, d)
+            equilibria_stage(state, values)
         elif stage == 'cycle_time':
             values['cycle_time'] = cycle_time(state['dynamics'])
         elif stage == 'contact_length':
