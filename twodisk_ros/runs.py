@@ -172,6 +172,11 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
     """
     if settings is None:
         settings = settings_from(**values)
+    scene = _scene_parameters(settings)
+    if scene:
+        raise RunError(f'{scene} is not simulated here (flat ground, free motion only): '
+                       f'record the scene with the node (record:=run.mcap) and show the '
+                       f'recording')
     if not (math.isfinite(stop) and stop > 0):
         raise RunError(f'the run must end after 0 s, got stop = {stop!r} s')
     description = _description(settings)
@@ -188,6 +193,16 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
         computed = ContactForceModel(dynamics).along(motion)
         run.force_a, run.force_b = computed.force_a, computed.force_b
     return run
+
+
+def _scene_parameters(settings):
+    """'name value' of the first scene parameter (slope, drive, rolling_resistance, damping)
+    that is not today's flat free scene, else ''."""
+    for name in ('slope', 'drive', 'rolling_resistance', 'damping'):
+        value = getattr(settings, name)
+        if value != BY_NAME[name].default:
+            return f'{name} {value}'
+    return ''
 
 
 def _topic_role(topic):
