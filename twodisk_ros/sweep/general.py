@@ -29,7 +29,7 @@ Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exp
 
 The body and its mass model are made by two callables that a caller may replace
 (``body_factory(b, delta, exponent)`` and ``mass_factory(model, body)``), so that this path is
-tested before :class:`~twodisk_ros.physics.lamina_body.LaminaBody` exists.
+also tested with the ellipse's closed forms standing in for the lamina body.
 """
 
 import math
