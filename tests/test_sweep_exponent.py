@@ -8,7 +8,7 @@ References, none of them the code under test:
   and its closed-form mass model for every n): its values must then be the ellipse's, which
   the batched closed forms compute by other code (arrays, fixed-angle equilibria, the
   roll-over speed from m(u*) and ω_u instead of I_AB);
-- a real n = 4 body (LaminaBody; skipped where that class is still a placeholder) against
+- a real n = 4 body (LaminaBody) against
   the closed-form symmetric equilibria and the superellipse's Γ-function area moments.
 
 Dask runs in this process (threads, in-process transport, no dashboard) where the fake factory must
@@ -276,14 +276,11 @@ def _superellipse_plate_moments(b, n):
 
 
 def test_a_real_superellipse_n4_body():
-    """n = 4, b/a = 1, Δ/a = 0.5 through LaminaBody (the lead runs it once that lands)."""
+    """n = 4, b/a = 1, Δ/a = 0.5 through LaminaBody."""
     b, d, n = 1.0, 0.5, 4.0
     got = chunk_quantities([b], [d], exponent=n)
     failure = got['failure'][0]
-    if any(word in failure for word in ('NotImplementedError', 'abstract', 'ImportError',
-                                        'mass_properties_of')):
-        pytest.skip(f'the general path is not on this branch yet: {failure}')
-    assert failure == ''
+    assert failure == ''      # LaminaBody is on main: a failing body is a failure, no skip
     from twodisk_ros.physics.symmetric_stability import symmetric_equilibria
     from twodisk_ros.physics.lamina import Superellipse
     first, turning, side = symmetric_equilibria(Superellipse(1.0, b, n), d)
