@@ -31,10 +31,7 @@ import numpy as np
 
 from .differences import kinetic_energy
 
-__all__ = ['SPEED_DRIVEN', 'balance_stretches', 'scene_timeline']
-
-#: Why a stretch under the speed drive is not checked (the detail of a skipped stretch).
-SPEED_DRIVEN = 'speed drive (its work is what its rule needs)'
+__all__ = ['balance_stretches', 'scene_timeline']
 
 _CHANGE = re.compile(r'(\w+) (\S+) -> ([^,\s]+)')
 _SCENE = ('drive', 'damping', 'rolling_resistance')
@@ -115,7 +112,7 @@ def balance_stretches(samples, motion, model, timeline, normal_force):
         t = samples.t[k[inside]]
         where = f't = {t[0]:.6g} … {t[-1]:.6g} s'
         if state['active'] == 'speed':
-            skipped.append(f'{where}: {SPEED_DRIVEN}')
+            skipped.append(f'{where}: speed drive (its work is what its rule needs)')
             continue
         power = -state['damping'] * omega[inside]**2
         if state['rolling_resistance'] > 0:

@@ -58,7 +58,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .balance import SPEED_DRIVEN, balance_stretches, scene_timeline
+from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
 from .results import Check, json_ready
 from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES, WRENCHES, values_at
@@ -370,9 +370,7 @@ def _check_stamps(series, truncated):
 def _run(checks, name, function, *args):
     """Append ``function(*args)``; an error while evaluating it is a failed check."""
     try:
-        check = function(*args)
-        if check is not None:          # None: the check does not apply to this recording
-            checks.append(check)
+        checks.append(function(*args))
     except Exception as error:  # noqa: BLE001 - reported as a failed check, not a traceback
         checks.append(_not_evaluated(name, f'cannot be evaluated: {type(error).__name__}: '
                                            f'{" ".join(str(error).split())}'))
@@ -441,8 +439,7 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(
 
 
 def _check_energy_balance(samples, motion, model, parameters, events, series):
-    """E + W − W_d = E(t₀) on each stretch whose drive's work is known (:mod:`.balance`);
-    None (no such check) for a run under the speed drive throughout."""
+    """E + W − W_d = E(t₀) on each stretch whose drive's work is known (:mod:`.balance`)."""
     if motion.index.size == 0:
         return _not_evaluated('energy_balance', _NO_DIFFERENCES)
     (force_a, found_a), (force_b, found_b) = (
@@ -452,8 +449,6 @@ def _check_energy_balance(samples, motion, model, parameters, events, series):
     scale = model.dynamics.energy_scale
     residuals, skipped, quadrature = balance_stretches(
         samples, motion, model, scene_timeline(parameters, events), normal)
-    if not residuals and skipped and all(SPEED_DRIVEN in line for line in skipped):
-        return None        # only the speed drive: its work is what its rule needs (as kinematic)
     if not residuals:
         return _not_evaluated('energy_balance', 'no stretch whose drive\'s work is known: '
                               + '; '.join(skipped[:3]))
