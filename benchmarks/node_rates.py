@@ -215,12 +215,11 @@ def _cpu_seconds(pid):
 
 
 #: Bodies of the real-time runs at 1 kHz by shape: name → (params file in config/, extra
-#: node parameters). The egg runs ``method:=direct``: in dynamic table mode the parallel egg
-#: is refused today ("the motion does not advance monotonically in u"), a physics fix pending.
+#: node parameters).
 SHAPE_SCENARIOS = {
     'oloid': ('oloid.yaml', ()),
     'rounded_square': ('rounded_square.yaml', ()),
-    'egg (method direct)': ('egg.yaml', ('-p', 'method:=direct')),
+    'egg': ('egg.yaml', ()),
 }
 
 
