@@ -297,6 +297,8 @@ def conservative_solution(terms, u0, u_dot0, angular_speed=None):
     """
     if not terms.scene.conservative:
         raise ValueError('closed forms are for conservative scenes (no drive, no dissipation)')
+    if not terms.periodic_potential and terms.sin_b != 0:
+        return None            # V is not periodic plus a drift: a curving path (DOP853)
     u0 = float(u0)
     jet = terms.energy_jet(u0)
     w0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * float(jet[4])

@@ -412,10 +412,13 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
       u; ``terms`` reused if given).
     """
     kwargs = dict(method=method, tolerance=tolerance, chunk=chunk, lookahead=lookahead)
+    rate0 = float(dynamics.angular_speed_per_phase(u0))
+    omega0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * rate0
     if angular_speed is not None:
-        kwargs['angular_speed'] = angular_speed
-    omega0 = float(angular_speed) if angular_speed is not None else \
-        float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
+        if dynamics.general:
+            kwargs['angular_speed'] = omega0
+        else:                   # the ellipse turns everywhere: today's state (u, u̇)
+            u_dot0 = omega0 / rate0
     if scene.flat_free:
         return MotionStream(dynamics, u0, u_dot0, mode='dynamic', **kwargs)
     if scene.drive == 'speed':

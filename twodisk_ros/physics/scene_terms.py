@@ -39,6 +39,8 @@ __all__ = ['SceneTerms', 'SceneForces', 'SceneEquilibrium', 'STOPPED']
 
 #: |ω_u| below this fraction of its largest value is a stop (the body does not turn in u)
 STOPPED = 1e-9
+#: a cycle's turn within this fraction of 2π is 2π (V periodic plus a drift per cycle)
+TURN_FLOOR = 1e-9
 
 # columns of the table
 # m, m′, |ω_u|, |ω_u|′, h, h′, p (Re, Im), k = |dG/du|
@@ -170,6 +172,19 @@ class SceneTerms:
                                spectral_derivative(inertia_line), spectral_derivative(speed)])
         first = spectral_derivative(jet)
         self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
+        # a cycle that turns by T ≠ 2π (an egg: the path curves) has no drift: G circles the
+        # fixed point C = shift/(1 − e^{iT}) of the cycle's map, Z_G = C + e^{iλu} q(u) with q
+        # periodic; V is then bounded, not periodic plus linear, and is evaluated from q
+        turn = self.cycle.displacement.turn
+        self.periodic_potential = abs(turn - TWO_PI) <= TURN_FLOOR * TWO_PI
+        self._orbit = None
+        if not self.periodic_potential:
+            g = self.cycle.positions(u)[0]
+            self._centre = complex(self.cycle.displacement.shift) / (1 - np.exp(1j * turn))
+            q = np.exp(-1j * self.turn_rate * u) * (g[:, 0] + 1j * g[:, 1] - self._centre)
+            q = np.column_stack([q.real, q.imag])
+            first = spectral_derivative(q)
+            self._orbit = HermiteTable.periodic(q, first, spectral_derivative(first))
 
     # -- the table ----------------------------------------------------------------------------
     def rows(self, u):
@@ -197,7 +212,10 @@ class SceneTerms:
         derivatives in u (``1``), array u.shape + (10,), from one table of m, of V's periodic
         part (V = V_p + drift u/2π), of |ω_u| and of J = m/|ω_u|² (kg m², the moment of
         inertia about AB, positive also where the body stops turning in u): the narrow table
-        the closed forms and the samples read."""
+        the closed forms and the samples read. If the cycle turns by T ≠ 2π
+        (``periodic_potential`` False) V and V′ are exact (G's orbit about the cycle map's
+        fixed point) but V″ and the derivatives (``1``) are not: the closed forms, which
+        need them, are not used then."""
         u = np.asarray(u, dtype=float)
         table = self._energy_table
         jet = table.combine(*table.weights(np.mod(u, TWO_PI))) if derivative == 0 else \
@@ -205,6 +223,13 @@ class SceneTerms:
         if derivative == 0:
             jet[..., 1] += self.drift * u / TWO_PI
         jet[..., 3 - 2 * derivative] += self.drift / TWO_PI
+        if self._orbit is not None and derivative == 0:
+            q = self._orbit(np.mod(u, TWO_PI))
+            z = self._centre + np.exp(1j * self.turn_rate * u) * (q[..., 0] + 1j * q[..., 1])
+            downhill = np.real(np.exp(1j * self.phi0) * z)
+            jet[..., 1] = self.weight * (self.cos_b * self.rows(u)[..., H]
+                                         - self.sin_b * downhill)
+            jet[..., 3] = self.potential_slope(u)
         return jet
 
     def potential(self, u):
