@@ -63,6 +63,15 @@ def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolera
     return math.nan, math.nan, None
 
 
+def _forces(terms, samples):
+    """The scene's forces along samples, from (u, w, ẇ) where the samples carry ẇ (finite
+    where the body stops turning in u), else from (u, u̇, ü)."""
+    if samples.angular_acceleration is not None:
+        return terms.forces(samples.phase, samples.rolling_speed,
+                            samples.angular_acceleration, turning=True)
+    return terms.forces(samples.phase, samples.phase_rate, samples.phase_acceleration)
+
+
 def first_failure(terms, samples, stream=None, *, resolution=0.01):
     """Where the rolling model first fails along sampled motion: lift-off or slip.
 
@@ -76,7 +85,7 @@ def first_failure(terms, samples, stream=None, *, resolution=0.01):
     1e-12 s); ``index`` is then the first sample after it.
     """
     friction = terms.scene.friction
-    forces = terms.forces(samples.phase, samples.phase_rate, samples.phase_acceleration)
+    forces = _forces(terms, samples)
     report = check_validity(samples.t, forces, friction)
     if not hasattr(stream, 'samples_at') or samples.t.size < 2:
         return report
@@ -89,7 +98,7 @@ def first_failure(terms, samples, stream=None, *, resolution=0.01):
 
     def margins(times):
         s = stream.samples_at(np.atleast_1d(times))
-        f = terms.forces(s.phase, s.phase_rate, s.phase_acceleration)
+        f = _forces(terms, s)
         out = [f.normal_a, f.normal_b]
         if 'slip' in names:
             out.append(np.clip(friction - f.mu_required, -1e300, 1e300))
