@@ -273,7 +273,7 @@ def test_driven_from_a_second_node(tmp_path):
         live.event('timeout', count=2)
         live.node.set_parameters([Parameter('drive', value='speed')])   # the start's again
         live.event('scene drive torque -> speed')
-        live.spin(0.2)
+        live.spin(4 * timeout)          # the torque command times out before the reset
         live.call(live.reset, live.Empty.Request())
         live.event('reset')
         live.spin(0.3)
