@@ -20,7 +20,10 @@ the N intervals between nodes, every other interval is bisected until it is cert
 The uncertified pieces are merged into clusters: each root of f lies in a cluster. A cluster
 with a sign change of f between its ends holds an odd number of roots (counted as one
 equilibrium, located by bisection of f's sign); one without holds none or an even number
-(reported in the certificate, not as an equilibrium). K = 4. A bracket holding a phase
+(reported in the certificate, not as an equilibrium). K = 4. The jets f_N^(j)(c) of one
+bisection level are read off one zero-padded inverse FFT per derivative when the level has
+many intervals (its centres are the odd points of a grid of M = 2π/r points), else summed
+directly over the half spectrum: the same values to rounding, O(M log M) instead of O(N²). A bracket holding a phase
 where a contact sits on a flat vertex (:func:`flat_vertex_phases`) has its root snapped to
 that phase, exact by construction: bisection stops ~1e-5 rad off there, where z_G − z* ~
 (u − u*)⁴ or flatter is below rounding.
@@ -53,6 +56,12 @@ MIN_HALF_WIDTH = 5e-14
 DEGENERATE_RATE = 1e-6
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
 TWO_PI = 2 * math.pi
+#: relative accuracy of the γ levels of the local fit (_offsets_for)
+OFFSET_RTOL = 1e-8
+#: offsets reach·2^−j, j < LADDER_STEPS, bracketing the γ levels (_offsets_for)
+LADDER_STEPS = 48
+#: largest grid evaluated by FFT in the interval search (points)
+MAX_GRID = 2**22
 
 
 @dataclass(frozen=True)
@@ -92,17 +101,43 @@ class _Series:
         coeffs[n // 2] = 0.0
         self.k = np.fft.fftfreq(n, d=1.0 / n)
         self.c = coeffs
+        # real samples: c_{−k} = conj(c_k), so f_N = Re Σ_{0 ≤ k < N/2} w_k c_k e^{ikx}
+        self._half_k = np.arange(n // 2, dtype=float)
+        self._half_c = coeffs[:n // 2] * np.where(self._half_k > 0, 2.0, 1.0)
 
     def jets(self, x, order):
-        """f_N^(j)(x) for j < order: array (order, len(x))."""
+        """f_N^(j)(x) for j < order: array (order, len(x)), by direct summation."""
         x = np.asarray(x, dtype=float)
         out = np.empty((order, x.size))
+        k = self._half_k
+        weights = np.array([self._half_c * (1j * k) ** j for j in range(order)]).T
         for start in range(0, x.size, 256):
             part = x[start:start + 256]
-            e = np.exp(1j * np.outer(part, self.k)) * self.c
-            for j in range(order):
-                out[j, start:start + 256] = np.real(e @ ((1j * self.k) ** j))
+            e = np.exp(1j * np.outer(part, k))
+            out[:, start:start + 256] = np.real(e @ weights).T
         return out
+
+    def grid_jets(self, points, order):
+        """f_N^(j)(2πm/M) for j < order on all M points of a fine grid (M ≥ N, a multiple
+        of N), by one zero-padded inverse FFT per derivative: array (order, M)."""
+        index = self.k.astype(int) % points
+        out = np.empty((order, points))
+        padded = np.zeros(points, dtype=complex)
+        for j in range(order):
+            padded[index] = self.c * (1j * self.k) ** j
+            out[j] = np.real(np.fft.ifft(padded)) * points
+        return out
+
+    def jets_at_grid(self, centres, half_width, order):
+        """:meth:`jets` at centres that are odd multiples of ``half_width`` = 2π/M (the
+        intervals of one bisection level), by :meth:`grid_jets` when the M-point FFT is
+        cheaper than summing the series at every centre; the same values to rounding."""
+        points = int(round(TWO_PI / half_width))
+        if (points > MAX_GRID or abs(points * half_width - TWO_PI) > 1e-12
+                or len(centres) * self.k.size <= points * math.log2(points)):
+            return self.jets(centres, order)
+        grid = self.grid_jets(points, order)
+        return grid[:, np.rint(np.asarray(centres) / half_width).astype(int) % points]
 
 
 def _slope_samples(body, n):
@@ -140,7 +175,7 @@ def certified_roots(body):
     factorials = np.array([math.factorial(j) for j in range(order + 1)], dtype=float)
 
     def lower_bounds(centres, r):
-        jets = series.jets(centres, order)
+        jets = series.jets_at_grid(centres, r, order)
         powers = r ** np.arange(order)[:, None] / factorials[:order, None]
         taylor = np.sum(np.abs(jets[1:]) * powers[1:], axis=0)
         return np.abs(jets[0]) - taylor - bound * r**order / factorials[order], jets[0]
@@ -256,16 +291,51 @@ def _local_samples(body, centre, offsets):
 
 
 def _offsets_for(body, centre, targets, reach):
-    """Offsets δ (signed, rad) with γ(u* + δ) = targets (vectorised bisection in |δ|)."""
+    """Offsets δ (signed, rad) with γ(u* + δ) = targets to 1e-8 relative: a vectorised
+    Newton iteration on log|γ| against log|δ| (dγ/dδ = |ω_u(u* + δ)|; near a degenerate
+    phase γ is a power of δ, a straight line there), from a bracket and guess read off a
+    geometric ladder of offsets, safeguarded by geometric bisection of the bracket. The
+    callers use the γ actually reached, so the levels need not be exact."""
     targets = np.asarray(targets, dtype=float)
-    side = np.sign(targets)
+    side, goal = np.sign(targets), np.abs(targets)
+    # bracket and first guess from |γ| on a geometric ladder of offsets (log-log interpolation)
+    ladder = reach * 0.5 ** np.arange(LADDER_STEPS)
     low, high = np.zeros(targets.size), np.full(targets.size, reach)
+    x = 0.5 * (low + high)
+    for sign in (-1.0, 1.0):
+        mine = side == sign
+        if not np.any(mine):
+            continue
+        reached = np.abs(_local_samples(body, centre, sign * ladder)[0])[::-1]  # increasing
+        steps = ladder[::-1]
+        at = np.clip(np.searchsorted(reached, goal[mine]), 1, LADDER_STEPS - 1)
+        g0, g1, s0, s1 = reached[at - 1], reached[at], steps[at - 1], steps[at]
+        low[mine], high[mine] = np.where(g0 <= goal[mine], s0, 0.0), np.where(
+            g1 >= goal[mine], s1, reach)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            guess = s0 * np.exp(np.log(goal[mine] / g0) * np.log(s1 / s0) / np.log(g1 / g0))
+        fine = np.isfinite(guess) & (guess > low[mine]) & (guess < high[mine])
+        x[mine] = np.where(fine, guess, 0.5 * (low[mine] + high[mine]))
+    todo = np.ones(targets.size, dtype=bool)
     for _ in range(60):
-        mid = 0.5 * (low + high)
-        gamma, _ = _local_samples(body, centre, side * mid)
-        below = np.abs(gamma) < np.abs(targets)
-        low, high = np.where(below, mid, low), np.where(below, high, mid)
-    return side * 0.5 * (low + high)
+        gamma, _ = _local_samples(body, centre, side[todo] * x[todo])
+        reached = np.abs(gamma)
+        miss = np.log(reached / goal[todo])
+        done = np.abs(miss) <= OFFSET_RTOL
+        lo, hi, xs = low[todo], high[todo], x[todo]
+        lo, hi = np.where(miss < 0, xs, lo), np.where(miss < 0, hi, xs)
+        # Newton on log|γ| against log|δ| (a power law near a degenerate phase: ~linear)
+        slope = xs * _rotation_rate(body, centre + side[todo] * xs) / reached
+        with np.errstate(divide='ignore', invalid='ignore', over='ignore'):
+            newton = xs * np.exp(-miss / slope)
+        inside = np.isfinite(newton) & (newton > lo) & (newton < hi)
+        middle = np.where(lo > 0, np.sqrt(lo * hi), 0.5 * hi)
+        xs = np.where(done, xs, np.where(inside, newton, middle))
+        low[todo], high[todo], x[todo] = lo, hi, xs
+        todo[np.flatnonzero(todo)[done]] = False
+        if not np.any(todo):
+            break
+    return side * x
 
 
 def classify_root(body, series_curvature, centre, reach, max_rate):
