@@ -33,8 +33,13 @@ derivative and, γ being the angle the body has turned about the contact line AB
 |ω_u|), d²z_G/dγ² = (d²z_G/du²)/|ω_u|². Where |ω_u(u*)| vanishes (a degenerate phase, e.g. a
 contact on a superellipse's flat vertex) u is not a physical coordinate; z_G − z* is then
 taken as a function of γ (both by Gauss quadrature from u*, no cancellation), its order q
-from z_G − z* ~ A|γ|^q: q = 2 gives d²z_G/dγ² from a polynomial fit of (z_G − z*)/γ², q < 2
-gives stability from the sign of A and **no linear small-oscillation period**.
+from z_G − z* = w ≈ A|γ|^q + Bγ²: two levels that give q ≈ 2 give d²z_G/dγ² from a
+polynomial fit of w/γ²; otherwise q and A come from three levels γ_j (1e-3 rad, ratio 1/4)
+with the γ² term cancelled, r_j = w_{j+1} − (γ_{j+1}/γ_j)² w_j = A γ_j^q (ρ^q − ρ²) (a plain
+two-level ratio was off by 0.2 at the tips of Superellipse n = 3: Bγ² is not small there),
+and q < 2 gives stability from the sign of A and **no linear small-oscillation period**. An
+exponent n within ~0.05 of 2 (q = n/(n − 1) near 2, its well (A/|B|)^(1/(2−q)) below 1e-4
+rad) is seen as quadratic, Bγ², at the levels rounding allows.
 """
 
 from dataclasses import dataclass
@@ -56,6 +61,11 @@ MIN_HALF_WIDTH = 5e-14
 DEGENERATE_RATE = 1e-6
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(24)
 TWO_PI = 2 * math.pi
+#: Gauss panels of the quadratures from u* (_local_samples)
+PANELS = 4
+#: the order's probe levels: PROBE_GAMMA·PROBE_RATIO^j (rad), j = 0, 1, 2, on each side,
+#: reached within PROBE_SPAN (rad) of u*
+PROBE_GAMMA, PROBE_RATIO, PROBE_SPAN = 1e-3, 0.25, 0.5 * math.pi
 #: relative accuracy of the γ levels of the local fit (_offsets_for)
 OFFSET_RTOL = 1e-8
 #: offsets reach·2^−j, j < LADDER_STEPS, bracketing the γ levels (_offsets_for)
@@ -280,11 +290,12 @@ def _rotation_rate(body, u):
 
 
 def _local_samples(body, centre, offsets):
-    """(γ, z_G − z*) at u* + offsets by Gauss quadrature of |ω_u| and dz_G/du from u*."""
+    """(γ, z_G − z*) at u* + offsets by composite Gauss quadrature (:data:`PANELS` equal
+    panels) of |ω_u| and dz_G/du from u*."""
     offsets = np.asarray(offsets, dtype=float)
-    x = 0.5 * (1 + _GAUSS_X)
+    x = ((np.arange(PANELS)[:, None] + 0.5 * (1 + _GAUSS_X)) / PANELS).ravel()
     u = centre + offsets[:, None] * x
-    w = 0.5 * _GAUSS_W * offsets[:, None]
+    w = 0.5 * np.tile(_GAUSS_W, PANELS) / PANELS * offsets[:, None]
     gamma = np.sum(w * _rotation_rate(body, u), axis=1)
     rise = np.sum(w * complex_step(body.phase_height, u), axis=1)
     return gamma, rise
@@ -360,19 +371,37 @@ def classify_root(body, series_curvature, centre, reach, max_rate):
         curvature = series_curvature / rate**2
         return dict(order=2.0, leading=0.5 * curvature, gamma_curvature=curvature, rate=rate,
                     degenerate=False)
-    # degenerate phase: γ as coordinate; the largest γ reached within the reach on both sides
-    g_left, _ = _local_samples(body, centre, [-reach])
-    g_right, _ = _local_samples(body, centre, [reach])
+    # degenerate phase: γ as coordinate. The phase may dwell near u* (γ ≪ 1 far out in u):
+    # the quadratic fit's levels stay within half the γ-distance to the nearest other root
+    # (at 2·reach in u); the order's probe levels are absolute (γ ≤ PROBE_GAMMA), also beyond
+    # it: the expansion w = z_G − z* = A|γ|^q + Bγ² + o(γ²) does not care where the next root
+    # is (a narrow well, |γ| < (A/|B|)^(1/(2−q)) ≪ 1, has its maxima close by)
+    reach = 1.9 * reach
+    g_left, _ = _local_samples(body, centre, [-reach, -PROBE_SPAN])
+    g_right, _ = _local_samples(body, centre, [reach, PROBE_SPAN])
     gamma_max = min(0.05, 0.5 * min(abs(float(g_left[0])), abs(float(g_right[0]))))
-    # order from two small levels on each side
-    probe = gamma_max * np.array([-1e-2, -2.5e-3, 2.5e-3, 1e-2])
-    delta = _offsets_for(body, centre, probe, reach)
+    top = min(PROBE_GAMMA, 0.5 * min(abs(float(g_left[1])), abs(float(g_right[1]))))
+    # order from three small levels ρ apart on each side
+    probe = top * PROBE_RATIO ** np.arange(3.0)
+    delta = _offsets_for(body, centre, np.concatenate([-probe, probe]), PROBE_SPAN)
     gamma, rise = _local_samples(body, centre, delta)
-    orders = [math.log(abs(rise[i] / rise[j])) / math.log(abs(gamma[i] / gamma[j]))
-              for i, j in ((0, 1), (3, 2)) if rise[i] * rise[j] > 0]
-    order = float(np.mean(orders)) if orders else math.nan
+    g, w = np.abs(gamma).reshape(2, 3), rise.reshape(2, 3)
+    plain = [math.log(w[i, 1] / w[i, 0]) / math.log(g[i, 1] / g[i, 0])
+             for i in range(2) if w[i, 0] * w[i, 1] > 0]
+    order = float(np.mean(plain)) if plain else math.nan
     if not abs(order - 2.0) < 0.05:
-        leading = float(np.mean(rise[[1, 2]] / np.abs(gamma[[1, 2]]) ** order))
+        # q < 2: the Bγ² term cancelled, r_j = w_{j+1} − (γ_{j+1}/γ_j)² w_j = A γ_j^q (ρ^q − ρ²)
+        ratio = g[:, 1:] / g[:, :-1]
+        r = w[:, 1:] - ratio**2 * w[:, :-1]
+        sides = [i for i in range(2) if r[i, 0] * r[i, 1] > 0]
+        if sides:
+            order = float(np.mean([math.log(r[i, 1] / r[i, 0]) / math.log(ratio[i, 0])
+                                   for i in sides]))
+            leading = float(np.mean([r[i, 0] / (g[i, 0]**order * (ratio[i, 0]**order
+                                                                  - ratio[i, 0]**2))
+                                     for i in sides]))
+        else:
+            leading = float(np.mean(w[:, 1] / g[:, 1] ** order))
         return dict(order=order, leading=leading, gamma_curvature=math.nan, rate=rate,
                     degenerate=True)
     # quadratic: fit (z_G − z*)/γ² by a polynomial in γ on Chebyshev levels, value at 0
