@@ -15,6 +15,9 @@ side by side in one run, for the shapes of ``SHAPES``:
   other shapes, A's ground trace against DOP853 integration of the trace equations (rtol 1e-13)
   on the same body: the error of the cycle's spectral integration and tables, not of the
   body's own tables (those are checked by tests/test_lamina_body.py); target ≤ 1e-10;
+* **equilibria**: ``RollingDynamics(body, laminae 1 kg).equilibria_with_periods()`` (the
+  certified search, stability, order and periods; the node's start and the sweep per body) in
+  seconds, best of ``REPEATS`` on fresh dynamics objects (it is cached); target ≤ 1 s;
 * the same build and pose rate for TwoDiskBody itself (the closed forms), as the ratio.
 
 Run: ``python benchmarks/general_shapes.py [--quick]``.
@@ -35,20 +38,25 @@ import numpy as np  # noqa: E402
 
 from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace  # noqa: E402
+from twodisk_ros.physics.dynamics import RollingDynamics  # noqa: E402
 from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse  # noqa: E402
 from twodisk_ros.physics.lamina_body import LaminaBody  # noqa: E402
+from twodisk_ros.physics.mass_models import mass_properties_of  # noqa: E402
 
 REPEATS = 3
 SAMPLES = 1_000_000
 TARGET_BUILD = 1.0
 TARGET_RATE = 1e6
 TARGET_ERROR = 1e-10
+TARGET_EQUILIBRIA = 1.0
 #: name → (description, lamina factory, Δ (m)); the ellipse first (the side-by-side reference)
 SHAPES = {
     'ellipse': ('ellipse a = 1, b = 0.8, Δ = 0.45 (general path)',
                 lambda: Ellipse(1.0, 0.8), 0.45),
     'superellipse4': ('superellipse n = 4, a = b = 1, Δ = 0.5', lambda: Superellipse(1.0, 1.0, 4.0),
                       0.5),
+    'superellipse3': ('superellipse n = 3, a = b = 1, Δ = 0.5 (odd exponent)',
+                      lambda: Superellipse(1.0, 1.0, 3.0), 0.5),
     'superellipse10': ('superellipse n = 10, a = b = 1, Δ = 0.5',
                        lambda: Superellipse(1.0, 1.0, 10.0), 0.5),
     'egg': ('egg a = 1, b = 0.8, ε = 0.05, Δ = 0.45', lambda: Egg(1.0, 0.8, 0.05), 0.45),
@@ -82,6 +90,14 @@ def _trace_error(cycle, u, size):
     return float(np.max(np.abs(trace - reference.y[1:].T))) / size
 
 
+def _equilibria_time(body, mass, cycle):
+    """Seconds of one ``equilibria_with_periods()`` on a fresh RollingDynamics (it caches)."""
+    dynamics = RollingDynamics(body, mass, cycle=cycle)
+    start = time.perf_counter()
+    dynamics.equilibria_with_periods()
+    return time.perf_counter() - start
+
+
 def measure(quick=False, log=print):
     """The measurements (a dict) of every shape of :data:`SHAPES`."""
     repeats = 1 if quick else REPEATS
@@ -93,8 +109,10 @@ def measure(quick=False, log=print):
         build, (body, cycle) = _best(lambda: (lambda b: (b, RollingCycle(b)))(
             LaminaBody(lamina, delta)), repeats)
         rate_wall, _ = _best(lambda: cycle.positions(u), repeats)
+        mass = mass_properties_of('laminae', body, 1.0)
+        equilibria_wall = min(_equilibria_time(body, mass, cycle) for _ in range(repeats))
         row = dict(name=name, text=text, build=build, resolution=cycle.resolution,
-                   rate=samples / rate_wall, size=body.size)
+                   rate=samples / rate_wall, size=body.size, equilibria=equilibria_wall)
         if isinstance(lamina, Ellipse):
             closed = TwoDiskBody(lamina.a, lamina.b, delta)
             closed_build, closed_cycle = _best(lambda: RollingCycle(closed), repeats)
@@ -106,7 +124,8 @@ def measure(quick=False, log=print):
             row.update(error=_trace_error(cycle, u[::997], body.size),
                        error_kind='trace of A vs DOP853 on the same body')
         log(f'   {name}: build {row["build"]:.3f} s, {row["rate"] / 1e6:.2f} M poses/s, '
-            f'error {row["error"]:.1e} ({row["error_kind"]})')
+            f'error {row["error"]:.1e} ({row["error_kind"]}), equilibria '
+            f'{row["equilibria"]:.3f} s')
         rows.append(row)
     return dict(rows=rows, samples=samples, repeats=repeats)
 
@@ -119,18 +138,21 @@ def report_lines(m):
     w(f'`benchmarks/general_shapes.py`: `LaminaBody(lamina, Δ)` + `RollingCycle(body)` (build, '
       f'best of {m["repeats"]}), `RollingCycle.positions` on {m["samples"]:.0e} phases over '
       f'three cycles (samples/s, best of {m["repeats"]}) and the error of those poses as a '
-      f'fraction of the size. Targets: build ≤ {TARGET_BUILD:g} s, ≥ {TARGET_RATE:.0e} '
-      f'poses/s, error ≤ {TARGET_ERROR:.0e}.\n')
-    w('| shape | build (s) | nodes | poses/s | pose error | error measured | closed forms: '
-      'build (s), poses/s |')
-    w('|---|---|---|---|---|---|---|')
+      f'fraction of the size; `RollingDynamics(body, laminae 1 kg).equilibria_with_periods()` '
+      f'(certified equilibria, stability, periods; best of {m["repeats"]}, fresh objects). '
+      f'Targets: build ≤ {TARGET_BUILD:g} s, ≥ {TARGET_RATE:.0e} poses/s, error ≤ '
+      f'{TARGET_ERROR:.0e}, equilibria ≤ {TARGET_EQUILIBRIA:g} s.\n')
+    w('| shape | build (s) | nodes | poses/s | pose error | error measured | equilibria (s) | '
+      'closed forms: build (s), poses/s |')
+    w('|---|---|---|---|---|---|---|---|')
     for r in m['rows']:
         closed = (f'{r["closed_build"]:.3f}, {r["closed_rate"] / 1e6:.2f} M/s (general path '
                   f'{r["build"] / r["closed_build"]:.1f}× the build, '
                   f'{r["closed_rate"] / r["rate"]:.2f}× the pose time)'
                   if 'closed_build' in r else '—')
         w(f'| {r["text"]} | {r["build"]:.3f} | {r["resolution"]} | {r["rate"] / 1e6:.2f} M | '
-          f'{r["error"]:.1e} | {r["error_kind"]} | {closed} |')
+          f'{r["error"]:.1e} | {r["error_kind"]} | {r.get("equilibria", math.nan):.3f} | '
+          f'{closed} |')
     w('')
     return lines
 

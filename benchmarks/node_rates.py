@@ -20,6 +20,10 @@ a batch run as wall time per sample (:func:`batch_tf_cost`, in process, runs alt
 Real time by shape: the same real-time run at 1 kHz for the ellipse (config/oloid.yaml) and
 non-elliptic bodies (config/rounded_square.yaml, a superellipse n = 4; config/egg.yaml), side
 by side (:func:`shape_rates`, :data:`SHAPE_SCENARIOS`).
+
+Real time by scene: the same run at 1 kHz in every scene (slope, damping, rolling resistance,
+the speed and the torque drive commanded at 10 Hz by the listener) beside the flat free
+oloid (:func:`scene_rates`, :data:`SCENE_SCENARIOS`).
 """
 
 from dataclasses import asdict, dataclass
@@ -215,13 +219,36 @@ def _cpu_seconds(pid):
 
 
 #: Bodies of the real-time runs at 1 kHz by shape: name → (params file in config/, extra
-#: node parameters). The egg runs ``method:=direct``: in dynamic table mode the parallel egg
-#: is refused today ("the motion does not advance monotonically in u"), a physics fix pending.
+#: node parameters).
 SHAPE_SCENARIOS = {
     'oloid': ('oloid.yaml', ()),
     'rounded_square': ('rounded_square.yaml', ()),
-    'egg (method direct)': ('egg.yaml', ('-p', 'method:=direct')),
+    'egg': ('egg.yaml', ()),
 }
+
+
+#: Scenes of the real-time runs at 1 kHz: name → (params file in config/, extra node
+#: parameters, command published by the listener at 10 Hz as (topic, value) or None). The
+#: drives are commanded throughout (cmd_timeout 1 s in config/driven.yaml): 6 rad/s, and
+#: 0.01 N m against the damping of 0.002 N m s (|ω| → τ/c = 5 rad/s).
+SCENE_SCENARIOS = {
+    'flat free (oloid.yaml)': ('oloid.yaml', (), None),
+    'slope 0.05 rad, damped (slope.yaml)': ('slope.yaml', (), None),
+    'slope 0.05 rad across, conservative': (
+        'slope.yaml', ('-p', 'heading0:=1.5708', '-p', 'damping:=0.0'), None),
+    'damping 0.01 N m s': ('oloid.yaml', ('-p', 'damping:=0.01'), None),
+    'rolling resistance 0.01': ('oloid.yaml', ('-p', 'rolling_resistance:=0.01'), None),
+    'speed drive, cmd_speed 6 (driven.yaml)': ('driven.yaml', (), ('cmd_speed', 6.0)),
+    'torque drive, cmd_torque 0.01': ('driven.yaml', ('-p', 'drive:=torque'),
+                                      ('cmd_torque', 0.01)),
+}
+
+
+def _scenario(body):
+    """(params file, extra parameters, command or None) of a SHAPE_ or SCENE_SCENARIOS name."""
+    if body in SCENE_SCENARIOS:
+        return SCENE_SCENARIOS[body]
+    return SHAPE_SCENARIOS[body] + (None,)
 
 
 def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True, body='oloid'):
@@ -229,7 +256,8 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True, body='olo
 
     ``tf=False`` leaves /tf unsubscribed and ``record=False`` the recording off: with both,
     the node builds no /tf (the "off" side of the cost of /tf). ``body``: a name of
-    :data:`SHAPE_SCENARIOS` (its params file and parameters).
+    :data:`SHAPE_SCENARIOS` or :data:`SCENE_SCENARIOS` (its params file and parameters; a
+    scene's command is published at 10 Hz from the listener, warm-up included).
     """
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
@@ -239,7 +267,7 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True, body='olo
         env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID=DOMAIN,
                    PYTHONPATH=ROOT + os.pathsep + os.environ.get('PYTHONPATH', ''))
         recording = ['-p', f'record:={os.path.join(folder, "rt.mcap")}'] if record else []
-        params_file, extra = SHAPE_SCENARIOS[body]
+        params_file, extra, command = _scenario(body)
         process = subprocess.Popen(
             [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
              os.path.join(ROOT, 'config', params_file), '-p', f'rate:={float(rate)}',
@@ -255,6 +283,10 @@ def realtime_rate(rate, seconds=8.0, warmup=3.0, tf=True, record=True, body='olo
             stamps.append(sec + 1e-9 * nanosec)
         # raw: the listener must not be the bottleneck
         _listen(node, every_topic(tf), {'pose': on_pose, '/diagnostics': diagnostics.append})
+        if command is not None:
+            from std_msgs.msg import Float64
+            publisher = node.create_publisher(Float64, command[0], 10)
+            node.create_timer(0.1, lambda: publisher.publish(Float64(data=command[1])))
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         try:
@@ -307,6 +339,12 @@ def shape_rates(rate=1000.0, seconds=8.0, warmup=3.0):
             for name in SHAPE_SCENARIOS]
 
 
+def scene_rates(rate=1000.0, seconds=8.0, warmup=3.0):
+    """:func:`realtime_rate` of every scene of :data:`SCENE_SCENARIOS` at ``rate`` Hz."""
+    return [realtime_rate(rate, seconds=seconds, warmup=warmup, body=name)
+            for name in SCENE_SCENARIOS]
+
+
 if __name__ == '__main__':
     import argparse
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] + ' Real time at '
@@ -317,7 +355,13 @@ if __name__ == '__main__':
     parser.add_argument('--only-tf', action='store_true', help='only the cost of /tf')
     parser.add_argument('--only-shapes', action='store_true',
                         help='only real time at 1 kHz by shape (SHAPE_SCENARIOS)')
+    parser.add_argument('--only-scenes', action='store_true',
+                        help='only real time at 1 kHz by scene (SCENE_SCENARIOS)')
     options = parser.parse_args()
+    if options.only_scenes:
+        for result in scene_rates(seconds=options.seconds, warmup=2.0):
+            print(result)
+        raise SystemExit(0)
     if options.only_shapes:
         for result in shape_rates(seconds=options.seconds, warmup=2.0):
             print(result)

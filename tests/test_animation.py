@@ -104,11 +104,6 @@ def _cli(*args):
     (['-o', 'x.gif', '--size', 'big'], 'WIDTHxHEIGHT'),
     (['-o', 'x.gif', '--delta', '0.5'], 'delta/a'),
     (['-o', 'x.gif', '--fps', '0'], 'fps'),
-    # a scene of the node is not a flat free run: never animated as one (it used to be)
-    (['-o', 'x.gif', '--params-file', str(REPO / 'config' / 'slope.yaml')],
-     'slope 0.05 is not simulated here'),
-    (['-o', 'x.gif', '--params-file', str(REPO / 'config' / 'driven.yaml')],
-     'is not simulated here'),
 ])
 def test_bad_input_one_line_exit_2(tmp_path, args, words):
     result = subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', *args],

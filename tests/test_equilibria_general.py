@@ -100,3 +100,46 @@ def test_certificate_sees_close_roots():
     slope = np.imag(double.phase_height(u + 1e-30j)) / 1e-30
     changes = np.count_nonzero(np.sign(slope[1:]) != np.sign(slope[:-1]))
     assert len(roots) == changes == 10
+
+
+#: superellipses with flat vertices (n > 2): a = b, b < a, a rounded square, non-even
+#: exponents (2.5, 3, 7.5), and n = 3 with a narrow well at the tips (|γ| < 1.7e-4 rad)
+FLAT_VERTEX_BODIES = [((0.1, 0.1, 4.0), 0.05), ((0.1, 0.07, 6.0), 0.04), ((1.0, 1.0, 10.0), 0.3),
+                      ((0.1, 0.1, 2.5), 0.05), ((0.1, 0.1, 3.0), 0.05), ((0.1, 0.08, 3.0), 0.03),
+                      ((0.1, 0.1, 7.5), 0.05)]
+#: the flat-vertex order q (z_G − z* ≈ A|γ|^q + Bγ²) estimated by the search from three levels
+#: (the γ² term eliminated), against symmetric_stability's n/(n − 1): measured ≤ 9.0e-3
+#: (n = 10, where the o(γ²) rest is largest), ≤ 2.1e-4 for n ≤ 4
+ORDER_TOL = 1.5e-2
+#: A against symmetric_stability's leading coefficient (relative) for n ≤ 4 (q ≥ 4/3), where
+#: the order is that close: measured ≤ 2.4e-3
+LEADING_RTOL = 5e-3
+
+
+@pytest.mark.parametrize('shape, delta', FLAT_VERTEX_BODIES)
+def test_flat_vertex_equilibria_sit_exactly_on_the_vertex(shape, delta):
+    """Claim: an equilibrium resting on a flat vertex is reported at exactly the phase of the
+    flat-vertex pose (bisection of the sign of dz_G/du stopped 1.3e-5 rad off: z_G − z* is
+    below rounding there), with θ, stability and order of symmetric_stability's closed forms
+    (an independent derivation from the vertex's order of contact)."""
+    from twodisk_ros.physics.equilibria_general import flat_vertex_phases
+    from twodisk_ros.physics.lamina import Superellipse
+    from twodisk_ros.physics.lamina_body import LaminaBody
+    body = LaminaBody(Superellipse(*shape), delta)
+    phases = flat_vertex_phases(body)
+    found = equilibria(body)
+    closed = {s.name: s for s in symmetric_equilibria(body.lamina, delta)}
+    on_vertex = [eq for eq in found if np.any(phases == eq.phase)]
+    assert len(on_vertex) >= 4
+    for eq in on_vertex:
+        # A on its far tip (θ = 0), B on its far tip (θ = ±θ_max) or both on side vertices
+        ref = min(closed.values(), key=lambda s: abs(abs(eq.theta) - s.theta))
+        assert abs(abs(eq.theta) - ref.theta) <= POSITION_TOL
+        assert eq.stability == ref.stability and abs(eq.order - ref.order) <= ORDER_TOL
+        if ref.order >= 4 / 3 - 1e-12:
+            assert abs(eq.leading / ref.leading - 1) <= LEADING_RTOL
+        assert not eq.has_linear_period
+    # and each flat-vertex phase with a sign change of dz_G/du is one of them
+    assert sorted(eq.phase for eq in on_vertex) == sorted(
+        p for p in phases if any(abs(math.remainder(p - eq.phase, 2 * math.pi)) < 1e-3
+                                 for eq in found))

@@ -34,10 +34,6 @@ REPO = Path(__file__).resolve().parents[1]
 DOMAIN = 60
 TIMEOUT = 300      # s: a short batch run takes ~3 s alone; bound for a loaded 2-core machine
 CONFIGS = sorted(p.stem for p in (REPO / 'config').glob('*.yaml'))
-#: The parallel egg in dynamic table mode: the physics refuses its closed form today ("the
-#: motion does not advance monotonically in u over a cycle"); another change fixes that.
-WAITS_FOR_PHYSICS = {'egg': 'the parallel egg in dynamic table mode waits for the physics fix '
-                            '(solvers: "the motion does not advance monotonically in u")'}
 
 
 def _env():
@@ -71,9 +67,7 @@ def recordings(tmp_path_factory):
     return get
 
 
-@pytest.mark.parametrize('config', [
-    pytest.param(c, marks=pytest.mark.xfail(reason=WAITS_FOR_PHYSICS[c], strict=False))
-    if c in WAITS_FOR_PHYSICS else c for c in CONFIGS])
+@pytest.mark.parametrize('config', CONFIGS)
 def test_every_config_records_a_consistent_run(tmp_path, config):
     from twodisk_ros.inspect import inspect_recording
     out, made = _record(tmp_path, config, '--params-file', str(REPO / 'config' / f'{config}.yaml'),
@@ -89,7 +83,7 @@ def test_every_config_records_a_consistent_run(tmp_path, config):
 
 
 EGG_SOLID = ('--params-file', str(REPO / 'config' / 'egg.yaml'), '-p', 'mass_model:=solid',
-             '-p', 'method:=direct', '-p', 'duration:=1.0')
+             '-p', 'duration:=1.0')
 SQUARE = ('--params-file', str(REPO / 'config' / 'rounded_square.yaml'), '-p',
           'duration:=1.0')
 
@@ -133,8 +127,7 @@ def test_a_parameter_file_of_another_shape_animates(tmp_path):
                  str(REPO / 'config' / 'rounded_square.yaml'), '--stop', '1',
                  '--size', '320x240']) == 0
     assert main(['-o', str(tmp_path / 'egg.gif'), '--shape', 'egg', '--egg-asymmetry', '0.5',
-                 '--b', '0.08', '--delta', '0.04', '--mass-model', 'solid', '--method',
-                 'direct', '--stop', '0.4', '--fps', '5', '--size', '320x240']) == 0
+                 '--b', '0.08', '--delta', '0.04', '--mass-model', 'solid', '--stop', '0.4', '--fps', '5', '--size', '320x240']) == 0
     with Image.open(tmp_path / 'egg.gif') as gif:
         assert gif.n_frames == 3
 

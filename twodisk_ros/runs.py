@@ -20,6 +20,8 @@ from .io.reader import read_recording
 from .model.outline import DEFAULT_TOLERANCE, disk_rims
 from .node.arguments import ArgumentError, params_file_values
 from .node.parameters import BY_NAME, DEFAULTS
+from .node.scene_simulation import flat_free
+from .node.simulation import Simulation
 from .physics.contact_forces import ContactForceModel
 from .physics.motion import simulate
 from .run.description import RunDescription
@@ -59,9 +61,21 @@ class Run:
     quaternion: np.ndarray | None = None   #: (n, 4) x, y, z, w
     stamp_ns: np.ndarray | None = None     #: (n,) int64 ns
     settings: object = None                #: RollerSettings
+    slope: float = 0.0         #: β (rad): the ground through the origin, normal ground_normal
 
     def __len__(self):
         return len(self.t)
+
+    @property
+    def ground_normal(self):
+        """The ground's unit normal (sin β, 0, cos β) in the world frame: the ground is the
+        plane through the origin with this normal, going down along +X at the slope β
+        (the node's ``frame_id`` is gravity-aligned, docs/physics.md "Scenes")."""
+        return np.array([math.sin(self.slope), 0.0, math.cos(self.slope)])
+
+    def ground_height(self, x):
+        """Z (m) of the ground at world X = ``x`` (m): −x tan β."""
+        return -np.asarray(x, dtype=float) * math.tan(self.slope)
 
     def span(self, start, stop):
         """The samples with start ≤ t ≤ stop (a new Run)."""
@@ -70,7 +84,7 @@ class Run:
         return Run(self.body, self.t[keep], self.position_g[keep], self.contact_a[keep],
                    self.contact_b[keep], self.rotation[keep], pick(self.force_a),
                    pick(self.force_b), self.weight, self.label, pick(self.quaternion),
-                   pick(self.stamp_ns), self.settings)
+                   pick(self.stamp_ns), self.settings, self.slope)
 
     def outlines(self, index, tolerance=DEFAULT_TOLERANCE):
         """World points (m) of both disk rims at sample ``index``: two closed arrays (N + 1, 3)
@@ -110,7 +124,21 @@ def _describe(run):
     if s.shape != 'ellipse' and s.arrangement != 'parallel':
         body += f', {s.arrangement}'
     return (f'{body}, Δ = {s.delta:.4g} m, {s.mass_model}, {s.mode}, '
-            f'θ0 = {s.theta0:.3g} rad, ω0 = {s.omega0:.3g} rad/s')
+            f'θ0 = {s.theta0:.3g} rad, ω0 = {s.omega0:.3g} rad/s' + _describe_scene(s))
+
+
+def _describe_scene(s):
+    """', slope …, drive …, damping …' for what the scene adds to the flat free one."""
+    parts = []
+    if s.slope:
+        parts.append(f'slope {s.slope:.3g} rad, heading0 {s.heading0:.3g} rad')
+    if s.drive != 'none':
+        parts.append(f'{s.drive} drive')
+    if s.rolling_resistance:
+        parts.append(f'μr = {s.rolling_resistance:.3g}')
+    if s.damping:
+        parts.append(f'damping {s.damping:.3g} N m s')
+    return ''.join(', ' + part for part in parts)
 
 
 def _description(settings):
@@ -146,7 +174,8 @@ def settings_from(params_file=None, **values):
     if isinstance(known.get('principal_moments'), list):
         known['principal_moments'] = tuple(known['principal_moments'])
     for name in ('a', 'b', 'delta', 'mass', 'gravity', 'theta0', 'omega0', 'exponent',
-                 'egg_asymmetry'):
+                 'egg_asymmetry', 'slope', 'heading0', 'drive_lag', 'cmd_timeout',
+                 'rolling_resistance', 'damping'):
         if isinstance(known.get(name), int) and not isinstance(known[name], bool):
             known[name] = float(known[name])
     try:
@@ -172,17 +201,14 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
     """
     if settings is None:
         settings = settings_from(**values)
-    scene = _scene_parameters(settings)
-    if scene:
-        raise RunError(f'{scene} is not simulated here (flat ground, free motion only): '
-                       f'record the scene with the node (record:=run.mcap) and show the '
-                       f'recording')
     if not (math.isfinite(stop) and stop > 0):
         raise RunError(f'the run must end after 0 s, got stop = {stop!r} s')
     description = _description(settings)
     s, body, dynamics = description.settings, description.body, description.dynamics
     count = max(2, int(math.ceil(stop * rate)) + 1)
     t = np.linspace(0.0, stop, count)
+    if not flat_free(s):
+        return _scene_run(description, t, forces)
     motion = simulate(dynamics, t, mode=s.mode, theta0=s.theta0, branch=s.branch,
                       omega0=s.omega0, method=s.method, tolerance=s.tolerance)
     poses = dynamics.cycle.poses(motion.phase)
@@ -195,14 +221,23 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
     return run
 
 
-def _scene_parameters(settings):
-    """'name value' of the first scene parameter (slope, drive, rolling_resistance, damping)
-    that is not today's flat free scene, else ''."""
-    for name in ('slope', 'drive', 'rolling_resistance', 'damping'):
-        value = getattr(settings, name)
-        if value != BY_NAME[name].default:
-            return f'{name} {value}'
-    return ''
+def _scene_run(description, t, forces):
+    """A run of a scene (slope, drive, dissipation) as the node's batch run makes it: the
+    node's :class:`~twodisk_ros.node.simulation.Simulation`, with no command and no service
+    call (a speed drive holds its starting speed, a torque drive gives 0 N m)."""
+    s = description.settings
+    try:
+        simulation = Simulation(s, description)
+        sample = simulation.sample(t, forces=forces)
+    except (ValueError, RuntimeError, ArithmeticError) as error:
+        raise RunError(f'the parameters define no run: {one_line(error)}') from None
+    run = Run(description.body, t, sample.position_g, sample.contact_a, sample.contact_b,
+              rotation_matrices(sample.quaternion), weight=simulation.weight,
+              label=_describe(description), quaternion=sample.quaternion, settings=s,
+              slope=s.slope)
+    if forces:
+        run.force_a, run.force_b = sample.forces.force_a, sample.forces.force_b
+    return run
 
 
 def _topic_role(topic):
@@ -268,7 +303,7 @@ def recorded_run(path):
               np.array([by_role['contact_b'][k] for k in stamps]),
               rotation_matrices(quaternion), weight=settings.mass * settings.gravity,
               label=_describe(description), quaternion=quaternion, stamp_ns=stamps_ns,
-              settings=settings)
+              settings=settings, slope=settings.slope)
     if by_role['wrench_a'] and by_role['wrench_b']:
         run.force_a = _resample(by_role['wrench_a'], stamps_ns)
         run.force_b = _resample(by_role['wrench_b'], stamps_ns)

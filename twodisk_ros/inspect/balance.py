@@ -112,7 +112,8 @@ def balance_stretches(samples, motion, model, timeline, normal_force):
         t = samples.t[k[inside]]
         where = f't = {t[0]:.6g} … {t[-1]:.6g} s'
         if state['active'] == 'speed':
-            skipped.append(f'{where}: speed drive (its work is what its rule needs)')
+            skipped.append(f'{where}: speed drive (its work is what its rule needs; '
+                           'the rule is the speed_drive check)')
             continue
         power = -state['damping'] * omega[inside]**2
         if state['rolling_resistance'] > 0:

@@ -61,6 +61,7 @@ from scipy.spatial.transform import Rotation
 from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
 from .results import Check, json_ready
+from .speed_drive import TITLE as SPEED_DRIVE_TITLE, speed_drive_check
 from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES, WRENCHES, values_at
 
 __all__ = ['TITLES', 'run_checks']
@@ -87,6 +88,7 @@ TITLES = {
     'angular_speed': 'kinematic mode: angular speed |ω| constant = |omega0|',
     'energy_balance': 'drive or dissipation: E + W − W_d = E0 on each stretch (from the '
                       'recording alone)',
+    'speed_drive': SPEED_DRIVE_TITLE,
     'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
     'stamps': 'consistent stamps across messages and topics',
 }
@@ -428,13 +430,19 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(
         _not_evaluated_all(checks, ('no_slip', speed_check), f'no finite differences: {reason}')
         return None
     _run(checks, 'no_slip', _check_no_slip, samples, motion, scale)
+    timeline = scene_timeline(parameters, events) if model.scene else []
+    speed_driven = [state['active'] == 'speed' for _, state in timeline]
     if model.mode == 'kinematic' and not model.scene:
         _run(checks, 'angular_speed', _check_angular_speed, samples, motion, model)
     elif model.scene and not _conservative(parameters):
-        _run(checks, 'energy_balance', _check_energy_balance, samples, motion, model,
-             parameters, events, series)
+        if not all(speed_driven):   # a speed drive's work is what its rule needs: speed_drive
+            _run(checks, 'energy_balance', _check_energy_balance, samples, motion, model,
+                 parameters, events, series)
     else:
         _run(checks, 'energy', _check_energy, samples, motion, model)
+    if any(speed_driven) and motion.index.size:
+        _run(checks, 'speed_drive', speed_drive_check, samples, motion, model, timeline,
+             parameters, events, FD_MARGIN, ROUNDOFF / motion.step + _solver_allowance(model))
     return motion
 
 

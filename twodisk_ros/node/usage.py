@@ -31,6 +31,13 @@ outline of `shape_file`, a CSV or YAML list of x, y points in metres around it: 
 then the outline's, and the parameters a and b are not used). `arrangement` turns the second
 disk end for end (swapped) or not (parallel). A recording keeps a points outline as fitted.
 
+Scenes (README "Scenes"): `slope` and `heading0` tilt the ground, `drive` (speed, torque)
+follows cmd_speed / cmd_torque, `damping` and `rolling_resistance` dissipate; the services
+reset and pause restart or hold the run. Commands and service calls act only in a real-time
+run (realtime:=true, the default): a batch run (realtime:=false) never waits for them, so it
+is the motion of its parameters alone (a speed drive holds the speed it starts from, a torque
+drive gives 0 N m).
+
 Parameters are ROS 2 parameters and go after --ros-args:
   -p NAME:=VALUE        one parameter; doubles need a decimal point (rate:=50.0)
   --params-file FILE    a YAML file: /**: {{ros__parameters: {{NAME: VALUE, ...}}}}
@@ -43,6 +50,7 @@ examples:
   {PROG} --ros-args -p realtime:=false -p duration:=2.0 -p record:=run.mcap
   {PROG} --ros-args -p shape:=superellipse -p exponent:=4.0 -p delta:=0.05
   {PROG} --ros-args -p shape:=points -p shape_file:=outline.csv -p delta:=0.03
+  {PROG} --ros-args --params-file config/driven.yaml    (then publish on /cmd_speed)
 
 exit status: 0 the run ended (duration reached, SIGINT, SIGTERM); 1 internal error;
 2 invalid input (one line on stderr); 3 the recording could not be written.

@@ -8,6 +8,7 @@ The derivation is in docs/physics.md, section "Contact forces".
 """
 
 from dataclasses import dataclass
+from functools import partial
 import math
 
 import numpy as np
@@ -17,6 +18,7 @@ from .cycle import TWO_PI
 from .contact_forces import QUANTITIES, squeeze_split
 from .spectral import real_spectral_derivative
 from .tables import hermite_jet
+from .turning import turning_points
 
 __all__ = ['ValidityReport', 'check_validity', 'motion_validity', 'liftoff_speed',
            'liftoff_speed_batch', 'mu_required_kinematic', 'mu_required_kinematic_batch',
@@ -210,8 +212,9 @@ def mu_required_kinematic(model, omega, samples=2048):
 def mu_required_dynamic(model, energy, u0=None, samples=2048):
     """μ_required over the phases a free motion of energy E (J) reaches.
 
-    Rolling over (E above every maximum of V) reaches the whole cycle; otherwise the well of
-    V holding ``u0`` (rad) if given, else every u with V(u) ≤ E. w² = 2(E − V)/J (the
+    Rolling over (E above every maximum of V) reaches the whole cycle; otherwise, if ``u0``
+    (rad) is given, the well of V holding it, or (E above the lower maximum bounding that
+    well) the span between the turning points either side of u0; else every u with V(u) ≤ E. w² = 2(E − V)/J (the
     angular speed, J the inertia about AB: finite also where the body does not turn in u).
 
     Returns
@@ -225,8 +228,12 @@ def mu_required_dynamic(model, energy, u0=None, samples=2048):
     """
     dynamics = model.dynamics
     u = TWO_PI * np.arange(samples) / samples
-    if u0 is not None and energy < dynamics.potential_range[1]:
+    if u0 is not None and energy < dynamics.barrier:
         _, low, high = dynamics.well(float(u0))
+        if energy >= dynamics.well_rim(float(u0)):   # over the lower maximum: several wells
+            bounds = turning_points(dynamics.tabulated_potential, partial(
+                dynamics.tabulated_potential, derivative=1), energy, float(u0), 1.0, samples)
+            low, high = bounds if bounds is not None else (low, high)
         u = low + (high - low) * (np.arange(samples) + 0.5) / samples
     rate2 = 2 * (energy - dynamics.tabulated_potential(u)) / dynamics.tabulated_inertia(u)
     reached = rate2 >= 0

@@ -237,6 +237,17 @@ class RollingDynamics:
         inside = centres[(centres > low) & (centres < high)]
         return float(inside[0]), float(low), float(high)
 
+    def well_rim(self, u):
+        """V (J) at the lower of the two maxima bounding the well holding phase u.
+
+        Below it a motion oscillates in that well (about its minimum); from it up to
+        :attr:`barrier` it crosses the lower maximum and swings over several wells between
+        two turning points (unequal maxima: a parallel egg, V(0) ≠ V(π/2)); above the barrier
+        it rolls over. For the ellipse both maxima are at the same height.
+        """
+        _, low, high = self.well(u)
+        return float(np.min(self.tabulated_potential(np.array([low, high]))))
+
     @property
     def has_wells(self):
         """True if V has wells: g > 0 and some equilibrium is stable."""

@@ -24,6 +24,7 @@ carries its solution as ``sol``, a :class:`~twodisk_ros.physics.solvers.PhaseSol
 """
 
 from dataclasses import dataclass, field
+from functools import partial
 import math
 
 import numpy as np
@@ -34,6 +35,7 @@ from .dynamics import RollingDynamics
 from .motion_general import SundmanSolution, general_closed_form, sundman
 from .solvers import (LibrationSolution, OdeSolution, QuadratureSolution, RestSolution)
 from .spectral import STALL, spectral_tail
+from .turning import TurningPointSolution, turning_points
 
 __all__ = ['CLOSED_FORM_SOLVERS', 'METHODS', 'MODES', 'MotionStream', 'RollingMotion',
            'simulate', 'simulate_phase']
@@ -58,7 +60,7 @@ LOCAL_FRACTION = 0.5
 MODES = ('dynamic', 'kinematic')
 #: names of the solvers whose motion is known at any time without stepping (for reports)
 CLOSED_FORM_SOLVERS = tuple(kind.name for kind in (QuadratureSolution, LibrationSolution,
-                                                   RestSolution))
+                                                   RestSolution, TurningPointSolution))
 
 
 @dataclass
@@ -76,7 +78,7 @@ class RollingMotion:
     nfev : int
         Right-hand-side evaluations (0 for the quadrature path).
     solver : str
-        Name of the solver used: 'quadrature', 'libration', 'rest' or 'DOP853'.
+        Name of the solver used: 'quadrature', 'libration', 'oscillation' (over several wells), 'rest' or 'DOP853'.
     sol : PhaseSolution
         Dense output: ``sol(t)`` is an array (2, ...) of u (rad) and u̇ (rad/s) at times t
         (s), for every method, like scipy's ``OdeSolution``.
@@ -330,7 +332,7 @@ def _ode(dynamics, mode, method, t_end, u0, u_dot0, tolerance):
         return _solve(rhs, t_end, [u0, u_dot0], tolerance, max(abs(u_dot0), 1.0))
     f0 = dynamics.tabulated(u0)
     energy = 0.5 * f0[0] * u_dot0**2 + f0[1]
-    centre = dynamics.well(u0)[0] if energy < dynamics.barrier else None
+    centre = dynamics.well(u0)[0] if _in_one_well(dynamics, u0, energy) else None
     if method == 'table':
         def rhs(t, y):
             u = y[0] if centre is None else centre + y[0]
@@ -372,6 +374,10 @@ def _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre):
         if margin > ROLLING_MARGIN * scale or _resolved(inverse_speed, n):
             return QuadratureSolution(u0, math.copysign(1.0, u_dot0), inverse_speed, n)
     if margin < 0:
+        margin = energy - dynamics.well_rim(u0)    # the lower maximum bounding the well
+        if margin >= 0:      # over it: an oscillation across several wells
+            return span_closed_form(dynamics, u0, math.copysign(1.0, u_dot0) if u_dot0 else
+                                    0.0, energy)
         well = dynamics.tabulated_well(centre)
         if margin < -LIBRATION_MARGIN * scale:
             return LibrationSolution(well, u0 - centre, u_dot0, n)
@@ -382,6 +388,32 @@ def _table_closed_form(dynamics, u0, u_dot0, energy, margin, centre):
         if libration.resolved:
             return libration
     return None
+
+
+def _in_one_well(dynamics, u0, energy):
+    """True if a motion of energy E (J) from u0 (rad) stays in the well holding u0: E below
+    the lower of the two maxima bounding it (:meth:`RollingDynamics.well_rim`)."""
+    return energy < dynamics.barrier and energy < dynamics.well_rim(u0)
+
+
+def span_closed_form(dynamics, u0, direction, energy):
+    """The table method's oscillation of energy E (J) over several wells, between the
+    turning points either side of u0 (rad) (physics/turning.py), or None (then DOP853) if
+    the turning points are not simple or dt/dφ is not resolved on the table's nodes."""
+    n = dynamics.table_size
+
+    def mass(u):
+        return dynamics.tabulated(u)[..., 0]
+    potential, slope = dynamics.tabulated_potential, partial(dynamics.tabulated_potential,
+                                                              derivative=1)
+    bounds = turning_points(potential, slope, energy, u0, direction, n)
+    if bounds is None:
+        return None
+    try:
+        solution = TurningPointSolution(potential, slope, mass, bounds, u0, direction, n)
+    except RuntimeError:
+        return None
+    return solution if solution.resolved else None
 
 
 def _resolved(function, n):
@@ -419,6 +451,9 @@ def _small_libration(dynamics, u0, u_dot0):
     delta0 = u0 - centre
     if delta0 == 0 and u_dot0 == 0:
         return RestSolution(u0)
+    f0 = dynamics.tabulated(u0)
+    if not _in_one_well(dynamics, u0, 0.5 * f0[0] * u_dot0**2 + f0[1]):
+        return None
     local = dynamics.local_well(centre)
     if abs(delta0) > local.radius:
         return None
@@ -456,4 +491,4 @@ def _solve(rhs, t_end, y0, tolerance, scale, rate=None, centre=None):
 
 
 #: the closed forms of the ellipse path that general_closed_form reuses where u is regular
-_REGULAR_FORMS = (_small_libration, _table_closed_form)
+_REGULAR_FORMS = (_small_libration, _table_closed_form, span_closed_form)

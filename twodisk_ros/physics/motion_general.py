@@ -29,10 +29,12 @@ __all__ = ['SundmanSolution', 'general_closed_form', 'sundman']
 def general_closed_form(dynamics, mode, method, u0, w0, regular_forms):
     """The closed-form solution from (u0 (rad), w0 (rad/s)), or None (then :func:`sundman`).
 
-    ``regular_forms`` = (small_libration, table_closed_form) of the ellipse path
-    (physics/motion.py), used where u is regular at the start and at the well's centre.
+    ``regular_forms`` = (small_libration, table_closed_form, span_closed_form) of the
+    ellipse path (physics/motion.py), the first two used where u is regular at the start and
+    at the well's centre; an oscillation over several wells (E above the lower maximum
+    bounding the well, below the highest) is the span's closed form wherever it starts.
     """
-    small_libration, table_closed_form = regular_forms
+    small_libration, table_closed_form, span_closed_form = regular_forms
     n = dynamics.table_size
     if w0 == 0 and (mode == 'kinematic' or dynamics.flat or dynamics.is_equilibrium(u0)):
         return RestSolution(u0)
@@ -54,6 +56,9 @@ def general_closed_form(dynamics, mode, method, u0, w0, regular_forms):
     energy = 0.5 * float(dynamics.tabulated_inertia(u0)) * w0 * w0 + float(
         dynamics.tabulated(u0)[1])
     margin = energy - dynamics.barrier
+    if centre is not None and margin < 0 and energy >= dynamics.well_rim(u0):
+        return (span_closed_form(dynamics, u0, direction if w0 else 0.0, energy)
+                if method == 'table' else None)
     regular = rate0 > 0 and (centre is None or dynamics.regular_centre(centre))
     if regular:
         u_dot0 = w0 / rate0

@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .cycle import TWO_PI
+from .scene_terms import STOPPED
 
 from .solvers import LibrationSolution, PhaseSolution, QuadratureSolution, RestSolution
 from .spectral import spectral_tail
@@ -53,13 +54,16 @@ class DriftQuadrature(PhaseSolution):
     (the integral of the quintic Hermite interpolant of f), f′ and f″ from m, V and their
     first two derivatives. A sample time is located among the t_j and x solved in its panel
     by Newton on the quintic Hermite of t(x) (data t, f, f′), to 1e-14 of the panel; then
-    u̇ = σ √(2(E − V(u))/m(u)).
+    w = σ √(2(E − V(u))/J(u)) and u̇ = w/|ω_u|. f = |ω_u| √(J/(2(E − V))) is written with
+    J = m/|ω_u|², so that it stays regular where the body stops turning in u (f = 0 there).
 
     Parameters
     ----------
     terms : SceneTerms
     u0, u_dot0 : float
         Initial phase (rad) and rate (rad/s), u̇0 ≠ 0.
+    angular_speed : float, optional
+        w0 = |ω_u(u0)| u̇0 (rad/s, ≠ 0) instead of u̇0: the start where |ω_u(u0)| = 0.
     """
 
     name = 'quadrature'
@@ -70,11 +74,13 @@ class DriftQuadrature(PhaseSolution):
     #: STRIDE = 1 over 13 cycles of the oloid; 8 moved it by 1e-11)
     STRIDE = 4
 
-    def __init__(self, terms, u0, u_dot0):
+    def __init__(self, terms, u0, u_dot0, angular_speed=None):
         self._terms = terms
-        self._u0, self._s = float(u0), math.copysign(1.0, u_dot0)
-        m0, v0 = (float(x) for x in terms.energy_jet(self._u0)[:2])
-        self.energy = 0.5 * m0 * float(u_dot0) ** 2 + v0
+        jet = terms.energy_jet(float(u0))
+        w0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * float(
+            jet[4])
+        self._u0, self._s = float(u0), math.copysign(1.0, w0)
+        self.energy = 0.5 * float(jet[7]) * w0 ** 2 + float(jet[1])
         self._n = terms.table_nodes // self.STRIDE
         self._h = TWO_PI / self._n
         self._first = 0                        # index of the first node kept
@@ -84,16 +90,22 @@ class DriftQuadrature(PhaseSolution):
         self._extend()
 
     def _integrand(self, x):
-        """f, f′, f″ (in x) at x (arrays)."""
+        """f, f′, f″ (in x) at x (arrays): f = |ω_u| a, a = √(J / (2(E − V))), regular
+        where the body stops turning in u (f = 0 there: u̇ is infinite for an instant)."""
         u = self._u0 + self._s * x
-        m, v, dm, dv, _, ddm, ddv = np.moveaxis(self._terms.energy_jet(u), -1, 0)
+        _, v, _, dv, rate, _, ddv, j, dj, drate = np.moveaxis(
+            self._terms.energy_jet(u), -1, 0)
+        _, _, _, _, _, _, _, _, ddj, ddrate = np.moveaxis(
+            self._terms.energy_jet(u, 1), -1, 0)
         room = self.energy - v
         if not np.all(room > 0):
             raise RuntimeError('E - V reached 0: the motion turns back (no quadrature)')
-        f = np.sqrt(m / (2 * room))
-        g1 = 0.5 * dm / m + 0.5 * dv / room                      # (ln f)′ in u
-        g2 = 0.5 * ddm / m - 0.5 * (dm / m) ** 2 + 0.5 * ddv / room + 0.5 * (dv / room) ** 2
-        return f, self._s * f * g1, f * (g2 + g1 * g1)
+        a = np.sqrt(j / (2 * room))
+        g1 = 0.5 * dj / j + 0.5 * dv / room                      # (ln a)′ in u
+        g2 = 0.5 * ddj / j - 0.5 * (dj / j) ** 2 + 0.5 * ddv / room + 0.5 * (dv / room) ** 2
+        da, dda = a * g1, a * (g2 + g1 * g1)
+        f = rate * a
+        return f, self._s * (drate * a + rate * da), ddrate * a + 2 * drate * da + rate * dda
 
     def _extend(self):
         """Tabulate one more cycle of nodes."""
@@ -119,6 +131,15 @@ class DriftQuadrature(PhaseSolution):
             self._first += j
 
     def _evaluate(self, t):
+        u, w = self.state(t)
+        rate = self._terms.energy_jet(u)[..., 4]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return u, w / rate
+
+    def state(self, t):
+        """(u, w) at times t (s): the phase and the angular speed about AB,
+        w = σ √(2(E − V)/J) (rad/s, finite where the body stops turning in u)."""
+        t = np.asarray(t, dtype=float)
         if t.size == 0:
             return np.zeros(0), np.zeros(0)
         if float(np.min(t)) < self._t[0]:
@@ -139,8 +160,9 @@ class DriftQuadrature(PhaseSolution):
                 break
         x = self._x[j] + s * self._h
         u = self._u0 + self._s * x
-        m, v = np.moveaxis(self._terms.energy_jet(u)[..., :2], -1, 0)
-        return u, self._s * np.sqrt(2 * np.maximum(self.energy - v, 0.0) / m)
+        jet = self._terms.energy_jet(u)
+        return u, self._s * np.sqrt(2 * np.maximum(self.energy - jet[..., 1], 0.0)
+                                    / jet[..., 7])
 
 
 class SceneWell:
@@ -204,7 +226,8 @@ class OscillationSolution(PhaseSolution):
             with np.errstate(divide='ignore', invalid='ignore'):
                 rate = np.where(end, np.sqrt(m * r / np.where(phi == 0, *slopes)),
                                 r * np.abs(np.sin(phi)) * np.sqrt(m / (2 * room)))
-            if not (np.all(np.isfinite(rate)) and np.all(rate > 0)):
+            # dt/dφ vanishes at isolated phases where the body stops turning in u
+            if not (np.all(np.isfinite(rate)) and np.all(rate >= 0) and np.mean(rate) > 0):
                 raise RuntimeError('E - V is not positive between the turning points')
             if spectral_tail(rate) < self.TAIL:
                 break
@@ -264,21 +287,33 @@ def _within(phases, u, side):
     return candidates[(travel > 0) & (travel <= TWO_PI)]
 
 
-def conservative_solution(terms, u0, u_dot0):
+def conservative_solution(terms, u0, u_dot0, angular_speed=None):
     """The closed-form solution of a conservative scene from (u0 (rad), u̇0 (rad/s)), or None.
 
     Module docstring: rest, rolling on (DriftQuadrature) or rocking (LibrationSolution).
+    ``angular_speed`` w0 = |ω_u(u0)| u̇0 (rad/s) replaces u̇0 if given (the one form that
+    holds where the body stops turning in u). Wells whose centre is such a stop, and starts
+    from rest at one, have no closed form here (None: DOP853 in τ).
     """
     if not terms.scene.conservative:
         raise ValueError('closed forms are for conservative scenes (no drive, no dissipation)')
-    u0, u_dot0 = float(u0), float(u_dot0)
-    m0, v0, _, dv0 = (float(x) for x in terms.energy_jet(u0)[:4])
-    energy = 0.5 * m0 * u_dot0 ** 2 + v0
+    if not terms.periodic_potential and terms.sin_b != 0:
+        return None            # V is not periodic plus a drift: a curving path (DOP853)
+    u0 = float(u0)
+    jet = terms.energy_jet(u0)
+    w0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * float(jet[4])
+    energy = 0.5 * float(jet[7]) * w0 ** 2 + float(jet[1])
+    u_dot0 = w0                                    # only its sign is used below
     scale = terms.dynamics.energy_scale
     maxima, minima = _extrema(terms)
-    if u_dot0 == 0 and (abs(dv0) <= 1e-13 * scale or any(
+    stopped = float(jet[4]) <= STOPPED * terms.turn_scale
+    if w0 == 0 and not stopped and (
+            abs(float(terms.potential_turn_slope(u0))) <= 1e-13 * scale or any(
             abs(math.remainder(u0 - p, TWO_PI)) < 1e-9 for p in maxima + minima)):
         return RestSolution(u0)
+    if w0 == 0 and stopped:
+        return RestSolution(u0) if abs(float(terms.potential_turn_slope(u0))) <= \
+            1e-13 * scale else None
     if u_dot0 != 0:
         sigma = math.copysign(1.0, u_dot0)
         if sigma * terms.drift <= DRIFT_FLOOR * scale:      # level or downhill on average
@@ -286,7 +321,7 @@ def conservative_solution(terms, u0, u_dot0):
             tops = terms.potential(ahead) if ahead.size else np.zeros(0)
             if np.all(tops < energy):
                 try:
-                    return DriftQuadrature(terms, u0, u_dot0)
+                    return DriftQuadrature(terms, u0, None, angular_speed=w0)
                 except RuntimeError:           # E − V not positive on the first cycle's nodes
                     pass
     if not (minima and maxima):
@@ -294,10 +329,11 @@ def conservative_solution(terms, u0, u_dot0):
     low, high = _around(maxima, u0, -1.0), _around(maxima, u0, 1.0)
     if energy < float(np.min(terms.potential(np.array([low, high])))):
         centre = _around(minima, low, 1.0)
-        if centre < high:                                  # one well: libration in φ
+        regular = float(terms.energy_jet(centre)[4]) > 1e-3 * terms.turn_scale
+        if centre < high and regular and float(jet[4]) > 0:    # one well: libration in φ
             well = SceneWell(terms, centre, low, high)
             try:
-                libration = LibrationSolution(well, u0 - well.centre, u_dot0,
+                libration = LibrationSolution(well, u0 - well.centre, w0 / float(jet[4]),
                                               terms.table_nodes)
                 if libration.resolved:
                     return libration

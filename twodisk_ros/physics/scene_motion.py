@@ -16,67 +16,60 @@ is the 1-DOF equation of motion (SI units, Q the generalised forces, J/rad):
   Q_drive = m ü + ½ m′ u̇² + V′ − Q_damping − Q_rolling, i.e. the torque Q_drive/|ω_u| about AB
   and the power Q_drive u̇.
 
+**Regular form.** Where the body stops turning in u (|ω_u| = 0, m = 0: a flat vertex) u̇ is
+infinite for an instant and the equation above is singular. With w = |ω_u| u̇ the angular
+speed about AB (rad/s, finite), J = m/|ω_u|² the moment of inertia about AB (> 0), ρ as
+above, and the regularised time τ, dt/dτ = |ω_u| (as
+:class:`~twodisk_ros.physics.solvers.SundmanSolution`):
+
+    du/dτ = w,   (J + μ_r ρ σ N_ẇ) dw/dτ = −½ J′ w² − |ω_u| V_γ + Q_drive + Q_damping
+                                          − μ_r ρ σ (|ω_u| N_g + N_w w²),
+
+with V_γ = dV/dγ = V′/|ω_u| (regular), Q_drive = τ |ω_u|, Q_damping = −c |ω_u| w, σ = sgn w
+and N = N_g + N_ẇ ẇ + N_w w²/|ω_u| the normal sum of
+:mod:`~twodisk_ros.physics.contact_terms` (Q_a, P): |ω_u| N is regular, so every term is.
+The speed drive prescribes w = Ω(t): du/dτ = Ω, and the drive's Q follows as above.
+
 The state carries the dissipated work W (J, ≥ 0) and the drive's work W_d (J), so that
-E(t) + W(t) − W_d(t) = E₀ is the energy balance. DOP853 (scipy, dense output) integrates
-(u, u̇, W, W_d) (speed drive: (u, W, W_d)); rolling resistance switches sign with u̇, so each
-stretch between two stops (u̇ = 0) is integrated on its own, and at a stop the body stays at
-rest if |V′ − Q_drive| ≤ μ_r k N (it sticks: the time to rest is exact). Where the flat fast
-paths hold (:func:`scene_stream`) today's :class:`~twodisk_ros.physics.motion.MotionStream` is
-used unchanged, and a conservative scene on a slope has the closed forms of
+E(t) + W(t) − W_d(t) = E₀ (E = ½ J w² + V) is the energy balance: DOP853 (scipy, dense
+output) integrates (u, w, W, W_d, t) in τ (speed drive: (u, W, W_d, t)), dW/dτ =
+−(Q_damping + Q_rolling) w, dW_d/dτ = Q_drive w. Rolling resistance switches sign with w, so
+each stretch between two stops (w = 0) is integrated on its own, and at a stop the body
+stays at rest if |V_γ − τ| ≤ μ_r ρ N_g (it sticks: the time to rest is exact). A start
+from rest exactly where |ω_u| = 0 (t(τ) would not advance) takes its first 1e-3 rad of u in
+closed form (:data:`LEAVE_STOP`). Where the flat fast paths hold (:func:`scene_stream`)
+today's :class:`~twodisk_ros.physics.motion.MotionStream` is used unchanged, and a
+conservative scene on a slope has the closed forms of
 :mod:`~twodisk_ros.physics.scene_closed` (:class:`ClosedSceneStream`).
 """
 
-from dataclasses import dataclass
 import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
-from .contact_validity import ValidityReport, check_validity
 from .motion import MotionStream
 from .scene_closed import DriftQuadrature, conservative_solution
-from .scene_terms import C2, CN, CU, DM, DW, K_G, KIM, KRE, M, SceneTerms, W
+from .cycle import TWO_PI
+from .scene_samples import Piece, SceneSamples, samples_from
+from .scene_terms import DJ, DW, J, PW, QA, RHO, SceneTerms, W
+
+#: a start from rest where |ω_u| is below this fraction of its largest value is taken in
+#: closed form over its first 1e-3 rad of u (SceneStream._leave_stop): t(τ) barely advances
+LEAVE_STOP = 1e-6
 
 __all__ = ['ClosedSceneStream', 'SceneStream', 'SceneSamples', 'scene_stream',
            'simulate_scene', 'settle', 'first_failure']
 
 
-@dataclass
-class SceneSamples:
-    """A scene's motion at sample times (arrays over ``t``; SI units)."""
-
-    t: np.ndarray                   #: s
-    phase: np.ndarray               #: u (rad)
-    phase_rate: np.ndarray          #: u̇ (rad/s)
-    phase_acceleration: np.ndarray  #: ü (rad/s²)
-    energy: np.ndarray              #: E = T + V (J), V along gravity (0 at A's start height)
-    dissipated: np.ndarray          #: W (J): work done by damping and rolling resistance
-    drive_work: np.ndarray          #: W_d (J): work done by the drive
-    drive_torque: np.ndarray        #: τ about AB (N m) (0 without drive)
-    power: np.ndarray               #: drive power τ ê·ω (W)
-    rolling_speed: np.ndarray       #: Ω = |ω_u| u̇ (rad/s), signed
-
-    @property
-    def balance(self):
-        """E + W − W_d (J): constant (= E₀) along any motion."""
-        return self.energy + self.dissipated - self.drive_work
-
-
-class _Piece:
-    """One stretch [start, end] of the motion: dense output of the state, or rest."""
-
-    def __init__(self, start, end, sol=None, rest=None):
-        self.start, self.end, self.sol, self.rest = start, end, sol, rest
-
-    def __call__(self, t):
-        if self.sol is None:
-            return np.repeat(np.asarray(self.rest, dtype=float)[:, None], len(t), axis=1)
-        return self.sol(t)
-
-
 class SceneStream:
     """Samples of a scene's motion at increasing times (DOP853, lazily in segments).
+
+    The state is (u, w, W, W_d), w = |ω_u| u̇ the angular speed about AB (rad/s), finite also
+    where the body stops turning in u (speed drive: w = Ω(t) is known, the state is
+    (u, W, W_d)). The independent variable is the regularised time τ, dt/dτ = |ω_u| (module
+    docstring), regular also where |ω_u| vanishes (a flat vertex); t is the last component of
+    the integrated state and samples are located in τ by safeguarded Newton.
 
     Parameters
     ----------
@@ -88,30 +81,36 @@ class SceneStream:
     chunk, lookahead : float
         As :class:`~twodisk_ros.physics.motion.MotionStream`: segments of at most ``chunk``
         s, reaching ``lookahead`` s beyond the times asked.
+    angular_speed : float, optional
+        w0 (rad/s) instead of u̇0 (which is then ignored): the start where |ω_u(u0)| = 0.
 
     The dense output of every segment reaching back to the earliest time of the latest
     call is kept, so :meth:`evaluate` gives the state at any time of that window (the root
     finding of :func:`first_failure` and :func:`settle`).
     """
 
-    def __init__(self, terms, u0, u_dot0, *, tolerance=1e-10, chunk=10.0, lookahead=0.5):
+    def __init__(self, terms, u0, u_dot0, *, tolerance=1e-10, chunk=10.0, lookahead=0.5,
+                 angular_speed=None):
         if not isinstance(terms, SceneTerms):
             raise TypeError(f'terms must be a SceneTerms, got {type(terms).__name__}')
         self.terms, self.scene, self.tolerance = terms, terms.scene, float(tolerance)
         self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
-        u0, u_dot0 = float(u0), float(u_dot0)
+        u0 = float(u0)
+        w0 = float(angular_speed) if angular_speed is not None else \
+            float(u_dot0) * float(terms.rows(u0)[W])
         self.speed_drive = self.scene.drive == 'speed'
-        self.initial_speed = u_dot0 * float(terms.rows(u0)[W])
-        self.initial_energy = float(terms.energy(u0, u_dot0))
+        self._mean_rate = float(np.mean(terms.rows(TWO_PI * np.arange(64) / 64)[:, W]))
+        self.initial_speed = w0
+        self.initial_energy = float(terms.energy_turning(u0, w0))
         self.rest_time = math.nan                   #: time the body stuck at rest (s)
         self.nfev = 0
         scale = terms.dynamics.energy_scale
-        state = [u0, 0.0, 0.0] if self.speed_drive else [u0, u_dot0, 0.0, 0.0]
+        state = [u0, 0.0, 0.0] if self.speed_drive else [u0, w0, 0.0, 0.0]
         self._atol = self.tolerance * np.array(
-            [1.0, scale, scale] if self.speed_drive else [1.0, max(abs(u_dot0), 1.0),
+            [1.0, scale, scale] if self.speed_drive else [1.0, max(abs(w0), 1.0),
                                                           scale, scale])
-        self._pieces = [_Piece(0.0, 0.0, rest=state)]
-        self._sigma = self._direction(u0, u_dot0)
+        self._pieces = [Piece(0.0, 0.0, rest=state)]
+        self._sigma = self._direction(u0, w0, 0.0)
         self._stops = [(0.0, self._sigma)]          # (time, direction of motion from then)
 
     @property
@@ -119,14 +118,15 @@ class SceneStream:
         """'DOP853' (or 'rest' once stuck)."""
         return 'rest' if math.isfinite(self.rest_time) else 'DOP853'
 
-    # -- the equation of motion (arrays or scalars) ---------------------------------------
+    # -- the equation of motion per unit τ (arrays or scalars) ---------------------------
     def _terms(self, u):
+        """J, J′, |ω_u|, |ω_u|′, dV/dγ, ρ, N_g, N per w², N per ẇ at phase(s) u."""
         t = self.terms
         row = t.rows(u)
         n_g = np.sum(t.quantities_from(u, row, 0.0, 0.0)[..., :2], axis=-1)
-        return (row[..., M], row[..., DM], row[..., W], row[..., DW],
-                t.potential_slope_from(u, row), row[..., K_G], n_g,
-                row[..., C2] + row[..., C2 + 1], row[..., CU] + row[..., CU + 1])
+        return (row[..., J], row[..., DJ], row[..., W], row[..., DW],
+                t.potential_turn_slope_from(u, row), row[..., RHO], n_g,
+                row[..., PW] + row[..., PW + 1], row[..., QA] + row[..., QA + 1])
 
     def speed(self, t):
         """The speed drive's Ω(t) (rad/s), t from the stream's start (s)."""
@@ -134,78 +134,138 @@ class SceneStream:
         return cmd + (self.initial_speed - cmd) * np.exp(-np.asarray(t, dtype=float)
                                                           / self.scene.lag)
 
-    def _free(self, u, u_dot, sigma):
-        """(ü, Q_drive, dW/dt) for the free or torque-driven equation (σ = sgn u̇)."""
+    def _free(self, u, w, sigma):
+        """(dw/dτ, Q_drive, dW/dτ, |ω_u|) of the free or torque-driven equation (σ = sgn w);
+        Q per unit u (J/rad), d/dτ = |ω_u| d/dt."""
         s = self.scene
-        m, dm, w, _, dv, k, n_g, n_2, n_u = self._terms(u)
-        q_drive = s.command * w if s.drive == 'torque' else 0.0 * w
-        q_damp = -s.damping * w * w * u_dot
-        rr = s.rolling_resistance * sigma * k
-        u_ddot = (-0.5 * dm * u_dot**2 - dv + q_drive + q_damp - rr * (n_g + n_2 * u_dot**2)) \
-            / (m + rr * n_u)
-        q_roll = -rr * (n_g + n_2 * u_dot**2 + n_u * u_ddot)
-        return u_ddot, q_drive, -(q_damp + q_roll) * u_dot
+        j, dj, rate, _, dv, rho, n_g, n_2, n_w = self._terms(u)
+        q_drive = s.command * rate if s.drive == 'torque' else 0.0 * rate
+        q_damp = -s.damping * rate * w
+        rr = s.rolling_resistance * sigma * rho
+        w_tau = (-0.5 * dj * w**2 - rate * dv + q_drive + q_damp - rr * (
+            rate * n_g + n_2 * w**2)) / (j + rr * n_w)
+        q_roll = -rr * (rate * n_g + n_2 * w**2 + n_w * w_tau)
+        return w_tau, q_drive, -(q_damp + q_roll) * w, rate
 
     def _driven(self, t, u):
-        """(u̇, ü, Q_drive, dW/dt) under the speed drive."""
+        """(w, dw/dτ, Q_drive, dW/dτ, |ω_u|) under the speed drive."""
         s = self.scene
-        m, dm, w, dw, dv, k, n_g, n_2, n_u = self._terms(u)
-        omega = self.speed(t)
-        u_dot = omega / w
-        u_ddot = ((s.command - omega) / s.lag - dw * u_dot**2) / w
-        q_damp = -s.damping * w * w * u_dot
-        q_roll = -s.rolling_resistance * np.sign(u_dot) * k * (
-            n_g + n_2 * u_dot**2 + n_u * u_ddot)
-        q_drive = m * u_ddot + 0.5 * dm * u_dot**2 + dv - q_damp - q_roll
-        return u_dot, u_ddot, q_drive, -(q_damp + q_roll) * u_dot
+        j, dj, rate, _, dv, rho, n_g, n_2, n_w = self._terms(u)
+        w = self.speed(t)
+        w_tau = rate * (s.command - w) / s.lag
+        q_damp = -s.damping * rate * w
+        q_roll = -s.rolling_resistance * np.sign(w) * rho * (
+            rate * n_g + n_2 * w**2 + n_w * w_tau)
+        q_drive = j * w_tau + 0.5 * dj * w**2 + rate * dv - q_damp - q_roll
+        return w, w_tau, q_drive, -(q_damp + q_roll) * w, rate
 
-    def _direction(self, u, u_dot):
-        """sgn(u̇), or at u̇ = 0 the way the body starts to move (0: it stays at rest)."""
-        if u_dot != 0 or self.speed_drive:
-            return math.copysign(1.0, u_dot)
+    def _direction(self, u, w, t):
+        """sgn w, or at w = 0 the way the body starts to move (0: it stays at rest)."""
+        if w != 0 or self.speed_drive:
+            return math.copysign(1.0, w)
         s = self.scene
-        m, dm, w, _, dv, k, n_g, _, _ = (float(x) for x in self._terms(u))
-        push = (s.command * w if s.drive == 'torque' else 0.0) - dv
-        if s.rolling_resistance > 0 and abs(push) <= s.rolling_resistance * k * n_g:
+        j, _, _, _, dv, rho, n_g, _, _ = (float(x) for x in self._terms(u))
+        push = (s.command if s.drive == 'torque' else 0.0) - dv        # per unit γ (N m)
+        if s.rolling_resistance > 0 and abs(push) <= s.rolling_resistance * rho * n_g:
             return 0.0
         return math.copysign(1.0, push) if push else 0.0
 
     # -- integration ----------------------------------------------------------------------
+    def _leave_stop(self, t0, y0):
+        """A start from w = 0 where |ω_u| = 0: (piece, state) over the first instants.
+
+        There t(τ) does not advance, so the first 1e-3 rad of u are taken in closed form:
+        with the angular acceleration a at rest, γ − γ0 = ½ a t² to O(t³), and as γ − γ0 ∝
+        (u − u0)³ near the stop, u − u0 ∝ t^{2/3}; the works to the same order."""
+        s, u0, sigma = self.scene, y0[0], self._sigma
+        j, _, _, _, dv, rho, n_g, _, n_w = (float(x) for x in self._terms(u0))
+        if self.speed_drive:
+            accel = (s.command - float(self.speed(t0))) / s.lag
+        else:
+            torque = (s.command if s.drive == 'torque' else 0.0) - dv
+            rr = s.rolling_resistance * sigma * rho
+            accel = (torque - rr * n_g) / (j + rr * n_w)
+        step = math.copysign(1e-3, accel)
+        nodes, weights = np.polynomial.legendre.leggauss(8)
+        points = u0 + 0.5 * step * (nodes + 1)
+        turn = 0.5 * abs(step) * float(np.sum(weights * self.terms.rows(points)[:, W]))
+        duration = math.sqrt(2 * turn / abs(accel))
+        w1 = accel * duration
+        dissipated = (s.damping * accel**2 * duration**3 / 3
+                      + s.rolling_resistance * rho * n_g * abs(w1) * duration / 2)
+        drive = (s.command * math.copysign(turn, step) if s.drive == 'torque' else
+                 self.terms.energy_turning(u0 + step, w1) - self.terms.energy_turning(u0, 0.0)
+                 + dissipated if self.speed_drive else 0.0)
+        end = ([u0 + step, y0[-3] + dissipated, y0[-2] + drive] if self.speed_drive else
+               [u0 + step, w1, y0[-3] + dissipated, y0[-2] + drive])
+        end.append(t0 + duration)
+        begin = np.asarray(y0, dtype=float)
+        stop = np.asarray(end, dtype=float)
+
+        def state(t):
+            x = np.clip((np.asarray(t, dtype=float) - t0) / duration, 0.0, 1.0)
+            out = begin[:, None] + (stop - begin)[:, None] * x**3
+            out[0] = u0 + step * x ** (2.0 / 3.0)
+            if not self.speed_drive:
+                out[1] = w1 * x
+            return out[:-1]
+        return Piece(t0, t0 + duration, start_of=state), [float(x) for x in end]
+
     def _advance(self, t0, t1, y0):
         """Pieces covering [t0, t1] from state y0 (stops split them)."""
         pieces = []
+        y0 = list(y0) + [t0]
         while t0 < t1:
             if self._sigma == 0.0 and not self.speed_drive:
                 self.rest_time = t0 if math.isnan(self.rest_time) else self.rest_time
-                pieces.append(_Piece(t0, math.inf, rest=[y0[0], 0.0, y0[2], y0[3]]))
+                pieces.append(Piece(t0, math.inf, rest=[y0[0], 0.0, y0[2], y0[3]]))
                 return pieces
+            w_start = float(self.speed(t0)) if self.speed_drive else y0[1]
+            if w_start == 0 and float(self.terms.rows(y0[0])[W]) <= \
+                    LEAVE_STOP * self.terms.turn_scale:
+                piece, y0 = self._leave_stop(t0, y0)
+                pieces.append(piece)
+                t0 = piece.end
+                continue
             if self.speed_drive:
-                def rhs(t, y):
-                    u_dot, _, q_drive, dw = self._driven(t, y[0])
-                    return [u_dot, dw, q_drive * u_dot]
-                events = None
+                def rhs(tau, y):
+                    w, _, q_drive, dw, rate = self._driven(y[-1], y[0])
+                    return [w, dw, q_drive * w, rate]
+                events = []
             else:
                 sigma = self._sigma
 
-                def rhs(t, y):
-                    u_ddot, q_drive, dw = self._free(y[0], y[1], sigma)
-                    return [y[1], u_ddot, dw, q_drive * y[1]]
+                def rhs(tau, y):
+                    w_tau, q_drive, dw, rate = self._free(y[0], y[1], sigma)
+                    return [y[1], w_tau, dw, q_drive * y[1], rate]
 
-                def stop(t, y):
+                def stop(tau, y):
                     return y[1]
                 stop.terminal, stop.direction = True, -sigma
-                events = [stop] if self.scene.rolling_resistance > 0 else None
-            result = solve_ivp(rhs, (t0, t1), y0, method='DOP853', rtol=self.tolerance,
-                               atol=self._atol, dense_output=True, events=events)
+                events = [stop] if self.scene.rolling_resistance > 0 else []
+            def reached(tau, y):
+                return y[-1] - t1
+            reached.terminal = True
+            events = events + [reached]
+            span = (0.0, 4.0 * (t1 - t0) / self._mean_rate + 1.0)
+            atol = np.append(self._atol, self.tolerance * max(1.0, t1))
+            result = solve_ivp(rhs, span, y0, method='DOP853', rtol=self.tolerance,
+                               atol=atol, dense_output=True, events=events or None)
             if not result.success:
                 raise RuntimeError(f'scene integration failed: {result.message}')
             self.nfev += result.nfev
-            end = float(result.t[-1])
-            pieces.append(_Piece(t0, end, sol=result.sol))
-            y0 = [float(x) for x in result.y[:, -1]]
-            if result.status == 1:                  # stopped: u̇ = 0
+            y_end = [float(x) for x in result.y[:, -1]]
+            end = y_end[-1]
+            if result.status == 1 and result.t_events[-1].size:
+                end = y_end[-1] = t1               # reached t1 (to the event's rounding)
+            pieces.append(Piece(t0, end, sol=result.sol, rate=lambda u: self.terms.rows(
+                u)[..., W], steps=(result.t, result.y[-1])))
+            y0 = y_end
+            stopped = result.status == 1 and not self.speed_drive and \
+                result.t_events[0].size > 0 and self.scene.rolling_resistance > 0
+            if stopped:                             # w = 0
                 y0[1] = 0.0
-                self._sigma = self._direction(y0[0], 0.0)
+                self._sigma = self._direction(y0[0], 0.0, end)
                 self._stops.append((end, self._sigma))
             t0 = end
         return pieces
@@ -225,10 +285,10 @@ class SceneStream:
             y0 = [float(x) for x in last(np.array([end]))[:, 0]]
             span = min(self._chunk, max(float(t[-1]) - end, self._lookahead))
             self._pieces.extend(self._advance(end, end + span, y0))
-        return self.evaluate(t)
+        return self.state(t)
 
-    def evaluate(self, t):
-        """The state (u, u̇, W, W_d) (speed drive: (u, W, W_d)) at times t (s) inside the
+    def state(self, t):
+        """The state (u, w, W, W_d) (speed drive: (u, W, W_d)) at times t (s) inside the
         window already integrated: from the earliest time of the latest call to its end."""
         t = np.asarray(t, dtype=float)
         out = np.empty((3 if self.speed_drive else 4, t.size))
@@ -241,6 +301,15 @@ class SceneStream:
             out[:, inside] = self._pieces[i](t[inside])
         return out
 
+    def evaluate(self, t):
+        """The state (u, u̇, W, W_d) (speed drive: (u, W, W_d)) at times t (s) inside the
+        window (:meth:`state`; u̇ = w/|ω_u| is inf where the body stops turning in u)."""
+        y = self.state(t)
+        if not self.speed_drive:
+            with np.errstate(divide='ignore', invalid='ignore'):
+                y[1] = y[1] / self.terms.rows(y[0])[..., W]
+        return y
+
     def sample(self, t):
         """(u, u̇) at times t (s, increasing, not before earlier calls)."""
         s = self.samples(t)
@@ -252,32 +321,28 @@ class SceneStream:
         return self._samples_of(t, self._states(t))
 
     def samples_at(self, t):
-        """:class:`SceneSamples` at times t (s) inside the window (:meth:`evaluate`)."""
+        """:class:`SceneSamples` at times t (s) inside the window (:meth:`state`)."""
         t = np.asarray(t, dtype=float)
-        return self._samples_of(t, self.evaluate(t))
+        return self._samples_of(t, self.state(t))
 
     def _samples_of(self, t, y):
         """The samples from the states y at times t, vectorised over the samples."""
         u = y[0]
         if self.speed_drive:
-            u_dot, u_ddot, q_drive, _ = self._driven(t, u)
+            w, w_tau, q_drive, _, rate = self._driven(t, u)
         else:
-            u_dot = y[1]
-            sigma = self._sigma_at(t, u_dot)
-            u_ddot, q_drive, _ = self._free(u, u_dot, sigma)
-            u_ddot = np.where(sigma == 0.0, 0.0, u_ddot)
-        w = self.terms.rows(u)[..., W]
-        return SceneSamples(t=t, phase=u, phase_rate=u_dot, phase_acceleration=u_ddot,
-                            energy=self.terms.energy(u, u_dot), dissipated=y[-2],
-                            drive_work=y[-1], drive_torque=q_drive / w, power=q_drive * u_dot,
-                            rolling_speed=w * u_dot)
+            w = y[1]
+            sigma = self._sigma_at(t, w)
+            w_tau, q_drive, _, rate = self._free(u, w, sigma)
+            w_tau = np.where(sigma == 0.0, 0.0, w_tau)
+        return samples_from(self.terms, t, u, w, w_tau, rate, y[-2], y[-1], q_drive)
 
-    def _sigma_at(self, t, u_dot):
-        """sgn u̇, or where u̇ = 0 the direction in force after the last stop before t."""
+    def _sigma_at(self, t, w):
+        """sgn w, or where w = 0 the direction in force after the last stop before t."""
         times = np.array([time for time, _ in self._stops])
         after = np.array([sigma for _, sigma in self._stops])
         held = after[np.clip(np.searchsorted(times, t, side='right') - 1, 0, len(times) - 1)]
-        return np.where(u_dot != 0, np.sign(u_dot), held)
+        return np.where(w != 0, np.sign(w), held)
 
 
 class ClosedSceneStream:
@@ -290,7 +355,7 @@ class ClosedSceneStream:
     def __init__(self, terms, solution):
         self.terms, self.scene, self.solution = terms, terms.scene, solution
         self.initial_energy = float(solution.energy) if hasattr(solution, 'energy') else \
-            float(terms.energy(*(float(x) for x in solution(0.0))))
+            float(terms.energy_turning(*(float(np.ravel(x)[0]) for x in self.state(0.0))))
 
     @property
     def solver(self):
@@ -298,63 +363,76 @@ class ClosedSceneStream:
         return self.solution.name
 
     def sample(self, t):
-        """(u, u̇) at times t (s, increasing)."""
+        """(u, u̇) at times t (s, increasing); u̇ is inf where the body stops turning in u."""
+        s = self.samples(t)
+        return s.phase, s.phase_rate
+
+    def state(self, t):
+        """(u, w) at times t (s): the phase and the angular speed about AB (rad/s)."""
         t = np.asarray(t, dtype=float)
-        if isinstance(self.solution, DriftQuadrature) and t.size:
-            self.solution.forget_before(float(t[0]))
+        if hasattr(self.solution, 'state'):
+            return self.solution.state(t)
         u, u_dot = self.solution(t)
-        return u, u_dot
+        return u, u_dot * self.terms.energy_jet(u)[..., 4]
 
     def samples(self, t):
         """:class:`SceneSamples` at times t (s, increasing)."""
         t = np.asarray(t, dtype=float)
-        u, u_dot = self.sample(t)
-        return self._samples_of(t, u, u_dot)
+        if isinstance(self.solution, DriftQuadrature) and t.size:
+            self.solution.forget_before(float(t[0]))
+        return self._samples_of(t, *self.state(t))
 
     def samples_at(self, t):
         """:class:`SceneSamples` at any times t (s) the solution still holds."""
         t = np.asarray(t, dtype=float)
-        return self._samples_of(t, *self.solution(t))
+        return self._samples_of(t, *self.state(t))
 
-    def _samples_of(self, t, u, u_dot):
-        m, v, dm, dv, w = np.moveaxis(self.terms.energy_jet(u)[..., :5], -1, 0)
+    def _samples_of(self, t, u, w):
+        jet = self.terms.energy_jet(u)
+        w_tau = -(0.5 * jet[..., 8] * w**2 + jet[..., 3]) / jet[..., 7]
         zero = np.zeros(t.shape)
-        return SceneSamples(t=t, phase=u, phase_rate=u_dot,
-                            phase_acceleration=-(0.5 * dm * u_dot**2 + dv) / m,
-                            energy=0.5 * m * u_dot**2 + v, dissipated=zero, drive_work=zero,
-                            drive_torque=zero, power=zero,
-                            rolling_speed=w * u_dot)
+        return samples_from(self.terms, t, u, w, w_tau, jet[..., 4], zero, zero, zero)
 
 
 def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10, terms=None,
-                 chunk=10.0, lookahead=0.5):
+                 chunk=10.0, lookahead=0.5, angular_speed=None):
     """The motion of a scene from (u0 (rad), u̇0 (rad/s)): closed forms where they hold.
 
+    ``angular_speed`` w0 = |ω_u(u0)| u̇0 (rad/s) replaces u̇0 if given: the one form of the
+    start where the body stops turning in u (u̇0 infinite).
+
     * flat, free, conservative (``Scene()``): today's dynamic MotionStream, bit for bit;
-    * speed drive whose command equals the initial speed (Ω₀ = |ω_u(u0)| u̇0, to 1e-12): the
+    * speed drive whose command equals the initial speed (Ω₀ = w0, to 1e-12): the
       motion is today's kinematic MotionStream on any slope and with any dissipation (u(t)
       is then kinematic; only the drive torque depends on the scene);
     * conservative on a slope, ``method='table'``: the closed forms of
       :func:`~twodisk_ros.physics.scene_closed.conservative_solution` (rolling on, rocking,
       rest) in a :class:`ClosedSceneStream`;
-    * otherwise a :class:`SceneStream` (DOP853; ``terms`` reused if given).
+    * otherwise a :class:`SceneStream` (DOP853 in t, or in τ where the body stops turning in
+      u; ``terms`` reused if given).
     """
     kwargs = dict(method=method, tolerance=tolerance, chunk=chunk, lookahead=lookahead)
+    rate0 = float(dynamics.angular_speed_per_phase(u0))
+    omega0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * rate0
+    if angular_speed is not None:
+        if dynamics.general:
+            kwargs['angular_speed'] = omega0
+        else:                   # the ellipse turns everywhere: today's state (u, u̇)
+            u_dot0 = omega0 / rate0
     if scene.flat_free:
         return MotionStream(dynamics, u0, u_dot0, mode='dynamic', **kwargs)
     if scene.drive == 'speed':
-        omega0 = float(u_dot0) * float(dynamics.angular_speed_per_phase(u0))
         if abs(omega0 - scene.command) <= 1e-12 * max(abs(omega0), abs(scene.command)) \
                 and omega0 != 0:
             return MotionStream(dynamics, u0, u_dot0, mode='kinematic', **kwargs)
     if terms is None:
         terms = SceneTerms(dynamics, scene)
     if scene.conservative and method == 'table':
-        solution = conservative_solution(terms, u0, u_dot0)
+        solution = conservative_solution(terms, u0, None, angular_speed=omega0)
         if solution is not None:
             return ClosedSceneStream(terms, solution)
-    return SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=chunk,
-                       lookahead=lookahead)
+    return SceneStream(terms, u0, None, tolerance=tolerance, chunk=chunk,
+                       lookahead=lookahead, angular_speed=omega0)
 
 
 def simulate_scene(terms, t_eval, u0, u_dot0, *, tolerance=1e-10):
@@ -365,96 +443,5 @@ def simulate_scene(terms, t_eval, u0, u_dot0, *, tolerance=1e-10):
     return stream.samples(t_eval)
 
 
-def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolerance=1e-10):
-    """When a dissipative free body comes to rest: (time (s), u (rad), SceneEquilibrium).
-
-    The criterion: the body is at rest when it sticks (rolling resistance: u̇ = 0 with
-    |V′ − Q_drive| ≤ μ_r k N, the stop located by DOP853's event to its tolerance), or when
-    its energy above the bottom of the well it oscillates in first falls to ``rest_energy``
-    × M g L: E(t) − V(u*) = ε M g L (damping alone only approaches u* exponentially; E − V*
-    decreases monotonically, so that instant is unique). It is bracketed on a grid of step/8
-    s and located by Brent's method on the dense output (to 1e-9 s).
-    (nan, nan, None) if not at rest by ``t_max`` s (e.g. it rolls down the slope).
-    """
-    stable = [eq for eq in terms.equilibria() if eq.stable]
-    stream = SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=10 * step)
-    threshold = rest_energy * terms.dynamics.energy_scale
-
-    def excess(samples):
-        """E − V(u*) for the stable equilibrium within π/4 of each sample (J; 1e300 if
-        none), and (that equilibrium, its phase)."""
-        best, which = np.full(samples.t.shape, 1e300), [None] * samples.t.size
-        for eq in stable:
-            centre = eq.phase + 2 * math.pi * np.round((samples.phase - eq.phase) / (2 * math.pi))
-            gap = samples.energy - terms.potential(centre)
-            closer = np.abs(samples.phase - centre) < math.pi / 4
-            for i in np.flatnonzero(closer & (gap < best)):
-                best[i], which[i] = gap[i], (eq, centre[i])
-        return best, which
-    t = 0.0
-    while t < t_max:
-        grid = np.linspace(t, t + step, 9)
-        samples = stream.samples(grid)
-        gap, which = excess(samples)
-        if math.isfinite(stream.rest_time) and stream.rest_time <= grid[-1]:
-            rest = stream.samples_at(np.array([stream.rest_time]))
-            near = excess(rest)[1][0]
-            return stream.rest_time, float(rest.phase[0]), near[0] if near else None
-        below = np.flatnonzero(gap <= threshold)
-        if below.size:
-            i = int(below[0])
-            if i == 0:
-                return float(grid[0]), float(samples.phase[0]), which[0][0]
-            time = brentq(lambda x: float(excess(stream.samples_at(np.array([x])))[0][0])
-                          - threshold, grid[i - 1], grid[i], xtol=1e-9)
-            return time, float(stream.samples_at(np.array([time])).phase[0]), which[i][0]
-        t = grid[-1]
-    return math.nan, math.nan, None
-
-
-def first_failure(terms, samples, stream=None, *, resolution=0.01):
-    """Where the rolling model first fails along sampled motion: lift-off or slip.
-
-    Returns a :class:`~twodisk_ros.physics.contact_validity.ValidityReport`, forces with the
-    tilted gravity. Without ``stream`` the time is the first sample at which N_A < 0, N_B < 0
-    or μ_required > the scene's friction (the sampling's resolution: a short lift-off
-    between two samples is missed). With the stream that produced ``samples`` (its latest
-    call; a SceneStream or ClosedSceneStream) the dense output is scanned between the
-    samples, every ``resolution`` rad of u at most, up to the first failing sample, and the
-    first sign change of N_A, N_B or μ − μ_required is located by Brent's method (to
-    1e-12 s); ``index`` is then the first sample after it.
-    """
-    friction = terms.scene.friction
-    forces = terms.forces(samples.phase, samples.phase_rate, samples.phase_acceleration)
-    report = check_validity(samples.t, forces, friction)
-    if not hasattr(stream, 'samples_at') or samples.t.size < 2:
-        return report
-    last = samples.t.size - 1 if report.valid else report.index
-    t, u = samples.t[:last + 1], samples.phase[:last + 1]
-    pieces = np.maximum(1, np.ceil(np.abs(np.diff(u)) / resolution)).astype(int)
-    fine = np.concatenate([np.linspace(a, b, k, endpoint=False)
-                           for a, b, k in zip(t[:-1], t[1:], pieces)] + [t[-1:]])
-    names = ['lift-off A', 'lift-off B'] + ([] if math.isinf(friction) else ['slip'])
-
-    def margins(times):
-        s = stream.samples_at(np.atleast_1d(times))
-        f = terms.forces(s.phase, s.phase_rate, s.phase_acceleration)
-        out = [f.normal_a, f.normal_b]
-        if 'slip' in names:
-            out.append(np.clip(friction - f.mu_required, -1e300, 1e300))
-        return np.stack(out)
-    bad = np.flatnonzero(np.any(margins(fine) < 0, axis=0))
-    if bad.size == 0 or bad[0] == 0:
-        return report
-    low, high = float(fine[bad[0] - 1]), float(fine[bad[0]])
-    before, after = margins(low)[:, 0], margins(high)[:, 0]
-    roots = [(brentq(lambda x, k=k: float(margins(x)[k, 0]), low, high, xtol=1e-12), names[k])
-             for k in range(len(names)) if before[k] >= 0 > after[k]]
-    time, kind = min(roots)
-    index = int(np.searchsorted(samples.t, time))
-    if kind == 'slip':
-        reason = (f'the body would slip at t = {time:.9g} s: mu_required reaches mu = '
-                  f'{friction:g}')
-    else:
-        reason = f'contact {kind[-1]} would lift off at t = {time:.9g} s: N_{kind[-1]} = 0'
-    return ValidityReport(False, time, index, kind, reason)
+# the refined event times live in scene_events (they read SceneStream's dense output)
+from .scene_events import first_failure, settle  # noqa: E402  (re-exported, public API)

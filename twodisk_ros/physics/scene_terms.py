@@ -29,18 +29,28 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .contact_forces import ContactForceModel, squeeze_split
+from .contact_terms import ForceTerms
 from .cycle import TWO_PI
 from .scene import Scene, quaternion_product
 from .spectral import spectral_derivative
 from .tables import HermiteTable
 
-__all__ = ['SceneTerms', 'SceneForces', 'SceneEquilibrium']
+__all__ = ['SceneTerms', 'SceneForces', 'SceneEquilibrium', 'STOPPED']
+
+#: |ω_u| below this fraction of its largest value is a stop (the body does not turn in u)
+STOPPED = 1e-9
+#: a cycle's turn within this fraction of 2π is 2π (V periodic plus a drift per cycle)
+TURN_FLOOR = 1e-9
 
 # columns of the table
 # m, m′, |ω_u|, |ω_u|′, h, h′, p (Re, Im), k = |dG/du|
 M, DM, W, DW, H, DH, P, K_G = 0, 1, 2, 3, 4, 5, 6, 8
 CN, KRE, KIM, C2, CU, EDGE = 9, 15, 21, 27, 33, 39
-WIDTH = 41
+# per unit turn γ (regular where the body stops turning in u): ρ = |dG/dγ| (the distance of
+# G from AB), c·n and e^{iα_p}(c·t1 + i c·m) (c = dG/dγ), the quantities per ẇ and per w²
+# (contact_terms' Q_a and P) and J, J′
+RHO, CGN, CGP, QA, PW, J, DJ = 41, 42, 43, 45, 51, 57, 58
+WIDTH = 59
 
 
 @dataclass
@@ -70,7 +80,7 @@ class SceneEquilibrium:
     """A rest pose on the slope (V′ = 0) and what holds it."""
 
     phase: float            #: u* (rad) in [0, 2π)
-    stable: bool            #: V″(u*) > 0
+    stable: bool            #: (dV/dγ)′(u*) > 0 (V″ > 0 where the body turns in u)
     period: float           #: small-oscillation period 2π √(m/V″) (s); nan if unstable
     normal_a: float         #: N_A at rest (N)
     normal_b: float         #: N_B at rest (N)
@@ -127,6 +137,13 @@ class SceneTerms:
         alpha_p = self.cycle.heading(u) - self.turn_rate * u
         rot = np.exp(1j * alpha_p)[:, None]
         general = self.model.coefficients(u, 'general')
+        turn = self.model.terms if self.model.terms.regular else ForceTerms(
+            body, self.dynamics.mass.inertia, self.mass, self.dynamics.gravity, n,
+            phase_only=True)
+        axis = turn.sense * e                                   # ω̂
+        c_turn = -np.cross(axis, r1)                            # dG/dγ, body frame
+        inertia_line = turn.inertia_line
+        p_turn = rot[:, 0] * (np.sum(c_turn * t1, -1) + 1j * np.sum(c_turn * m_axis, -1))
         m_u = self.dynamics.effective_mass(u)
         speed = np.linalg.norm(w, axis=-1)
         height = np.real(body.phase_height(u))
@@ -137,9 +154,12 @@ class SceneTerms:
             m_u, spectral_derivative(m_u), speed, spectral_derivative(speed), height,
             spectral_derivative(height), p.real, p.imag, np.linalg.norm(c, axis=-1),
             unit_force(normal),
-            k.real, k.imag, general[:, 6:12], general[:, 12:18], edge.real, edge.imag])
+            k.real, k.imag, general[:, 6:12], general[:, 12:18], edge.real, edge.imag,
+            np.linalg.norm(c_turn, axis=-1), np.sum(c_turn * normal, -1), p_turn.real,
+            p_turn.imag, turn.q_a, turn.p, inertia_line, spectral_derivative(inertia_line)])
         first = spectral_derivative(columns)
         self._table = HermiteTable.periodic(columns, first, spectral_derivative(first))
+        self.turn_scale = float(np.max(speed))      #: max |ω_u| over the cycle
         self._equilibria = None
         # V = V_p(u) + drift u/2π: the periodic part tabulated once from G's composed
         # positions, the drift of one cycle composed (exact for a turn of 2π per cycle)
@@ -148,9 +168,23 @@ class SceneTerms:
             TWO_PI)) - v[0])
         jet = np.column_stack([m_u, v - self.drift * u / TWO_PI])
         slope = spectral_derivative(jet)
-        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope)])
+        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope), inertia_line,
+                               spectral_derivative(inertia_line), spectral_derivative(speed)])
         first = spectral_derivative(jet)
         self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
+        # a cycle that turns by T ≠ 2π (an egg: the path curves) has no drift: G circles the
+        # fixed point C = shift/(1 − e^{iT}) of the cycle's map, Z_G = C + e^{iλu} q(u) with q
+        # periodic; V is then bounded, not periodic plus linear, and is evaluated from q
+        turn = self.cycle.displacement.turn
+        self.periodic_potential = abs(turn - TWO_PI) <= TURN_FLOOR * TWO_PI
+        self._orbit = None
+        if not self.periodic_potential:
+            g = self.cycle.positions(u)[0]
+            self._centre = complex(self.cycle.displacement.shift) / (1 - np.exp(1j * turn))
+            q = np.exp(-1j * self.turn_rate * u) * (g[:, 0] + 1j * g[:, 1] - self._centre)
+            q = np.column_stack([q.real, q.imag])
+            first = spectral_derivative(q)
+            self._orbit = HermiteTable.periodic(q, first, spectral_derivative(first))
 
     # -- the table ----------------------------------------------------------------------------
     def rows(self, u):
@@ -174,9 +208,14 @@ class SceneTerms:
         return self.weight * (self.cos_b * h - self.sin_b * self.downhill(u))
 
     def energy_jet(self, u, derivative=0):
-        """(m, V, m′, V′, |ω_u|, m″, V″) at u (``derivative=0``) or their derivatives in u
-        (``1``), array u.shape + (7,), from one table of m, of V's periodic part (V = V_p +
-        drift u/2π) and of |ω_u|: the narrow table the closed forms and the samples read."""
+        """(m, V, m′, V′, |ω_u|, m″, V″, J, J′, |ω_u|′) at u (``derivative=0``) or their
+        derivatives in u (``1``), array u.shape + (10,), from one table of m, of V's periodic
+        part (V = V_p + drift u/2π), of |ω_u| and of J = m/|ω_u|² (kg m², the moment of
+        inertia about AB, positive also where the body stops turning in u): the narrow table
+        the closed forms and the samples read. If the cycle turns by T ≠ 2π
+        (``periodic_potential`` False) V and V′ are exact (G's orbit about the cycle map's
+        fixed point) but V″ and the derivatives (``1``) are not: the closed forms, which
+        need them, are not used then."""
         u = np.asarray(u, dtype=float)
         table = self._energy_table
         jet = table.combine(*table.weights(np.mod(u, TWO_PI))) if derivative == 0 else \
@@ -184,6 +223,13 @@ class SceneTerms:
         if derivative == 0:
             jet[..., 1] += self.drift * u / TWO_PI
         jet[..., 3 - 2 * derivative] += self.drift / TWO_PI
+        if self._orbit is not None and derivative == 0:
+            q = self._orbit(np.mod(u, TWO_PI))
+            z = self._centre + np.exp(1j * self.turn_rate * u) * (q[..., 0] + 1j * q[..., 1])
+            downhill = np.real(np.exp(1j * self.phi0) * z)
+            jet[..., 1] = self.weight * (self.cos_b * self.rows(u)[..., H]
+                                         - self.sin_b * downhill)
+            jet[..., 3] = self.potential_slope(u)
         return jet
 
     def potential(self, u):
@@ -206,6 +252,22 @@ class SceneTerms:
         u = np.asarray(u, dtype=float)
         return 0.5 * self.rows(u)[..., M] * np.square(u_dot) + self.potential(u)
 
+    def energy_turning(self, u, w):
+        """E = ½ J(u) w² + V(u) (J), w = |ω_u| u̇ the angular speed about AB (rad/s): finite
+        also where the body stops turning in u."""
+        jet = self.energy_jet(np.asarray(u, dtype=float))
+        return 0.5 * jet[..., 7] * np.square(w) + jet[..., 1]
+
+    def potential_turn_slope_from(self, u, row):
+        """dV/dγ (J/rad) from a table row at u: V′ = |ω_u| dV/dγ, regular where |ω_u| = 0."""
+        p = row[..., CGP] + 1j * row[..., CGP + 1]
+        return self.weight * (self.cos_b * row[..., CGN]
+                              - self.sin_b * np.real(self.phase_factor(u) * p))
+
+    def potential_turn_slope(self, u):
+        """dV/dγ (J/rad) at phase(s) u: its roots are the rest poses."""
+        return self.potential_turn_slope_from(u, self.rows(u))
+
     # -- contact forces -----------------------------------------------------------------------
     def quantities_from(self, u, row, u_dot, u_ddot):
         """(N_A, N_B, T_A, T_B, S, τ) at states, array (..., 6), from table rows."""
@@ -215,12 +277,31 @@ class SceneTerms:
         u_dot, u_ddot = (np.asarray(x, dtype=float)[..., None] for x in (u_dot, u_ddot))
         return gravity + u_dot**2 * row[..., C2:C2 + 6] + u_ddot * row[..., CU:CU + 6]
 
-    def forces(self, u, u_dot, u_ddot):
-        """:class:`SceneForces` at states (u (rad), u̇ (rad/s), ü (rad/s²)), broadcast."""
+    def quantities_turning_from(self, u, row, w, w_dot):
+        """(N_A, N_B, T_A, T_B, S, τ) from the angular speed w and acceleration ẇ about AB
+        (rad/s, rad/s²): Q_g + ẇ Q_a + w² P/|ω_u| (±inf where the body stops turning in u
+        and w ≠ 0: the force of a flat vertex, unbounded for an instant)."""
+        k = row[..., KRE:KRE + 6] + 1j * row[..., KIM:KIM + 6]
+        gravity = self.weight * (self.cos_b * row[..., CN:CN + 6] - self.sin_b * np.real(
+            self.phase_factor(u)[..., None] * k))
+        w, w_dot = (np.asarray(x, dtype=float)[..., None] for x in (w, w_dot))
+        s = row[..., W, None]
+        stopped = s <= STOPPED * self.turn_scale
+        square = w * w * row[..., PW:PW + 6]
+        with np.errstate(divide='ignore', invalid='ignore'):
+            inertial = np.where(stopped, np.where(square == 0, 0.0, np.copysign(
+                np.inf, square)), square / np.where(stopped, 1.0, s))
+        return gravity + w_dot * row[..., QA:QA + 6] + inertial
+
+    def forces(self, u, u_dot, u_ddot, *, turning=False):
+        """:class:`SceneForces` at states (u (rad), u̇ (rad/s), ü (rad/s²)), broadcast; with
+        ``turning=True`` the second and third arguments are w and ẇ (rad/s, rad/s²), the
+        angular speed and acceleration about AB (finite where the body stops turning in u)."""
         u, u_dot, u_ddot = np.broadcast_arrays(*(np.asarray(x, dtype=float)
                                                  for x in (u, u_dot, u_ddot)))
         row = self.rows(u)
-        q = self.quantities_from(u, row, u_dot, u_ddot)
+        q = (self.quantities_turning_from if turning else self.quantities_from)(
+            u, row, u_dot, u_ddot)
         along_a, _, _, mu = squeeze_split(*np.moveaxis(q[..., :5], -1, 0))
         edge = self.phase_factor(u) * (row[..., EDGE] + 1j * row[..., EDGE + 1])
         edge = edge / np.abs(edge)
@@ -263,15 +344,17 @@ class SceneTerms:
         return list(self._equilibria)
 
     def _find_equilibria(self):
+        # roots of dV/dγ, not of V′ = |ω_u| dV/dγ: where the body stops turning in u V′ = 0
+        # but, on a slope, the body is not at rest there
         n = self._table.last_index + 1
         u = TWO_PI * np.arange(n + 1) / n
-        slope = self.potential_slope(u)
+        slope = self.potential_turn_slope(u)
         found = []
         for i in np.flatnonzero(np.sign(slope[:-1]) * np.sign(slope[1:]) <= 0):
             if slope[i] == 0 and i > 0 and slope[i - 1] == 0:
                 continue
             root = u[i] if slope[i] == 0 else brentq(
-                lambda x: float(self.potential_slope(x)), u[i], u[i + 1], xtol=1e-15)
+                lambda x: float(self.potential_turn_slope(x)), u[i], u[i + 1], xtol=1e-15)
             found.append(self._rest(float(root) % TWO_PI))
         unique = []
         for eq in sorted(found, key=lambda e: e.phase):
@@ -282,12 +365,16 @@ class SceneTerms:
         return unique
 
     def _rest(self, u):
+        # stable where dV/dγ increases through its root (|ω_u| ≥ 0); the period
+        # 2π √(m/V″) = 2π √(J |ω_u| / (dV/dγ)′), nan where the body stops turning in u
         h = 1e-4 * min(1.0, TWO_PI / (self._table.last_index + 1) * 8)
-        curvature = float(self.potential_slope(u + h) - self.potential_slope(u - h)) / (2 * h)
-        mass = float(self.rows(u)[M])
-        period = TWO_PI * math.sqrt(mass / curvature) if curvature > 0 else math.nan
+        rise = float(self.potential_turn_slope(u + h) - self.potential_turn_slope(u - h)) / (
+            2 * h)
+        row = self.rows(u)
+        period = TWO_PI * math.sqrt(float(row[J]) * float(row[W]) / rise) \
+            if rise > 0 and float(row[W]) > STOPPED * self.turn_scale else math.nan
         f = self.forces(u, 0.0, 0.0)
-        return SceneEquilibrium(phase=u, stable=curvature > 0, period=period,
+        return SceneEquilibrium(phase=u, stable=rise > 0, period=period,
                                 normal_a=float(f.normal_a), normal_b=float(f.normal_b),
                                 mu_required=float(f.mu_required))
 

@@ -8,6 +8,11 @@ node (of any shape: the recording holds it)::
     twodisk-animate run.mcap -o run.gif --start 2 --stop 8 --fps 15 --size 480x360
     twodisk-animate -o top.gif --a 0.2 --b 0.1 --delta 0.1 --view top --forces
     twodisk-animate -o square.png --params-file config/rounded_square.yaml --stop 3
+    twodisk-animate -o slope.png --params-file config/slope.yaml --stop 3
+
+A scene (slope, drive, dissipation; README "Scenes") is drawn with its ground: the plane
+through the origin going down along +X at the slope. A simulated run is the node's batch
+run, in which no command or service call acts; a recording of a real-time run shows them.
 
 A ``.png`` output is one still: the body at ``--stop`` (default the run's end) with the
 traces from ``--start``. Outputs follow :mod:`twodisk_ros.outputs`: ``-o`` must end in
@@ -40,7 +45,8 @@ SHAPES = ('ellipse', 'superellipse', 'egg', 'points')
 #: The node's parameters a simulated run takes from options (after --params-file).
 RUN_OPTIONS = ('a', 'b', 'delta', 'theta0', 'branch', 'omega0', 'mass', 'gravity', 'mode',
                'mass_model', 'shape', 'exponent', 'egg_asymmetry', 'shape_file',
-               'arrangement', 'method')
+               'arrangement', 'method', 'slope', 'heading0', 'drive', 'rolling_resistance',
+               'damping')
 #: At most this many frames (4 min at 15 fps; ~0.09 s of drawing each at 640x480 here).
 MAX_FRAMES = 3600
 #: A simulated run is computed from 0 s up to at most this time (s): 720 001 samples.
@@ -114,6 +120,19 @@ def _parser():
                       help='points: a CSV or YAML outline (x, y in m, in order)')
     body.add_argument('--arrangement', choices=('parallel', 'swapped'))
     body.add_argument('--method', choices=('direct', 'table'))
+    scene = parser.add_argument_group(
+        'scene (the node\'s parameters; see README "Scenes")',
+        'A simulated run is the node\'s batch run: no command or service call acts in it (a '
+        'speed drive holds its starting speed, a torque drive gives 0 N m); commands, '
+        'reset and pause act in real-time runs of the node, and a recording of one shows '
+        'them. The ground is drawn through the origin, going down along +X.')
+    scene.add_argument('--slope', type=float, help='inclination of the ground (rad)')
+    scene.add_argument('--heading0', type=float,
+                       help='heading of the mean travel from straight downhill (rad)')
+    scene.add_argument('--drive', choices=('none', 'speed', 'torque'))
+    scene.add_argument('--rolling-resistance', dest='rolling_resistance', type=float,
+                       help='rolling-resistance coefficient (dimensionless, >= 0)')
+    scene.add_argument('--damping', type=float, help='viscous damping (N m s, >= 0)')
     return parser
 
 

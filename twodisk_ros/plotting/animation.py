@@ -4,7 +4,9 @@ Each frame shows the body as its two filled laminae (disk 1 blue, disk 2 orange;
 outline of ``run.body.lamina``, :mod:`~twodisk_ros.model.outline`), the
 contact segment AB (green), the traces of A and B so far on the ground, the path of G and,
 optionally, the ground forces on the body at A and B as arrows (length L for M g, L the
-body size). :func:`animate` renders a :class:`~twodisk_ros.runs.Run` (or the
+body size). A run on a slope (``run.slope`` β ≠ 0) draws its ground: in 3D the plane
+through the origin with normal (sin β, 0, cos β), going down along +X, as a gridded quad
+under the view (:attr:`_Scene.ground_quad`); seen from above, a note on the slope. :func:`animate` renders a :class:`~twodisk_ros.runs.Run` (or the
 node's settings, simulated on the fly); the command line is
 :mod:`twodisk_ros.plotting.animate_cli` (``twodisk-animate``,
 ``python -m twodisk_ros.plotting.animation``).
@@ -13,18 +15,20 @@ node's settings, simulated on the fly); the command line is
 import math
 import os
 import shutil
+import textwrap
 
 import numpy as np
 
 from . import palette
 from ..runs import Run, RunError, library_run
 
-__all__ = ['VIEWS', 'CAMERAS', 'animate', 'frame_times', 'still']
+__all__ = ['VIEWS', 'CAMERAS', 'animate', 'drawn', 'frame_times', 'still']
 
 VIEWS = ('3d', 'top')
 CAMERAS = ('auto', 'follow', 'fit')
 COLOR_1, COLOR_2 = palette.A, palette.B        # disk 1 / trace of A, disk 2 / trace of B
 COLOR_AB, COLOR_G, COLOR_FORCE = palette.AB, palette.G, palette.FORCE
+COLOR_GROUND = (0.93, 0.93, 0.90, 1.0)          # the ground pane (flat) or quad (slope)
 DPI = 100
 
 
@@ -96,7 +100,11 @@ class _Scene:
         self.low = xy.min(axis=0) - 0.9 * size
         self.high = xy.max(axis=0) + 0.9 * size
         self.half = 1.9 * size                      # half width of a following window
-        self.top = float(np.max(run.position_g[:, 2])) + size   # the body's highest point
+        self.slope = float(run.slope)
+        # the body's highest point above the ground, along Z (m)
+        self.rise = float(np.max(run.position_g @ run.ground_normal)) / math.cos(
+            self.slope) + size
+        self.ground_quad = None                    # (4, 3) corners of the drawn ground (m)
         fontsize = max(6.0, min(11.0, figure.get_figheight() * 2.3))
         self.fontsize = fontsize
         # the legend is read at the size of the picture: at least 8 px (6 pt at 100 dpi) high
@@ -105,8 +113,10 @@ class _Scene:
             self._setup_3d()
         else:
             self._setup_top()
-        figure.text(0.5, 0.985, run.label, ha='center', va='top', fontsize=fontsize * 0.75,
-                    color='0.3')
+        # the title, wrapped to the figure's width (a character ≈ 0.55 em wide)
+        chars = int(figure.get_figwidth() * 72.0 / (0.55 * 0.75 * fontsize))
+        figure.text(0.5, 0.985, textwrap.fill(run.label, max(20, chars)), ha='center',
+                    va='top', fontsize=fontsize * 0.75, color='0.3')
         self.clock = figure.text(0.03, 0.93, '', ha='left', va='top', fontsize=fontsize,
                                  family='monospace')
         self._legend()
@@ -123,12 +133,23 @@ class _Scene:
             axis.pane.set_edgecolor('0.8')
         ax.xaxis.pane.set_facecolor((1, 1, 1, 0))
         ax.yaxis.pane.set_facecolor((1, 1, 1, 0))
-        ax.zaxis.pane.set_facecolor((0.93, 0.93, 0.90, 1.0))   # the ground
+        ax.zaxis.pane.set_facecolor(COLOR_GROUND if not self.slope else (1, 1, 1, 0))
         ax.tick_params(labelsize=self.fontsize * 0.7, pad=0)
         ax.set_xlabel('X (m)', fontsize=self.fontsize * 0.8, labelpad=-4)
         ax.set_ylabel('Y (m)', fontsize=self.fontsize * 0.8, labelpad=-4)
         ax.set_zticks([])
         self.polys = Poly3DCollection([], linewidths=0.8, alpha=None)
+        if self.slope:
+            # the sloped ground: a quad under everything (drawn in this order: the ground is
+            # below the body seen from any of these elevations)
+            from mpl_toolkits.mplot3d.art3d import Line3DCollection
+            ax.computed_zorder = False
+            self.ground = Poly3DCollection([], facecolor=COLOR_GROUND, edgecolor='0.7',
+                                           linewidths=0.6, zorder=0)
+            self.ground_grid = Line3DCollection([], colors='0.8', linewidths=0.5, zorder=0.5)
+            ax.add_collection3d(self.ground, autolim=False)
+            ax.add_collection3d(self.ground_grid, autolim=False)
+            self.polys.set_zorder(2)
         ax.add_collection3d(self.polys)
         self.trace_a, = ax.plot([], [], [], color=COLOR_1, lw=1.1)
         self.trace_b, = ax.plot([], [], [], color=COLOR_2, lw=1.1)
@@ -136,15 +157,37 @@ class _Scene:
         self.segment, = ax.plot([], [], [], color=COLOR_AB, lw=2.2, marker='o', ms=2.5)
         self.centre, = ax.plot([], [], [], 'o', color=COLOR_G, ms=3)
         self.arrows = []
+        if self.slope:
+            for k, line in enumerate((self.trace_a, self.trace_b, self.path_g, self.segment,
+                                      self.centre)):
+                line.set_zorder(1 if k < 2 else 3)
         if self.camera == 'fit':
             self._limits_3d(self.low, self.high)
 
     def _limits_3d(self, low, high):
+        """Limits around [low, high] (X, Y) and from the ground's lowest point there to the
+        body's highest above it; on a slope the ground quad is moved to this window."""
         ax = self.ax
+        ground = self.run.ground_height([low[0], high[0]])
+        bottom, top = float(ground.min()), float(ground.max()) + self.rise
         ax.set_xlim(low[0], high[0])
         ax.set_ylim(low[1], high[1])
-        ax.set_zlim(0.0, self.top)
-        ax.set_box_aspect((high[0] - low[0], high[1] - low[1], self.top), zoom=1.3)
+        ax.set_zlim(bottom, top)
+        ax.set_box_aspect((high[0] - low[0], high[1] - low[1], top - bottom), zoom=1.3)
+        if self.slope:
+            x = np.array([low[0], high[0], high[0], low[0]])
+            y = np.array([low[1], low[1], high[1], high[1]])
+            self.ground_quad = np.stack([x, y, self.run.ground_height(x)], axis=-1)
+            self.ground.set_verts([self.ground_quad])
+            lines = []
+            for f in np.linspace(0.0, 1.0, 7)[1:-1]:
+                xf = low[0] + f * (high[0] - low[0])     # level lines (across the slope)
+                yf = low[1] + f * (high[1] - low[1])     # fall lines (downhill)
+                lines.append([(xf, low[1], self.run.ground_height(xf)),
+                              (xf, high[1], self.run.ground_height(xf))])
+                lines.append([(low[0], yf, self.run.ground_height(low[0])),
+                              (high[0], yf, self.run.ground_height(high[0]))])
+            self.ground_grid.set_segments(lines)
 
     def _setup_top(self):
         ax = self.ax = self.figure.add_axes((0.1, 0.2, 0.86, 0.7))
@@ -161,6 +204,10 @@ class _Scene:
         self.segment, = ax.plot([], [], color=COLOR_AB, lw=2.0, marker='o', ms=3, zorder=6)
         self.centre, = ax.plot([], [], 'o', color=COLOR_G, ms=3, zorder=7)
         self.arrows = []
+        if self.slope:
+            ax.text(0.98, 0.97, f'ground down along +X at {math.degrees(self.slope):.3g}° '
+                    f'(Z = −X tan β)', transform=ax.transAxes, ha='right', va='top',
+                    fontsize=self.fontsize * 0.7, color='0.35', zorder=9)
         if self.camera == 'fit':
             self._limits_top(self.low, self.high)
 
@@ -184,6 +231,9 @@ class _Scene:
                    Line2D([], [], color=COLOR_AB, lw=2),
                    Line2D([], [], color=COLOR_G, ls='--', lw=0.8)]
         labels = ['disk 1, trace of A', 'disk 2, trace of B', 'contact line AB', 'path of G']
+        if self.slope:
+            handles.append(Patch(fc=COLOR_GROUND, ec='0.6'))
+            labels.append(f'ground, slope {math.degrees(self.slope):.3g}°')
         if self.forces:
             handles.append(Line2D([], [], color=COLOR_FORCE, lw=1.5))
             labels.append('ground force (L ≙ Mg)' if self.view == '3d'
@@ -200,16 +250,17 @@ class _Scene:
         i = self.frames[frame]
         disk1, disk2 = run.outlines(i)
         centre1, centre2 = disk1[:-1].mean(axis=0), disk2[:-1].mean(axis=0)
-        halves = _halves(disk1, disk2, centre1, centre2)
+        self.halves = halves = _halves(disk1, disk2, centre1, centre2)  # as drawn (m)
         a, b, g = run.contact_a[: i + 1], run.contact_b[: i + 1], run.position_g[: i + 1]
         if self.camera == 'follow':
             self.window = (g[-1, :2] - self.half, g[-1, :2] + self.half)
         for line, data in ((self.trace_a, a), (self.trace_b, b)):
             data = self._clipped(data)
-            self._set_line(line, data[:, 0], data[:, 1], np.zeros(len(data)))
+            self._set_line(line, data[:, 0], data[:, 1], data[:, 2])
         clipped = self._clipped(g)
         self._set_line(self.path_g, clipped[:, 0], clipped[:, 1], clipped[:, 2])
-        self._set_line(self.segment, [a[-1, 0], b[-1, 0]], [a[-1, 1], b[-1, 1]], [0.0, 0.0])
+        self._set_line(self.segment, [a[-1, 0], b[-1, 0]], [a[-1, 1], b[-1, 1]],
+                       [a[-1, 2], b[-1, 2]])
         self._set_line(self.centre, g[-1:, 0], g[-1:, 1], g[-1:, 2])
         for arrow in self.arrows:
             arrow.remove()
@@ -349,6 +400,21 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     return len(frames)
 
 
+def drawn(run, *, at=None, start=0.0, view='3d', size=(640, 480), forces=False,
+          camera='fit'):
+    """The frame of a run at time ``at`` (s, default its end), drawn on an Agg figure (not
+    written): the scene's ``figure``, ``ax``, the drawn ``halves`` [(polygon (m), colour)],
+    the line artists (``segment`` AB, ``trace_a``, ...) and, on a slope in 3D, the
+    ``ground_quad`` (4, 3) (m). Other arguments as :func:`animate`."""
+    _check_view(view, camera)
+    at = float(run.t[-1]) if at is None else at
+    _check_span(run, start, at, 1.0)
+    shown = run.span(start, at)
+    figure = _figure(size)
+    scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None,
+                   [len(shown) - 1])
+    scene.draw(0)
+    return scene
 
 
 def still(run, path, *, at=None, start=0.0, view='3d', size=(640, 480), forces=False,
@@ -360,14 +426,8 @@ def still(run, path, *, at=None, start=0.0, view='3d', size=(640, 480), forces=F
     _check_view(view, camera)
     if os.path.splitext(os.fspath(path))[1].lower() != '.png':
         raise RunError(f'cannot write {path}: the file name must end in .png')
-    at = float(run.t[-1]) if at is None else at
-    _check_span(run, start, at, 1.0)
-    shown = run.span(start, at)
-    figure = _figure(size)
-    scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None,
-                   [len(shown) - 1])
-    scene.draw(0)
+    scene = drawn(run, at=at, start=start, view=view, size=size, forces=forces, camera=camera)
     try:
-        figure.savefig(os.fspath(path), dpi=DPI, facecolor='white')
+        scene.figure.savefig(os.fspath(path), dpi=DPI, facecolor='white')
     except OSError as error:
         raise RunError(f'cannot write {path}: {error.strerror or error}') from None
