@@ -245,6 +245,11 @@ def test_any_shape_values_give_a_valid_run_or_one_line(shape, exponent, asymmetr
     (dict(arrangement='diagonal'), 'arrangement must be one of parallel, swapped'),
     (dict(shape='egg', delta=0.1 - 1e-9), 'delta'),
     (dict(shape_file=3), 'shape_file must be a string'),
+    # a hull of sharper corners is not resolved (hull_general refuses n = 100 at run time)
+    (dict(shape='superellipse', exponent=60.0, mass_model='solid'),
+     'exponent must be <= 50 for mass_model solid'),
+    # 1000/s x 1 kg x (0.1 m)^2 = 10 N m s: stiffer damping is refused, not integrated for ever
+    (dict(damping=10.5), 'damping must be <= 1000/s x mass x max(a, b)^2 = 10 N m s'),
 ])
 def test_bad_shape_values_are_one_line_naming_the_parameter(changes, says):
     with pytest.raises(ValueError) as error:

@@ -26,6 +26,8 @@ __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', '
            'markdown_table', 'parse_recorded']
 
 B_OVER_A = (0.01, 100.0)             # allowed b/a
+DAMPING_RATE = 1000.0                # 1/s: damping <= this x mass x max(a, b)^2
+SOLID_EXPONENT = 50.0                # largest superellipse exponent of the solid hull
 DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
 SLOPE_MAX = 1.5                      # rad: |slope| allowed (86 deg; pi/2 is a wall)
 
@@ -130,7 +132,8 @@ PARAMETERS = (
     Parameter('rolling_resistance', float, 0.0, '', 'coefficient mu_r of a torque '
               'mu_r (N_A + N_B) rho about AB against the rolling, rho the distance of G from AB',
               0.0, 1.0, scene=True),
-    Parameter('damping', float, 0.0, 'N m s', 'viscous torque -damping * omega', 0.0, 1e6,
+    Parameter('damping', float, 0.0, 'N m s', 'viscous torque -damping * omega; at most '
+              '1000/s x mass x max(a, b)^2 (a spin-down no faster than ~1 ms)', 0.0, 1e6,
               scene=True),
     Parameter('friction', float, 0.5, '', 'friction coefficient mu between body and ground '
               '(.inf: no limit); slip where the motion needs more is outside the rolling '
@@ -246,6 +249,15 @@ def _check_together(s, outline=None):
     if s.drive != 'none' and s.mode != 'dynamic':
         raise ValueError(f'drive {s.drive} needs mode dynamic (mode kinematic is the speed '
                          f'drive holding |omega0|), got mode {s.mode!r}')
+    damping_limit = DAMPING_RATE * s.mass * max(a, b, s.delta) ** 2
+    if s.damping > damping_limit:
+        raise ValueError(f'damping must be <= {DAMPING_RATE:g}/s x mass x max(a, b)^2 = '
+                         f'{damping_limit:.6g} N m s for this body (a spin-down faster than '
+                         f'~1 ms is not simulated), got {s.damping!r}')
+    if s.shape == 'superellipse' and s.mass_model == 'solid' and s.exponent > SOLID_EXPONENT:
+        raise ValueError(f'exponent must be <= {SOLID_EXPONENT:g} for mass_model solid (the '
+                         'hull of sharper corners is not resolved in floating point; laminae '
+                         f'and custom take up to 100), got {s.exponent!r}')
 
 
 def _check_body_frame(body_frame, frame_id):

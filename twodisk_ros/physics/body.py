@@ -339,6 +339,9 @@ class TwoDiskBody(TwoDiskForms, RollingBody):
                                  f'hold fourth and sixth powers of the lengths, which leave '
                                  f'the float range beyond), got {value!r}')
         self.a, self.b, self.delta = a, b, delta
+        self.lamina = Ellipse(a, b)     # RollingBody: the shape (a along e2, b along e1)
+        # RollingBody: the width in u of the sharpest feature (module docstring)
+        self.feature_width = min(1.0, b / a, a / b, 2 * math.sqrt(delta / a))
         # Paper, after eq. (2): the range of θ (and ψ), cos θ_max = −a²/√(a⁴ + 4aΔb² + 4Δ²b²),
         # written as atan2 (acos of ≈ −1 would lose digits for thin disks and small Δ).
         root = math.sqrt(a**4 + 4 * a * delta * b * b + 4 * delta * delta * b * b)
@@ -369,16 +372,6 @@ class TwoDiskBody(TwoDiskForms, RollingBody):
     # -- scalar properties -------------------------------------------------------------------
     #: The ellipse body has the disk-swap symmetry; 'parallel' and 'swapped' are the same body.
     arrangement = 'parallel'
-
-    @property
-    def lamina(self):
-        """The :class:`~twodisk_ros.physics.lamina.Ellipse` (a along e2, b along e1)."""
-        return Ellipse(self.a, self.b)
-
-    @property
-    def feature_width(self):
-        """min(1, b/a, a/b, 2√(Δ/a)): the width in u of the sharpest feature (module doc)."""
-        return min(1.0, self.b / self.a, self.a / self.b, 2 * math.sqrt(self.delta / self.a))
 
     @property
     def psi_max(self):
