@@ -168,6 +168,29 @@ def test_damped_energy_balance_in_the_diagnostics(context, tmp_path):
         assert float(values['energy_balance_drift']) <= 1e-9
 
 
+@pytest.mark.parametrize('losses', [dict(damping=0.01), dict(rolling_resistance=0.01)],
+                         ids=['damping', 'rolling_resistance'])
+def test_the_time_to_rest_is_in_the_diagnostics(context, tmp_path, losses):
+    """The node's at_rest_since lies within one sample after the instant physics' settle()
+    locates by root finding on its dense output (the same criterion, a second evaluation)."""
+    from twodisk_ros.node.parameters import DEFAULTS
+    from twodisk_ros.physics.scene import Scene
+    from twodisk_ros.physics.scene_events import settle
+    from twodisk_ros.physics.scene_terms import SceneTerms
+    rate, s = 100.0, DEFAULTS
+    u0 = float(DYNAMICS.body.phase_from_theta(s.theta0, s.branch))
+    t_rest, _, _ = settle(SceneTerms(DYNAMICS, Scene(gravity=s.gravity, **losses)), u0,
+                          float(DYNAMICS.initial_phase_rate(u0, s.omega0)))
+    assert 1.0 < t_rest < 25.0
+    recording = record(context, tmp_path / 'r.mcap', duration=math.ceil(t_rest) + 1.0,
+                       rate=rate, **losses)
+    (status,) = by_topic(recording, 'diagnostics')[-1].status
+    values = {kv.key: kv.value for kv in status.values}
+    assert t_rest - 1e-9 <= float(values['at_rest_since']) <= t_rest + 1 / rate + 1e-9
+    assert float(values['energy_above_rest']) <= 1e-9 * DYNAMICS.energy_scale or \
+        'rolling_resistance' in losses
+
+
 def rotation(q):
     x, y, z, w = q
     return np.array([

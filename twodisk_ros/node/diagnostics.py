@@ -6,8 +6,11 @@ cannot stand on: from t = 0, with the reason), WARN when the invariant drifts be
 The invariant is the energy E (dynamic mode, flat free scene), the angular speed (kinematic
 mode, flat) or the energy balance E + W − W_d (any other scene: W the work done against
 damping and rolling resistance, W_d the drive's work, both from the run's start or its last
-reset).
+reset). With losses and no drive the body comes to rest on a stable pose: the values give the
+energy above it and, once at rest, the time it came to rest (``at_rest_since``, s).
 """
+
+import math
 
 import numpy as np
 
@@ -63,4 +66,17 @@ def scene_values(node, sample, i):
             ('drive_torque', float(v.drive_torque[i])), ('drive_power', float(v.power[i])),
             ('dissipated_work', float(v.dissipated[i])),
             ('drive_work', float(v.drive_work[i])),
-            ('energy0', node.simulation.energy0)]
+            ('energy0', node.simulation.energy0)] + _rest_values(node, sample, i)
+
+
+def _rest_values(node, sample, i):
+    """With losses and no drive: the energy above the nearest stable rest pose (J) and, once
+    the body is at rest (scene_simulation.REST_ENERGY), the time it came to rest (s)."""
+    motion = node.simulation.scene
+    if not motion.comes_to_rest:
+        return []
+    excess = float(motion.rest_excess(sample.phase[i], sample.scene.energy[i]))
+    values = [('energy_above_rest', excess if math.isfinite(excess) else 'not near a rest pose')]
+    if math.isfinite(motion.rested):
+        values.append(('at_rest_since', motion.rested))
+    return values

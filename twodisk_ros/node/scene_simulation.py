@@ -28,6 +28,9 @@ from ..physics.scene_motion import SceneStream, scene_stream
 from ..physics.scene_terms import SceneTerms
 
 __all__ = ['SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues', 'flat_free',
+
+#: At rest: energy above the stable rest pose at most this × M g L (as physics.scene_events).
+REST_ENERGY = 1e-9
            'frame_metadata', 'ground_normal', 'scene_of']
 
 #: rad/s: the largest |cmd_speed| (the range of omega0)
@@ -144,6 +147,7 @@ class SceneMotion:
         self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x) for x in carry)
         self.energy0 = self.carry[2]
         self.standing = (True, '')
+        self.rested = math.nan       # the time the body came to rest (s, :meth:`rest`)
         if carry is None and scene.slope != 0.0:
             self.standing = terms.standing()
 
@@ -172,6 +176,38 @@ class SceneMotion:
     def forces(self, u, u_dot, u_ddot):
         """The ground's forces (:class:`~twodisk_ros.physics.scene_terms.SceneForces`)."""
         return self.terms.forces(u, u_dot, u_ddot)
+
+    @property
+    def comes_to_rest(self):
+        """True for a free scene with losses (drive none, damping or rolling resistance)."""
+        scene = self.scene
+        return scene.drive == 'none' and bool(scene.damping or scene.rolling_resistance)
+
+    def rest_excess(self, u, energy):
+        """E − V(u*) (J) per sample: the energy above the stable rest pose u* within π/4 of u
+        (inf where there is none), arrays of the samples' u (rad) and E (J)."""
+        u, energy = np.asarray(u, dtype=float), np.asarray(energy, dtype=float)
+        excess = np.full(u.shape, np.inf)
+        for eq in self.terms.equilibria():
+            if eq.stable:
+                centre = eq.phase + 2 * np.pi * np.round((u - eq.phase) / (2 * np.pi))
+                near = np.abs(u - centre) < np.pi / 4
+                gap = energy - self.terms.potential(centre)
+                excess = np.where(near & (gap < excess), gap, excess)
+        return excess
+
+    def track_rest(self, t, u, u_dot, u_ddot, energy):
+        """Note the first time (s, the node's) at which a scene with losses is at rest, the
+        criterion of :func:`~twodisk_ros.physics.scene_events.settle`: stuck (rolling
+        resistance holds it: u̇ = ü = 0) or E − V(u*) ≤ :data:`REST_ENERGY` × M g L; judged
+        at every sample, so to within one sample period."""
+        if not self.comes_to_rest or not math.isnan(self.rested) or not len(t):
+            return
+        threshold = REST_ENERGY * self.terms.dynamics.energy_scale
+        stuck = (np.asarray(u_dot) == 0) & (np.asarray(u_ddot) == 0)
+        resting = np.flatnonzero(stuck | (self.rest_excess(u, energy) <= threshold))
+        if resting.size:
+            self.rested = float(np.asarray(t)[resting[0]])
 
     def standing_report(self):
         """A ValidityReport at t = 0 if the body cannot stand on this slope, else None."""

@@ -207,6 +207,7 @@ class Simulation:
 
     def _scene_sample(self, t, forces, time_offset):
         u, u_dot, u_ddot, values, (g, a, b, q) = self.scene.sample(t)
+        self.scene.track_rest(t + time_offset, u, u_dot, u_ddot, values.energy)
         quaternion = continuous_quaternions(q, self._last_quaternion)
         if len(quaternion):
             self._last_quaternion = quaternion[-1]
