@@ -27,11 +27,11 @@ from ..physics.scene import Scene
 from ..physics.scene_motion import SceneStream, scene_stream
 from ..physics.scene_terms import SceneTerms
 
-__all__ = ['SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues', 'flat_free',
+__all__ = ['REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues',
+           'flat_free', 'frame_metadata', 'ground_normal', 'scene_of']
 
 #: At rest: energy above the stable rest pose at most this × M g L (as physics.scene_events).
 REST_ENERGY = 1e-9
-           'frame_metadata', 'ground_normal', 'scene_of']
 
 #: rad/s: the largest |cmd_speed| (the range of omega0)
 SPEED_LIMIT = 1e3
