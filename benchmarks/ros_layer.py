@@ -196,8 +196,10 @@ def report_lines(out):
         w('The same real-time run at 1 kHz (recording on, every topic subscribed) for the '
           'ellipse (`config/oloid.yaml`, closed forms) and for non-elliptic bodies through '
           '`LaminaBody`\'s tables: `config/rounded_square.yaml` (superellipse n = 4) and '
-          '`config/egg.yaml` (with `method:=direct`: its dynamic table mode waits for a '
-          'physics fix). Columns as in the real-time table.\n')
+          '`config/egg.yaml` (the parallel egg, table method). The rounded square\'s '
+          'diagnostics say ERROR: its contact forces spike without bound where a contact '
+          'crosses a flat vertex, so it leaves the rolling model (physics, not speed). '
+          'Columns as in the real-time table.\n')
         w('| body | node achieved (Hz) | node lag (ms) | dropped | diagnostics | node CPU | '
           'listener p50 (ms) | listener p99 (ms) | listener lag (ms) |')
         w('|---|---|---|---|---|---|---|---|---|')
