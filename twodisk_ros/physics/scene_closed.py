@@ -73,6 +73,8 @@ class DriftQuadrature(PhaseSolution):
     #: that of the cycle's resolution: t(u) on the last node changed by < 1e-13 rad from
     #: STRIDE = 1 over 13 cycles of the oloid; 8 moved it by 1e-11)
     STRIDE = 4
+    #: most cycles of nodes tabulated in one batch
+    BATCH = 64
 
     def __init__(self, terms, u0, u_dot0, angular_speed=None):
         self._terms = terms
@@ -107,10 +109,11 @@ class DriftQuadrature(PhaseSolution):
         f = rate * a
         return f, self._s * (drate * a + rate * da), ddrate * a + 2 * drate * da + rate * dda
 
-    def _extend(self):
-        """Tabulate one more cycle of nodes."""
+    def _extend(self, cycles=1):
+        """Tabulate ``cycles`` more cycles of nodes (in one batch: the cost per cycle is then
+        that of the arithmetic, not of numpy's calls)."""
         start = self._first + len(self._x) - (1 if len(self._x) else 0)
-        x = self._h * np.arange(start, start + self._n + 1)
+        x = self._h * np.arange(start, start + cycles * self._n + 1)
         f, df, ddf = self._integrand(x)
         h = self._h
         panels = (0.5 * h * (f[:-1] + f[1:]) + h * h / 10 * (df[:-1] - df[1:])
@@ -131,22 +134,29 @@ class DriftQuadrature(PhaseSolution):
             self._first += j
 
     def _evaluate(self, t):
-        u, w = self.state(t)
-        rate = self._terms.energy_jet(u)[..., 4]
+        u, w, rate = self._state(t)
         with np.errstate(divide='ignore', invalid='ignore'):
             return u, w / rate
 
     def state(self, t):
         """(u, w) at times t (s): the phase and the angular speed about AB,
         w = σ √(2(E − V)/J) (rad/s, finite where the body stops turning in u)."""
+        return self._state(t)[:2]
+
+    def _state(self, t):
+        """(u, w, |ω_u|) at times t (s): one read of the energy table per call."""
         t = np.asarray(t, dtype=float)
         if t.size == 0:
-            return np.zeros(0), np.zeros(0)
+            return np.zeros(0), np.zeros(0), np.zeros(0)
         if float(np.min(t)) < self._t[0]:
             raise ValueError(f'time {float(np.min(t))!r} s is before the nodes kept '
                              f'(from {self._t[0]!r} s)')
-        while self._t[-1] < float(np.max(t)):
-            self._extend()
+        last = float(np.max(t))
+        while self._t[-1] < last:
+            # the cycles still needed if each took as long as the latest, a quarter more
+            # (rolling on downhill the cycles get shorter: this too few, else more batches)
+            took = self._t[-1] - self._t[-1 - self._n]
+            self._extend(min(self.BATCH, math.ceil(1.25 * (last - self._t[-1]) / took)))
         j = np.clip(np.searchsorted(self._t, t, side='right') - 1, 0, len(self._t) - 2)
         start, end = self._data[j].T, self._data[j + 1].T
         s = (t - start[0]) / (end[0] - start[0])            # linear guess
@@ -162,7 +172,7 @@ class DriftQuadrature(PhaseSolution):
         u = self._u0 + self._s * x
         jet = self._terms.energy_jet(u)
         return u, self._s * np.sqrt(2 * np.maximum(self.energy - jet[..., 1], 0.0)
-                                    / jet[..., 7])
+                                    / jet[..., 7]), jet[..., 4]
 
 
 class SceneWell:

@@ -363,9 +363,15 @@ class ClosedSceneStream:
         return self.solution.name
 
     def sample(self, t):
-        """(u, u̇) at times t (s, increasing); u̇ is inf where the body stops turning in u."""
-        s = self.samples(t)
-        return s.phase, s.phase_rate
+        """(u, u̇) at times t (s, increasing); u̇ is inf where the body stops turning in u.
+
+        Straight from the solution (one read of the narrow energy table at most), without
+        the wide table :meth:`samples` reads for ü and the energies."""
+        t = np.asarray(t, dtype=float)
+        if isinstance(self.solution, DriftQuadrature) and t.size:
+            self.solution.forget_before(float(t[0]))
+        u, u_dot = self.solution(t)
+        return u, u_dot
 
     def state(self, t):
         """(u, w) at times t (s): the phase and the angular speed about AB (rad/s)."""

@@ -218,8 +218,7 @@ class SceneTerms:
         need them, are not used then."""
         u = np.asarray(u, dtype=float)
         table = self._energy_table
-        jet = table.combine(*table.weights(np.mod(u, TWO_PI))) if derivative == 0 else \
-            table(np.mod(u, TWO_PI), derivative)
+        jet = table.combine(*table.weights(np.mod(u, TWO_PI), derivative))
         if derivative == 0:
             jet[..., 1] += self.drift * u / TWO_PI
         jet[..., 3 - 2 * derivative] += self.drift / TWO_PI

@@ -70,13 +70,15 @@ class HermiteTable:
             return (g0 * (y0 - y1) + g1 * d0 + g2 * s0 + g3 * s1 + g4 * d1) / self.step
         raise ValueError(f'derivative must be 0 or 1, got {derivative!r}')
 
-    def weights(self, x):
+    def weights(self, x, derivative=0):
         """Interval indices and Hermite weights at points x, for :meth:`combine`.
 
         Parameters
         ----------
         x : array_like
             Points inside the table's span (same unit as ``start`` and ``step``).
+        derivative : {0, 1}
+            Weights of f (0) or of f′ (1: :meth:`combine` then gives ``self(x, 1)``).
 
         Returns
         -------
@@ -90,6 +92,16 @@ class HermiteTable:
         t2 = t * t
         t3 = t2 * t
         w = np.empty(t.shape + (6,))
+        if derivative == 1:
+            w[..., 0] = t2 * (-30 + t * (60 - 30 * t)) / self.step
+            w[..., 1] = (1 + t2 * (-18 + t * (32 - 15 * t))) / self.step
+            w[..., 2] = (t + t2 * (-4.5 + t * (6 - 2.5 * t))) / self.step
+            w[..., 3] = -w[..., 0]
+            w[..., 4] = t2 * (-12 + t * (28 - 15 * t)) / self.step
+            w[..., 5] = t2 * (1.5 + t * (-4 + 2.5 * t)) / self.step
+            return i, w
+        if derivative != 0:
+            raise ValueError(f'derivative must be 0 or 1, got {derivative!r}')
         w[..., 0] = 1 + t3 * (-10 + t * (15 - 6 * t))
         w[..., 1] = t + t3 * (-6 + t * (8 - 3 * t))
         w[..., 2] = 0.5 * (t2 + t3 * (-3 + t * (3 - t)))
