@@ -56,11 +56,13 @@ class StopRequest:
             self.requested = name
         elif self.importing:
             # the entry point is still importing numpy, scipy and rclpy: no file, no node
-            # exists yet; SystemExit leaves the import and the interpreter quietly, exit 0
-            self.ignore_from_now()      # (Python's finalization must not die of a third)
+            # exists yet, so the process ends here, exit 0. Not SystemExit: raised inside an
+            # extension module's initialisation (scipy.optimize's HiGHS) it becomes
+            # "ImportError: initialization failed" with a traceback.
+            self.ignore_from_now()
             os.write(2, f'roller: stopped by {self.requested} during start-up: no recording '
                         'written\n'.encode())
-            raise SystemExit(0)
+            os._exit(0)
 
     def __bool__(self):
         return self.requested is not None
