@@ -65,6 +65,10 @@ def _modules():
     return sorted(PACKAGE.rglob('*.py'))
 
 
+#: Standard-library names that are public though they start with an underscore.
+PUBLIC_UNDERSCORED = {('os', '_exit')}
+
+
 def _private_reach_ins(path):
     """(line, text) of every access to a private name of another module of the package."""
     tree = ast.parse(path.read_text(encoding='utf-8'))
@@ -78,7 +82,8 @@ def _private_reach_ins(path):
         if isinstance(node, ast.Attribute) and node.attr.startswith('_') \
                 and not node.attr.startswith('__'):
             owner = node.value
-            if isinstance(owner, ast.Name) and owner.id not in ('self', 'cls'):
+            if isinstance(owner, ast.Name) and owner.id not in ('self', 'cls') \
+                    and (owner.id, node.attr) not in PUBLIC_UNDERSCORED:
                 found.append((node.lineno, f'{owner.id}.{node.attr}'))
             elif isinstance(owner, ast.Attribute):
                 found.append((node.lineno, f'….{owner.attr}.{node.attr}'))
