@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from dask_helpers import free_port, stop
+from harsh_start import harshly
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.contact_forces import ContactForceModel
 from twodisk_ros.physics.contact_validity import liftoff_speed, mu_required_kinematic
@@ -383,7 +384,8 @@ def test_unreachable_scheduler_exit_2_fast(tmp_path):
 #: client paused for good after saving chunk K (argv[1]): the test's SIGINT then always
 #: arrives mid-sweep, however fast the chunks are (no race with the sweep's end).
 _PAUSED_CLI = """
-import sys, time
+import signal, sys, time
+signal.signal(signal.SIGINT, signal.default_int_handler)  # also when started with it ignored
 import twodisk_ros.sweep.run as run
 real, pause_after = run.run_sweep, int(sys.argv[1])
 def paused(*args, **kwargs):
@@ -404,8 +406,10 @@ def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
             '--chunk-size', '1', '--workers', '1', '--quiet']
     saved_before_signal = 2
     parts = parts_folder(out)
-    proc = subprocess.Popen([sys.executable, '-c', _PAUSED_CLI, str(saved_before_signal), *args],
-                            env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(harshly([sys.executable, '-c', _PAUSED_CLI, str(saved_before_signal),
+                                     *args]),
+                            env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
     try:
         deadline = time.monotonic() + 60
         while len(list(parts.glob('chunk-*.npz'))) < saved_before_signal:

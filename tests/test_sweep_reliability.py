@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from dask_helpers import ENV, cluster
+from harsh_start import harshly
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
 from twodisk_ros.sweep.run import SweepSpec, dask_client, run_sweep
@@ -217,11 +218,15 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
 # -- interrupted and resumed -----------------------------------------------------------------
 
 #: The sweep's command line with a hook after the client's k-th finished chunk (argv[1]).
-#: SIGINT: the client signals itself (a real SIGINT through Python's handler). KILL: the
-#: client kills the `dask worker` command (nanny and worker, its process group) of a worker
-#: that is busy, then goes on.
+#: SIGINT: the client signals itself (a real SIGINT through Python's handler, which the
+#: script installs first: a suite started in the background or under nohup hands its
+#: children SIGINT ignored, and then Python installs none). KILL: the client kills the
+#: `dask worker` command (nanny and worker, its process group) of a worker that is busy, then
+#: goes on; only a group that the test's cluster started in a session of its own (the
+#: group's leader leads a session), never the client's own group.
 _HOOKED_CLI = """
 import os, signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import twodisk_ros.sweep.run as run
 real, action, after = run.run_sweep, sys.argv[1], int(sys.argv[2])
 def hooked(spec, client, *args, **kwargs):
@@ -230,11 +235,15 @@ def hooked(spec, client, *args, **kwargs):
             return
         if action == 'SIGINT':
             signal.raise_signal(signal.SIGINT)
+            sys.exit('SIGINT raised nothing')          # never fall through to the kill
         busy = [address for address, keys in client.processing().items() if keys]
         if not busy:
             sys.exit('no worker busy')
         pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
-        os.killpg(os.getpgid(pid), signal.SIGKILL)
+        group = os.getpgid(pid)
+        if group == os.getpgid(0) or os.getsid(group) != group:
+            sys.exit(f'worker {pid} is not in a session of its own: not killed')
+        os.killpg(group, signal.SIGKILL)
         print(f'killed a busy worker after {computed} chunks', file=sys.stderr)
     return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
 run.run_sweep = hooked
@@ -244,8 +253,9 @@ sys.exit(main(sys.argv[3:]))
 
 
 def _hooked(action, after, argv, timeout=180):
-    return subprocess.run([sys.executable, '-c', _HOOKED_CLI, action, str(after), *argv],
-                          env=ENV, capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(harshly([sys.executable, '-c', _HOOKED_CLI, action, str(after), *argv]),
+                          env=ENV, capture_output=True, text=True, timeout=timeout,
+                          start_new_session=True)
 
 
 @pytest.mark.slow
