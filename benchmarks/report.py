@@ -5,6 +5,7 @@ import math
 import ros_layer
 import general_shapes
 import scene_rate
+import suite_time
 import sweep_exponent
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
@@ -233,6 +234,7 @@ def write_report(path, ctx):
     out.extend(scene_rate.report_lines(ctx['scene_rate']))
     if ctx.get('sweep_exponent'):
         out.extend(sweep_exponent.report_lines(ctx['sweep_exponent']))
+    out.extend(suite_time.report_lines(ctx.get('suite_time')))
 
     # --- figure
     w('## Work-precision plot\n')

@@ -43,6 +43,7 @@ import sweep_exponent  # noqa: E402
 import sweep_scaling  # noqa: E402
 import general_shapes  # noqa: E402
 import scene_rate  # noqa: E402
+import suite_time  # noqa: E402
 
 
 def _run(cmd):
@@ -251,6 +252,8 @@ def main(argv=None):
     log('the sweep along the exponent axis: n = 2 batched, n = 4 general, per body')
     exponent = sweep_exponent.measure(quick=args.quick, log=log)
     machine['load_end'] = ' '.join(f'{x:.2f}' for x in os.getloadavg())
+    log('the test suite on a fresh clone, as CI runs it (after every other measurement)')
+    suite = suite_time.measure(quick=args.quick, log=log)
 
     # why a target was missed
     t1_why = []
@@ -317,7 +320,7 @@ def main(argv=None):
                findings=findings(results, hours, builds, fd_errors, ratios, throughput),
                target1_why=target1_why, target2_why=target2_why, target3_why=target3_why,
                ros_layer=ros, sweep_scaling=scaling, general_shapes=shapes, scene_rate=scenes,
-               sweep_exponent=exponent,
+               sweep_exponent=exponent, suite_time=suite,
                commit=_run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown',
                elapsed=elapsed)
     write_report(args.out, ctx)
@@ -338,6 +341,7 @@ def main(argv=None):
                 general_shapes=shapes,
                 scene_rate=scenes,
                 sweep_exponent=exponent,
+                suite_time=suite,
                 direct_fd_slope_error=fd_errors)
     with open(args.json, 'w') as fh:
         json.dump(data, fh, indent=1, default=lambda x: None if x != x else str(x))
