@@ -73,16 +73,34 @@ SIGNAL_CASES = [
 ]
 
 
+def _until_recording(process, target, timeout=30.0):
+    """Return once ``target`` exists (the recorder gives the file its name with its first
+    message on disk: the run is recording) or the process has ended."""
+    deadline = time.monotonic() + timeout
+    while not target.exists() and process.poll() is None:
+        assert time.monotonic() < deadline, 'the node never started recording'
+        time.sleep(0.002)
+
+
 @pytest.mark.parametrize('mode, pattern, seed', SIGNAL_CASES,
                          ids=[f'{m}-{p}-{s}' for m, p, s in SIGNAL_CASES])
 def test_signal_at_a_random_moment_leaves_a_complete_recording(tmp_path, mode, pattern, seed):
-    """Start-up, mid-chunk, during close: exit 0, no traceback, a recording that passes."""
+    """Start-up, mid-chunk, during close: exit 0, no traceback, a recording that passes.
+
+    Real time: a moment in the first 3 s (start-up or the run). Batch (15 s at 1 kHz, about a
+    second of work): seed 0 a moment in the first second from the start (start-up), seeds 1
+    and 2 a moment in the first 0.2 s after the recording got its name (mid-run, in a
+    chunk), so the batch is signalled while it runs instead of mostly after its end."""
     rng = random.Random(f'{mode}{pattern}{seed}')
-    delay = rng.uniform(0.0, 3.0)
     target = tmp_path / 'run.mcap'
     params = (['-p', 'rate:=200.0'] if mode == 'realtime'
               else ['-p', 'realtime:=false', '-p', 'rate:=1000.0', '-p', 'duration:=15.0'])
     process = roller(*params, '-p', f'record:={target}')
+    if mode == 'batch' and seed > 0:
+        _until_recording(process, target)
+        delay = rng.uniform(0.0, 0.2)
+    else:
+        delay = rng.uniform(0.0, 3.0 if mode == 'realtime' else 1.0)
     time.sleep(delay)
     try:
         for name in pattern.split('+'):
