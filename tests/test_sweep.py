@@ -53,10 +53,39 @@ def client():
 
 @pytest.fixture(scope='module')
 def local(client):
-    """The sweep's n = 2 plane (its only exponent: the ellipse)."""
+    """The sweep of the ellipse alone (no exponent named): 2-D, ``exponent`` a scalar."""
     dataset = run_sweep(_spec(), client, progress=None).dataset
-    assert dataset['exponent'].values.tolist() == [2.0]
-    return dataset.sel(exponent=2.0)
+    assert dataset['cycle_advance'].dims == ('b_over_a', 'delta_over_a')
+    assert dataset['exponent'].ndim == 0 and float(dataset['exponent']) == 2.0
+    return dataset
+
+
+def _user_code(dataset):
+    """What a user of the 2-D output wrote before the exponent axis existed."""
+    return float(dataset.sel(b_over_a=1.0, delta_over_a=0.5, method='nearest')['cycle_advance'])
+
+
+def test_without_an_exponent_axis_the_output_is_2d_in_memory_netcdf_and_zarr(client, local,
+                                                                            tmp_path):
+    import xarray as xr
+    expected = float(local['cycle_advance'].sel(b_over_a=1.0, delta_over_a=0.5))
+    assert _user_code(local) == expected
+    for name in ('map.nc', 'map.zarr'):
+        run_sweep(_spec(), client, out=tmp_path / name, progress=None, overwrite=False)
+        with xr.open_dataset(tmp_path / name) as opened:      # plain xarray, engine guessed
+            assert dict(opened.sizes) == {'b_over_a': 3, 'delta_over_a': 4}, name
+            assert float(opened['exponent']) == 2.0 and opened['exponent'].attrs['units']
+            assert _user_code(opened) == expected, name
+
+
+def test_named_exponents_give_the_exponent_axis(client, local):
+    spec = SweepSpec(_spec().b_over_a, _spec().delta_over_a, chunk_size=CHUNK, exponent=[2.0])
+    dataset = run_sweep(spec, client, progress=None).dataset
+    assert dataset['cycle_advance'].dims == ('exponent', 'b_over_a', 'delta_over_a')
+    np.testing.assert_array_equal(dataset['cycle_advance'].sel(exponent=2.0).values,
+                                  local['cycle_advance'].values)     # the same bodies
+    with pytest.raises(TypeError):       # the 3-D selection is not one number
+        _user_code(dataset)
 
 
 def _library(b, d, reference_speed=0.5):

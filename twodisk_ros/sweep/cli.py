@@ -150,7 +150,7 @@ def _exponents(args):
         exponent_values('--exponent-range', sorted({start, stop}))    # the ends named
         return exponent_values('--exponent-range', np.linspace(start, stop, n))
     if args.exponent is None:
-        return np.array([ELLIPSE_EXPONENT])
+        return None          # the ellipse alone, without an exponent axis (a 2-D output)
     return exponent_values('--exponent', [_number('--exponent', v) for v in args.exponent])
 
 
@@ -181,7 +181,8 @@ def _checked(args):
                      f'{B_OVER_A[1]:g}] (the range the physics is stated for)')
     d = _grid_range('--delta-over-a', args.delta_over_a)
     exponents = _exponents(args)
-    general = int(np.count_nonzero(exponents != ELLIPSE_EXPONENT))
+    counted = np.array([ELLIPSE_EXPONENT]) if exponents is None else exponents
+    general = int(np.count_nonzero(counted != ELLIPSE_EXPONENT))
     speed = _number('--reference-speed', args.reference_speed)
     if not 0 <= speed <= MAX_REFERENCE_SPEED:
         raise _Usage(f'--reference-speed must be finite, 0 <= W <= {MAX_REFERENCE_SPEED:g}, '
@@ -197,7 +198,7 @@ def _checked(args):
                           f'store')
     if fmt is None:
         check_output(args.out, suffixes=tuple(FORMATS))    # the refusal of the suffix
-    check_size(b[2], d[2], chunk, fmt, exponents.size, general)
+    check_size(b[2], d[2], chunk, fmt, counted.size, general)
     check_some_valid(d[0])
     if fmt == 'zarr' and args.keep_parts:
         raise _Usage('--keep-parts is for a .nc output only (a .zarr store is its own resume '

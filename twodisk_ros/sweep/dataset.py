@@ -1,7 +1,9 @@
 """The result of a sweep as an xarray Dataset, its NetCDF file, and the layout of its Zarr store.
 
 Coordinates ``exponent`` (the superellipse exponent n; 2 is the ellipse), ``b_over_a`` and
-``delta_over_a`` (dimensionless, a = 1), the dimensions in that order; one float64 variable per
+``delta_over_a`` (dimensionless, a = 1), the dimensions in that order when the request named
+exponents; without them (the ellipse alone) the dimensions are ``b_over_a`` and
+``delta_over_a`` and ``exponent`` is a scalar coordinate (2.0); one float64 variable per
 name of :data:`~twodisk_ros.sweep.quantities.VARIABLES` with ``units`` and ``description``
 attributes (and, when the grid has an exponent n != 2, ``general_path``: what the variable
 means there, or why it is NaN), NaN where a body failed; ``failure`` (str, '' on success)
@@ -64,7 +66,19 @@ def _exponents(exponent):
     return np.atleast_1d(np.asarray(2.0 if exponent is None else exponent, dtype=float))
 
 
-def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None):
+def _layout(b, d, n, axis):
+    """(dims, shape, coordinates) of the output: 3-D with the exponent axis, else 2-D with
+    ``exponent`` (one value) a scalar coordinate."""
+    coords = _coords(b, d, n)
+    if axis:
+        return DIMS, (n.size, b.size, d.size), coords
+    if n.size != 1:
+        raise ValueError(f'{n.size} exponents need the exponent axis')
+    coords['exponent'] = ((), n[0], coords['exponent'][2])
+    return DIMS[1:], (b.size, d.size), coords
+
+
+def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None, exponent_axis=None):
     """The sweep's Dataset from flat per-point arrays.
 
     Parameters
@@ -79,6 +93,10 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None):
         Global attributes (str, int or float values).
     exponent : 1-D array_like, optional
         The exponents n (default: 2 alone, the ellipse).
+    exponent_axis : bool, optional
+        Whether the output has the dimension ``exponent`` (default: when ``exponent`` is
+        given); without it the Dataset is 2-D (b_over_a, delta_over_a) and ``exponent`` is a
+        scalar coordinate.
 
     Returns
     -------
@@ -87,18 +105,20 @@ def build_dataset(b_over_a, delta_over_a, arrays, attrs, exponent=None):
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
     n = _exponents(exponent)
-    shape = (n.size, b.size, d.size)
+    dims, shape, coords = _layout(b, d, n, exponent is not None if exponent_axis is None
+                                  else exponent_axis)
     attrs_of = _variable_attrs(bool(np.any(n != 2.0)))
-    data = {name: (DIMS, np.asarray(arrays[name], dtype=float).reshape(shape), attrs_of[name])
+    data = {name: (dims, np.asarray(arrays[name], dtype=float).reshape(shape), attrs_of[name])
             for name in VARIABLES}
     failure = np.asarray(arrays['failure'], dtype=str).reshape(shape)
-    data['failure'] = (DIMS, failure, attrs_of['failure'])
-    return xr.Dataset(data, coords=_coords(b, d, n), attrs=dict(attrs))
+    data['failure'] = (dims, failure, attrs_of['failure'])
+    return xr.Dataset(data, coords=coords, attrs=dict(attrs))
 
 
-def template_dataset(b_over_a, delta_over_a, block, attrs, exponent=None):
+def template_dataset(b_over_a, delta_over_a, block, attrs, exponent=None, exponent_axis=None):
     """The sweep's Dataset with lazy (Dask) variables, and the encoding that chunks them in
-    ``block`` = (1, rows, columns) (exponents ``exponent``, default 2 alone): what
+    ``block`` = (1, rows, columns) (exponents ``exponent``, default 2 alone; without the
+    exponent axis, as :func:`build_dataset`, the chunks are (rows, columns)): what
     ``to_zarr(compute=False, encoding=...)`` lays out as an empty store. Floats NaN,
     ``failure`` '' (variable-length UTF-8 strings), ``computed`` 0
     (int8; 1 once a block is complete). Returns (Dataset, encoding).
@@ -109,16 +129,18 @@ def template_dataset(b_over_a, delta_over_a, block, attrs, exponent=None):
     b = np.asarray(b_over_a, dtype=float)
     d = np.asarray(delta_over_a, dtype=float)
     n = _exponents(exponent)
-    shape, chunks = (n.size, b.size, d.size), tuple(int(x) for x in block)
+    dims, shape, coords = _layout(b, d, n, exponent is not None if exponent_axis is None
+                                  else exponent_axis)
+    chunks = tuple(int(x) for x in block)[-len(dims):]
     attrs_of = _variable_attrs(bool(np.any(n != 2.0)))
-    data = {name: (DIMS, da.full(shape, np.nan, chunks=-1), attrs_of[name])
+    data = {name: (dims, da.full(shape, np.nan, chunks=-1), attrs_of[name])
             for name in VARIABLES}
-    data['failure'] = (DIMS, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=-1),
+    data['failure'] = (dims, da.full(shape, '', dtype=np.dtypes.StringDType(), chunks=-1),
                        attrs_of['failure'])
-    data[COMPUTED] = (DIMS, da.zeros(shape, dtype=np.int8, chunks=-1), {
+    data[COMPUTED] = (dims, da.zeros(shape, dtype=np.int8, chunks=-1), {
         'units': '1', 'description': '1 where the point was computed and written (its chunk '
                                      'complete), 0 where not yet (an interrupted sweep)'})
-    dataset = xr.Dataset(data, coords=_coords(b, d, n), attrs=dict(attrs))
+    dataset = xr.Dataset(data, coords=coords, attrs=dict(attrs))
     return dataset, {name: {'chunks': chunks} for name in dataset.data_vars}
 
 

@@ -268,7 +268,7 @@ def _run_in_memory(spec, client, out, progress, on_chunk, fresh, keep_parts, ove
             cache.remove()      # nothing worth resuming: the same grid fails the same way
         raise _all_masked(spec, failure.flat[0])
     run.dataset = build_dataset(spec.b_over_a, spec.delta_over_a, arrays, spec.attrs(),
-                                exponent=spec.exponent)
+                                exponent=spec.exponent, exponent_axis=spec.exponent_axis)
     if out:
         try:
             check_output(out, overwrite=overwrite)

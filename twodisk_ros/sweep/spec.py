@@ -26,9 +26,9 @@ from .request import DEFAULT_CHUNK_SIZE, ELLIPSE_EXPONENT, SweepError, exponent_
 
 __all__ = ['SweepSpec', 'MANIFEST_FORMAT', 'block_shape']
 
-#: Version of :meth:`SweepSpec.manifest` (3: the exponent axis; 2: rectangular blocks; 1 was
-#: runs of the flat grid).
-MANIFEST_FORMAT = 3
+#: Version of :meth:`SweepSpec.manifest` (4: whether the output has the exponent axis; 3: the
+#: exponent axis; 2: rectangular blocks; 1 was runs of the flat grid).
+MANIFEST_FORMAT = 4
 
 
 def _ellipse_only():
@@ -50,18 +50,26 @@ def block_shape(n_b, n_delta, chunk_size):
 class SweepSpec:
     """What to compute: the grid (exponent, b/a, Δ/a), the mass model, μ's reference speed,
     chunking. ``exponent`` (the superellipse exponents n, 2 ≤ n ≤ 100, strictly increasing)
-    comes last so that ``SweepSpec(b, d, ...)`` is the ellipse sweep (n = 2)."""
+    comes last so that ``SweepSpec(b, d, ...)`` is the ellipse sweep (n = 2) whose output is
+    2-D, as it was before the exponent axis existed; naming exponents (even ``[2.0]``) gives
+    the 3-D output."""
 
     b_over_a: np.ndarray
     delta_over_a: np.ndarray
     mass_model: str = 'laminae'
     reference_speed: float = 0.5     #: kinematic |ω| for mu_required (units √(g/a))
     chunk_size: int = DEFAULT_CHUNK_SIZE   #: the most bodies of one task
-    exponent: np.ndarray = field(default_factory=_ellipse_only)   #: superellipse n (1)
+    #: superellipse n (1); None: the ellipse alone, without an exponent axis in the output
+    exponent: np.ndarray = None
+    #: True when the request named exponents: the output has the dimension ``exponent``;
+    #: False (no exponent given): the 2-D (b/a, Δ/a) output, ``exponent`` a scalar coordinate
+    exponent_axis: bool = field(init=False)
 
     def __post_init__(self):
+        object.__setattr__(self, 'exponent_axis', self.exponent is not None)
         object.__setattr__(self, 'exponent', exponent_values('exponent', np.atleast_1d(
-            np.asarray(self.exponent, dtype=float))))
+            np.asarray(_ellipse_only() if self.exponent is None else self.exponent,
+                       dtype=float))))
         if self.mass_model not in MASS_MODELS:
             raise SweepError(f'mass model must be one of {", ".join(MASS_MODELS)}, got '
                              f'{self.mass_model!r}')
@@ -123,6 +131,7 @@ class SweepSpec:
         resume state only under equal manifests."""
         return {'format': MANIFEST_FORMAT, 'package_version': __version__,
                 'exponent': [float(x).hex() for x in self.exponent],
+                'exponent_axis': self.exponent_axis,
                 'b_over_a': [float(x).hex() for x in self.b_over_a],
                 'delta_over_a': [float(x).hex() for x in self.delta_over_a],
                 'mass_model': self.mass_model,

@@ -58,7 +58,8 @@ def create_store(path, spec):
                                     dir=path.parent))
     try:
         template, encoding = template_dataset(spec.b_over_a, spec.delta_over_a, spec.block,
-                                              spec.attrs(), exponent=spec.exponent)
+                                              spec.attrs(), exponent=spec.exponent,
+                                              exponent_axis=spec.exponent_axis)
         template.attrs.update({STORE_MANIFEST: json.dumps(spec.manifest()),
                                STORE_STATE: 'incomplete'})
         with _quiet_zarr():
@@ -86,13 +87,14 @@ def complete_blocks(path, spec):
     """Indices (into ``spec.blocks()``) of the blocks whose ``computed`` flags are all 1."""
     import zarr
     flags = zarr.open_array(Path(path) / COMPUTED, mode='r')
-    try:
-        return set(np.flatnonzero(_block_minima(flags[...], spec) == 1).tolist())
+    try:    # a store without the exponent axis: the same points, one exponent
+        return set(np.flatnonzero(_block_minima(flags[...].reshape(spec.shape), spec)
+                                  == 1).tolist())
     except Exception:  # noqa: BLE001 (a damaged chunk object: look at the blocks one by one)
         found = set()
         for k, block in enumerate(spec.blocks()):
             try:
-                if np.all(flags[block] == 1):
+                if np.all(flags[block[-flags.ndim:]] == 1):
                     found.add(k)
             except Exception:  # noqa: BLE001 (unreadable: the block is computed again)
                 pass
@@ -109,7 +111,8 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     path : str
         Absolute path of the store, as every worker sees it.
     block : (slice, slice, slice)
-        The block's exponent (one), rows (b/a) and columns (Δ/a) in the grid.
+        The block's exponent (one), rows (b/a) and columns (Δ/a) in the grid (a store without
+        the exponent axis is written at the rows and columns).
     b_values, delta_values : 1-D arrays
         The grid values of those rows and columns.
     mass_model, reference_speed, exponent
@@ -127,10 +130,11 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     result, seconds, cpu = timed_chunk(b.ravel(), d.ravel(), mass_model, reference_speed,
                                        exponent)
     start = time.perf_counter()
-    block = tuple(block)
-    shape = (1, *b.shape)
-    failure = np.asarray(result['failure'], dtype=object).reshape(shape)
     group = zarr.open_group(path, mode='r+')       # the layout, from the consolidated metadata
+    # (exponent, rows, columns), or (rows, columns) in a store without the exponent axis
+    block = tuple(block)[-group[COMPUTED].ndim:]
+    shape = (1, *b.shape)[-len(block):]
+    failure = np.asarray(result['failure'], dtype=object).reshape(shape)
     for name in VARIABLES:
         group[name][block] = np.asarray(result[name], dtype=float).reshape(shape)
     group['failure'][block] = failure.astype(np.dtypes.StringDType())
