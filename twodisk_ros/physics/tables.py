@@ -7,6 +7,8 @@ Hermite weights are computed once per sample (shared by tables on the same grid)
 table contributes one gather of its node data and one small matrix product per sample.
 """
 
+import math
+
 import numpy as np
 
 __all__ = ['HermiteTable', 'hermite_jet']
@@ -45,12 +47,22 @@ class HermiteTable:
         return i, t
 
     def __call__(self, x, derivative=0):
-        """f(x) (``derivative=0``) or f′(x) (``derivative=1``); x inside the table's span."""
-        i, t = self._locate(x)
+        """f(x) (``derivative=0``) or f′(x) (``derivative=1``); x inside the table's span.
+
+        A finite scalar x (an ODE's right-hand side asks for one point at a time) takes the
+        same arithmetic in Python floats, without the array set-up: the same result bit for
+        bit, at a third of the cost."""
+        if isinstance(x, (float, np.floating)) and math.isfinite(x):
+            position = (float(x) - self.start) / self.step
+            i = min(max(math.floor(position), 0), self.last_index)
+            t = position - i
+        else:
+            i, t = self._locate(x)
         y0, y1 = self.values[i], self.values[i + 1]
         d0, d1 = self.first[i], self.first[i + 1]
         s0, s1 = self.second[i], self.second[i + 1]
-        t = t.reshape(t.shape + (1,) * (y0.ndim - t.ndim))
+        if not isinstance(t, float):
+            t = t.reshape(t.shape + (1,) * (y0.ndim - t.ndim))
         t2 = t * t
         t3 = t2 * t
         if derivative == 0:
