@@ -500,7 +500,8 @@ def _check_energy_balance(samples, motion, model, parameters, events, series):
         f'trapezoid error ({quadrature / scale:.3g}) + solver'] + [
         f'not checked: {line}' for line in skipped[:5]] + (
         [] if kept.note is None else
-        [kept.note + '; the balance starts again after each (t0: the first sample after it)']))
+        [kept.note, 'the balance starts again after each stretch left out (t0: its first '
+                    'sample after it)']))
 
 
 def _conservative(parameters):

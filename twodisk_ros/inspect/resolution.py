@@ -108,10 +108,17 @@ def resolve(fd_tolerance, index, samples, body=None, minimum=1):
     finite = fd_tolerance[np.isfinite(fd_tolerance)]
     largest = f'{float(np.max(finite)):.3g}' if finite.size else 'not finite'
     if int(np.sum(keep)) < minimum:
+        count = int(np.sum(keep))
+        left = ('no sample left to judge' if count == 0 else
+                f'{count} sample(s) left, {minimum} needed')
+        hint = ''
+        if not vertices and finite.size:    # smooth motion: the error falls as h⁴
+            hint = (f'; the error falls as h⁴: a rate about '
+                    f'{(float(np.max(finite)) / CAP) ** 0.25:.2g} × higher would resolve it')
         return Resolution(keep, (
             f'not evaluated: {UNRESOLVED}: at {dropped.size} of {fd_tolerance.size} samples '
             f'a perfect recording\'s FD error alone gives a tolerance above {CAP:g} of the '
-            f'scale (up to {largest}){vertices}; no sample left to judge'))
+            f'scale (up to {largest}){vertices}; {left}{hint}'))
     return Resolution(keep, (
         f'left out {dropped.size} of {fd_tolerance.size} samples in {len(spans)} '
         f'stretch(es) where the samples do not resolve the motion (a perfect recording\'s FD '
@@ -143,6 +150,7 @@ def _vertex_stretches(samples, index, stretches, body):
         crossing += bool(np.any((images >= lo) & (images <= hi)))
     if crossing == 0:
         return ''
-    which = 'each' if crossing == len(stretches) else f'{crossing} of them'
-    return (f'; {which} around a flat vertex of the laminae, where the body stops turning in '
-            'u and its acceleration spikes')
+    which = ('it spans' if len(stretches) == 1 else 'each spans'
+             if crossing == len(stretches) else f'{crossing} of them span')
+    return (f'; {which} a flat-vertex crossing, where the body stops turning in u and its '
+            'acceleration spikes')
