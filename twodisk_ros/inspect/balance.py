@@ -21,7 +21,8 @@ parameters with the ``scene`` events (``scene <name> <old> -> <new>``) undone ba
 start. The speed drive's work is whatever
 its rule needs: stretches under it are not checked here (the node's own balance is in
 /diagnostics). Tolerance: twice the FD error of the energy (as the ``energy`` check) plus the
-trapezoid rule's error estimate (h/12 Σ|Δ²P| per stretch).
+trapezoid rule's error estimate (h/12 Σ|Δ²P| per stretch). Samples whose differences do not
+resolve the motion (:mod:`.resolution`) cut a stretch: each piece is balanced on its own.
 """
 
 import math

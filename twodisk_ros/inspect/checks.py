@@ -45,10 +45,19 @@ scale, so that round-off far from the origin is allowed for):
 ``angular_speed`` (kinematic mode)
     max | |ω| − |omega0| | / |omega0| with ω from the recorded poses; tolerance twice the FD
     error of the model's poses at the recorded phases plus the same solver allowance.
-``timestamps``
+Every FD-limited check (``no_slip``, ``energy``, ``angular_speed``, ``energy_balance``,
+``speed_drive`` and force_checks' ``contact_forces``) judges only the samples its
+differences resolve: those where the FD part of its tolerance, from that sample alone, is
+within 1e-3 of its scale (:mod:`.resolution`). It names the stretches it left out (around a
+superellipse's flat vertices, where the body stops turning in u and its acceleration
+spikes); with none left it is not evaluated ("the samples do not resolve the motion here"),
+a failed check. ``energy`` then measures the drift from its first sample kept, and
+``energy_balance`` starts again after each stretch left out.
+
+``timestamps`` (:mod:`.stamp_checks`)
     stamps of pose, contacts and rolling state increase with no gaps: every interval within
     1 % of 1/rate (the recorded ``rate``; the median interval if it is missing).
-``stamps``
+``stamps`` (:mod:`.stamp_checks`)
     header stamp = log time = publish time, and pose, contacts and rolling state carry the same
     stamps (the tail cut off a truncated file excepted); tolerance 0 mismatches.
 """
@@ -63,7 +72,8 @@ from .differences import kinetic_energy, motion_of
 from .resolution import Resolution, resolve
 from .results import Check, json_ready
 from .speed_drive import TITLE as SPEED_DRIVE_TITLE, speed_drive_check
-from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES, WRENCHES, values_at
+from .series import SAMPLED, TOPIC_TYPES, WRENCHES, values_at
+from .stamp_checks import STAMP_TITLES, check_stamps, check_timestamps, nominal_step_ns
 
 __all__ = ['TITLES', 'run_checks']
 
@@ -90,8 +100,7 @@ TITLES = {
     'energy_balance': 'drive or dissipation: E + W − W_d = E0 on each stretch (from the '
                       'recording alone)',
     'speed_drive': SPEED_DRIVE_TITLE,
-    'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
-    'stamps': 'consistent stamps across messages and topics',
+    **STAMP_TITLES,
 }
 
 
@@ -327,72 +336,6 @@ def _check_angular_speed(samples, motion, model):
         f'tolerance {FD_MARGIN:g} × that + solver allowance'] + _left_out(kept))
 
 
-def _nominal_step_ns(series, model):
-    """1/rate in ns from the recorded rate, else the median stamp interval; and its source."""
-    if model is not None and model.rate:
-        return 1e9 / model.rate, f'1/rate, rate = {model.rate:g} Hz'
-    intervals = [np.diff(series[role].stamp_ns) for role in SAMPLED
-                 if role in series and len(series[role]) > 1]
-    if not intervals:
-        return None, 'no intervals'
-    return float(np.median(np.concatenate(intervals))), 'median interval (no valid rate)'
-
-
-def _check_timestamps(series, step_ns, source):
-    roles = [role for role in SAMPLED if role in series]
-    if step_ns is None or not roles:
-        return _check('timestamps', None, STAMP_TOLERANCE, '', ['too few messages'])
-    detail, worst = [], 0.0
-    for role in roles:
-        stamps = series[role].stamp_ns
-        if stamps.size < 2:
-            detail.append(f'{series[role].topic}: {stamps.size} message(s), no interval')
-            worst = math.inf
-            continue
-        intervals = np.diff(stamps)
-        deviation = np.abs(intervals - step_ns) / step_ns
-        bad = np.nonzero(deviation > STAMP_TOLERANCE)[0]
-        worst = max(worst, float(np.max(deviation)))
-        line = f'{series[role].topic}: {stamps.size} stamps'
-        if bad.size:
-            first = int(bad[0])
-            line += (f', {bad.size} bad intervals, the first {intervals[first] * 1e-9:.6g} s '
-                     f'after t = {stamps[first] * 1e-9:.6g} s')
-            if np.any(intervals <= 0):
-                line += f', {int(np.sum(intervals <= 0))} not increasing'
-        detail.append(line)
-    detail.append(f'nominal interval {step_ns * 1e-9:.6g} s ({source}); '
-                  f'tolerance {STAMP_TOLERANCE:.0%} of it')
-    return _check('timestamps', worst, STAMP_TOLERANCE, '', detail)
-
-
-def _check_stamps(series, truncated):
-    roles = [role for role in SAMPLED if role in series and len(series[role])]
-    detail, mismatches = [], 0
-    for role in roles:
-        data = series[role]
-        count = int(np.sum(data.stamp_ns != data.log_ns) + np.sum(data.log_ns != data.publish_ns))
-        if count:
-            detail.append(f'{data.topic}: {count} header stamp / log time / publish time '
-                          'mismatches')
-        mismatches += count
-    if roles:
-        sets = {role: np.unique(series[role].stamp_ns) for role in roles}
-        union = np.unique(np.concatenate(list(sets.values())))
-        if truncated:
-            union = union[union <= min(stamps[-1] for stamps in sets.values())]
-        for role, stamps in sets.items():
-            lacking = union.size - np.intersect1d(union, stamps).size
-            if lacking:
-                detail.append(f'{series[role].topic}: lacks {lacking} stamps of the others')
-            mismatches += lacking
-    if not detail:
-        detail.append('pose, contacts and rolling_state share their stamps; header stamp = '
-                      'log time = publish time'
-                      + (' (the tail cut by the truncation ignored)' if truncated else ''))
-    return _check('stamps', mismatches, 0, 'mismatches', detail)
-
-
 def _run(checks, name, function, *args):
     """Append ``function(*args)``; an error while evaluating it is a failed check."""
     try:
@@ -413,11 +356,11 @@ def run_checks(recording, problems, chosen, series, samples, model, parameters, 
     _run(checks, 'inputs', _check_inputs, problems, chosen, model)
     _run(checks, 'ground', _check_ground, series, scale,
          None if model is None else model.ground_normal)
-    step_ns, source = _nominal_step_ns(series, model)
+    step_ns, source = nominal_step_ns(series, model)
     motion = _physics_checks(checks, samples, model, step_ns, scale, parameters, events,
                              series)
-    _run(checks, 'timestamps', _check_timestamps, series, step_ns, source)
-    _run(checks, 'stamps', _check_stamps, series, recording.truncated)
+    _run(checks, 'timestamps', check_timestamps, series, step_ns, source)
+    _run(checks, 'stamps', check_stamps, series, recording.truncated)
     return checks, motion
 
 

@@ -4,27 +4,27 @@ The checks that differentiate the recorded poses (``no_slip``, ``energy``,
 ``angular_speed``, ``energy_balance``, ``speed_drive``, ``contact_forces``) take their
 tolerance from the error the same differences show on a perfect recording: the model's poses
 at the recorded phases, against the model's exact values (:mod:`.checks`). That error is
-known sample by sample. Where the samples resolve the motion it is small (≤ 2e-4 of each
-check's scale for every body of ``config/`` at its rate: at most 6e-5 for the Oloid's
-forces, 1.8e-4 for the egg's slip; the slope's forces and balance, whose reference
-acceleration is a second difference of the recorded u̇, reach 8.4e-4 over 20 s). Where
-they do not it is of order one: a contact crossing a flat vertex of a superellipse makes
-the body stop turning in u for an instant, its acceleration is unbounded there (an integrable
-spike, docs/physics.md "Any body: the forces per unit of the turn, and flat vertices"), and
-no five-point stencil across that instant is accurate (0.03 to 12 of the scale at 100 Hz,
-tests/test_inspect_resolution.py). A tolerance taken from such samples makes a check that
-cannot fail.
+known sample by sample. Where the samples resolve the motion it is small: over the runs of
+every ``config/`` body at its rate (3 s and 20 s) the FD part of a tolerance is at most
+1.8e-4 of its scale (the egg's ``no_slip``; the Oloid's are ≤ 7.5e-6), except on the slope,
+whose forces take the reference acceleration from second differences of the recorded u̇:
+8.4e-4 over 20 s. Where they do not it is of order one: a contact crossing a flat vertex
+of a superellipse makes the body stop turning in u for an instant, its acceleration is
+unbounded there (an integrable spike, docs/physics.md "Any body: the forces per unit of the
+turn, and flat vertices"), and no five-point stencil across that instant is accurate (0.03
+to 12 of the scale at 100 Hz, tests/test_inspect_resolution.py). A tolerance taken from such
+samples makes a check that cannot fail.
 
 So each such check first sets aside the samples at which the FD part of its tolerance,
 computed from that sample alone, would exceed :data:`CAP` = 1e-3 of its scale, evaluates the
 rest with the tolerance they give, and names the stretches it left out. 1e-3 is where an
 FD-limited check stops saying anything the docs promise: it is the error of the plain
 three-point differences at 100 Hz, (ω h)² for ω = 3 rad/s, that the five-point stencils are
-there to avoid (a check that loose would hide millimetre errors of the contacts of a 0.1 m
-body), six orders above the motion's own accuracy (docs/physics.md "Accuracy and its limits"),
-and above every resolved run by a factor 1.2 or more. Where no sample is left the
-check is not evaluated (the samples do not resolve the motion): a failed check, like every
-check that cannot be evaluated, never a PASS.
+there to avoid (:mod:`.checks`: it would hide millimetre errors of the contacts); it is six
+orders above the motion's own accuracy (docs/physics.md "Accuracy and its limits") and 1.2
+times the largest of a resolved run above. Where no sample is left the check is not
+evaluated (the samples do not resolve the motion): a failed check, like every check that
+cannot be evaluated, never a PASS.
 """
 
 from dataclasses import dataclass

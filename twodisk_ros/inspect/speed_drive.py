@@ -19,7 +19,9 @@ reference's own difference error enters once more. The claim checked: the record
 obeys the lag rule to the accuracy the poses allow, i.e. the largest |Ω − Ω_rule| / Ω_s
 (Ω_s = max(|Ω| over the stretches, 1 rad/s)) is within 2 × FD_MARGIN × the difference error
 of |ω| (the model's poses at the recorded phases against the exact |ω_u(u)| |u̇|, as the
-``angular_speed`` check) + round-off and the solver's allowance (as ``energy``).
+``angular_speed`` check) + round-off and the solver's allowance (as ``energy``), on the
+samples whose own difference error keeps that within 1e-3 (:mod:`.resolution`; t_r is then
+the first of them).
 """
 
 import math
