@@ -21,7 +21,8 @@ parameters with the ``scene`` events (``scene <name> <old> -> <new>``) undone ba
 start. The speed drive's work is whatever
 its rule needs: stretches under it are not checked here (the node's own balance is in
 /diagnostics). Tolerance: twice the FD error of the energy (as the ``energy`` check) plus the
-trapezoid rule's error estimate (h/12 Σ|Δ²P| per stretch).
+trapezoid rule's error estimate (h/12 Σ|Δ²P| per stretch). Samples whose differences do not
+resolve the motion (:mod:`.resolution`) cut a stretch: each piece is balanced on its own.
 """
 
 import math
@@ -77,7 +78,7 @@ def scene_timeline(parameters, events):
     return timeline
 
 
-def balance_stretches(samples, motion, model, timeline, normal_force):
+def balance_stretches(samples, motion, model, timeline, normal_force, keep=None):
     """The balance residual on each stretch whose drive's work is known.
 
     Parameters
@@ -88,6 +89,10 @@ def balance_stretches(samples, motion, model, timeline, normal_force):
         :func:`scene_timeline`.
     normal_force : numpy.ndarray or None
         N_A + N_B (N) at every sample, or None (no wrenches: rolling resistance unknown).
+    keep : numpy.ndarray of bool, optional
+        Over the rows of ``motion.index``: the samples the differences resolve
+        (:mod:`.resolution`). A stretch is cut at the samples left out and each piece is
+        balanced from its own first sample (the work across a left-out sample is unknown).
 
     Returns
     -------
@@ -105,30 +110,37 @@ def balance_stretches(samples, motion, model, timeline, normal_force):
     residuals, skipped, quadrature = [], [], 0.0
     omega = np.linalg.norm(motion.angular_velocity, axis=1)
     speed_g = np.linalg.norm(motion.velocity, axis=1)
+    keep = np.ones(k.size, dtype=bool) if keep is None else np.asarray(keep, dtype=bool)
+    pieces = np.cumsum(~keep)       # the rows between two left-out samples share a number
     for (start, state), end in zip(zip(starts, (s for _, s in timeline)), starts[1:]):
-        inside = (stamps >= start) & (stamps < end)
-        if np.sum(inside) < 3:
+        stretch = (stamps >= start) & (stamps < end)
+        if np.sum(stretch) < 3:
             continue
-        t = samples.t[k[inside]]
+        t = samples.t[k[stretch]]
         where = f't = {t[0]:.6g} … {t[-1]:.6g} s'
         if state['active'] == 'speed':
             skipped.append(f'{where}: speed drive (its work is what its rule needs; '
                            'the rule is the speed_drive check)')
             continue
-        power = -state['damping'] * omega[inside]**2
-        if state['rolling_resistance'] > 0:
-            if normal_force is None:
-                skipped.append(f'{where}: rolling resistance without recorded wrenches')
+        if state['rolling_resistance'] > 0 and normal_force is None:
+            skipped.append(f'{where}: rolling resistance without recorded wrenches')
+            continue
+        for piece in np.unique(pieces[stretch & keep]):
+            inside = stretch & keep & (pieces == piece)
+            if np.sum(inside) < 3:
                 continue
-            power = power - state['rolling_resistance'] * normal_force[k[inside]] * \
-                speed_g[inside]
-        if state['active'] == 'torque' and state['command']:
-            signed = omega[inside] * np.sign(samples.rates[k[inside], 2])
-            power = power + state['command'] * signed
-        h = np.diff(t)
-        work = np.concatenate([[0.0], np.cumsum(0.5 * h * (power[1:] + power[:-1]))])
-        quadrature = max(quadrature, float(np.mean(h)) / 12 * float(np.sum(np.abs(
-            np.diff(power, 2)))))
-        total = energy[inside] - work
-        residuals.append((t, np.abs(total - total[0])))
+            t = samples.t[k[inside]]
+            power = -state['damping'] * omega[inside]**2
+            if state['rolling_resistance'] > 0:
+                power = power - state['rolling_resistance'] * normal_force[k[inside]] * \
+                    speed_g[inside]
+            if state['active'] == 'torque' and state['command']:
+                signed = omega[inside] * np.sign(samples.rates[k[inside], 2])
+                power = power + state['command'] * signed
+            h = np.diff(t)
+            work = np.concatenate([[0.0], np.cumsum(0.5 * h * (power[1:] + power[:-1]))])
+            quadrature = max(quadrature, float(np.mean(h)) / 12 * float(np.sum(np.abs(
+                np.diff(power, 2)))))
+            total = energy[inside] - work
+            residuals.append((t, np.abs(total - total[0])))
     return residuals, skipped, quadrature

@@ -45,10 +45,19 @@ scale, so that round-off far from the origin is allowed for):
 ``angular_speed`` (kinematic mode)
     max | |ω| − |omega0| | / |omega0| with ω from the recorded poses; tolerance twice the FD
     error of the model's poses at the recorded phases plus the same solver allowance.
-``timestamps``
+Every FD-limited check (``no_slip``, ``energy``, ``angular_speed``, ``energy_balance``,
+``speed_drive`` and force_checks' ``contact_forces``) judges only the samples its
+differences resolve: those where the FD part of its tolerance, from that sample alone, is
+within 1e-3 of its scale (:mod:`.resolution`). It names the stretches it left out (around a
+superellipse's flat vertices, where the body stops turning in u and its acceleration
+spikes); with none left it is not evaluated ("the samples do not resolve the motion here"),
+a failed check. ``energy`` then measures the drift from its first sample kept, and
+``energy_balance`` starts again after each stretch left out.
+
+``timestamps`` (:mod:`.stamp_checks`)
     stamps of pose, contacts and rolling state increase with no gaps: every interval within
     1 % of 1/rate (the recorded ``rate``; the median interval if it is missing).
-``stamps``
+``stamps`` (:mod:`.stamp_checks`)
     header stamp = log time = publish time, and pose, contacts and rolling state carry the same
     stamps (the tail cut off a truncated file excepted); tolerance 0 mismatches.
 """
@@ -60,9 +69,11 @@ from scipy.spatial.transform import Rotation
 
 from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
+from .resolution import Resolution, resolve
 from .results import Check, json_ready
 from .speed_drive import TITLE as SPEED_DRIVE_TITLE, speed_drive_check
-from .series import SAMPLED, STAMP_TOLERANCE, TOPIC_TYPES, WRENCHES, values_at
+from .series import SAMPLED, TOPIC_TYPES, WRENCHES, values_at
+from .stamp_checks import STAMP_TITLES, check_stamps, check_timestamps, nominal_step_ns
 
 __all__ = ['TITLES', 'run_checks']
 
@@ -89,8 +100,7 @@ TITLES = {
     'energy_balance': 'drive or dissipation: E + W − W_d = E0 on each stretch (from the '
                       'recording alone)',
     'speed_drive': SPEED_DRIVE_TITLE,
-    'timestamps': 'stamps increasing with no gaps (pose, contacts, rolling_state)',
-    'stamps': 'consistent stamps across messages and topics',
+    **STAMP_TITLES,
 }
 
 
@@ -208,7 +218,7 @@ def _slip(position_g, contact_a, contact_b, velocity, omega):
     return np.maximum(np.linalg.norm(slip_a, axis=1), np.linalg.norm(slip_b, axis=1))
 
 
-def _check_no_slip(samples, motion, scale):
+def _check_no_slip(samples, motion, scale, body=None):
     k = motion.index
     if k.size == 0:
         return _not_evaluated('no_slip', _NO_DIFFERENCES)
@@ -219,22 +229,32 @@ def _check_no_slip(samples, motion, scale):
                      motion.model_velocity, motion.model_angular_velocity)
     speed = float(np.max(np.linalg.norm(motion.velocity, axis=1)))
     roundoff = ROUNDOFF * scale / motion.step
-    worst = int(np.argmax(recorded))
-    omega_h = float(np.max(np.linalg.norm(motion.angular_velocity, axis=1))) * motion.step
     if speed > roundoff:
         unit, norm = '', speed
         what = f'max |v_A|, |v_B| / max |v_G| (max |v_G| = {speed:.4g} m/s)'
-    else:
+        kept = resolve(FD_MARGIN * expected / norm, k, samples, body)
+    else:       # at rest: absolute speeds, no scale to cap them against
         unit, norm = 'm/s', 1.0
         what = 'max |v_A|, |v_B| (the body is at rest)'
-    fd_error = float(np.max(expected)) / norm
+        kept = Resolution(np.ones(k.size, dtype=bool), None)
+    if not kept.count:
+        return _not_evaluated('no_slip', kept.note, unit)
+    rows = np.nonzero(kept.keep)[0]
+    worst = rows[int(np.argmax(recorded[rows]))]
+    omega_h = float(np.max(np.linalg.norm(motion.angular_velocity[rows], axis=1))) * motion.step
+    fd_error = float(np.max(expected[rows])) / norm
     return _check('no_slip', float(recorded[worst]) / norm,
                   FD_MARGIN * fd_error + roundoff / norm, unit, [
-                      f'{what}, worst {_where(samples, k[worst])}, {k.size} samples',
+                      f'{what}, worst {_where(samples, k[worst])}, {rows.size} samples',
                       f'FD-limited: the model poses at the recorded phases (rolling without '
                       f'slip) show {fd_error:.3g} at h = {motion.step:.4g} s '
                       f'((ω h)⁴ = {omega_h**4:.3g}); tolerance {FD_MARGIN:g} × that + '
-                      'round-off'])
+                      'round-off'] + _left_out(kept))
+
+
+def _left_out(resolution):
+    """The detail line on the samples a check left out (none if it kept them all)."""
+    return [] if resolution.note is None else [resolution.note]
 
 
 def _solver_allowance(model):
@@ -261,22 +281,30 @@ def _check_energy(samples, motion, model):
     k = motion.index
     if k.size == 0:
         return _not_evaluated('energy', _NO_DIFFERENCES)
-    if not np.all(np.isfinite(samples.rates[k, 2])):
+    if not np.any(np.isfinite(samples.rates[k, 2])):
         return _not_evaluated('energy', 'rolling_state carries no phase rate: the FD error '
                                         'cannot be estimated')
     scale = model.dynamics.energy_scale
     recorded, model_fd, exact = _energies(samples, motion, model)
-    drift = np.abs(recorded - recorded[0]) / scale
-    worst = int(np.argmax(drift))
-    fd_error = float(np.max(np.abs(model_fd - exact))) / scale
+    errors = np.abs(model_fd - exact) / scale
+    kept = resolve(2 * FD_MARGIN * errors, k, samples, model.body, minimum=2)
+    if kept.count < 2:
+        return _not_evaluated('energy', kept.note)
+    rows = np.nonzero(kept.keep)[0]
+    reference = rows[0]
+    drift = np.abs(recorded[rows] - recorded[reference]) / scale
+    worst = rows[int(np.argmax(drift))]
+    fd_error = float(np.max(errors[rows]))
     solver = _solver_allowance(model)
-    model_drift = float(np.max(np.abs(exact - exact[0]))) / scale
-    return _check('energy', float(drift[worst]), 2 * FD_MARGIN * fd_error + solver, '', [
-        f'max |E − E0| / (M g L), E0 = {recorded[0]:.8g} J, M g L = {scale:.4g} J; worst '
-        f'{_where(samples, k[worst])}, {k.size} samples',
+    model_drift = float(np.max(np.abs(exact[rows] - exact[reference]))) / scale
+    return _check('energy', float(np.max(drift)), 2 * FD_MARGIN * fd_error + solver, '', [
+        f'max |E − E0| / (M g L), E0 = {recorded[reference]:.8g} J'
+        + ('' if reference == 0 else f' (at t = {samples.t[k[reference]]:.6g} s)')
+        + f', M g L = {scale:.4g} J; worst {_where(samples, k[worst])}, {rows.size} samples',
         f'FD-limited: the model poses at the recorded phases give E within {fd_error:.3g} of '
         f'the exact E(u, u̇); tolerance 2 × {FD_MARGIN:g} × that + {solver:.3g} (solver)',
-        f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}'])
+        f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}']
+        + _left_out(kept))
 
 
 def _check_angular_speed(samples, motion, model):
@@ -288,85 +316,24 @@ def _check_angular_speed(samples, motion, model):
     model_speed = np.linalg.norm(motion.model_angular_velocity, axis=1)
     if target > 0:
         error = np.abs(speed - target) / target
-        fd_error = float(np.max(np.abs(model_speed - target))) / target
-        tolerance = FD_MARGIN * fd_error + _solver_allowance(model)
+        errors = np.abs(model_speed - target) / target
+        kept = resolve(FD_MARGIN * errors, k, samples, model.body)
+        allowance = _solver_allowance(model)
         unit, what = '', f'max ||ω| − |omega0|| / |omega0|, |omega0| = {target:g} rad/s'
-    else:
-        error = speed
-        fd_error = float(np.max(model_speed))
-        tolerance = FD_MARGIN * fd_error + ROUNDOFF / motion.step
+    else:       # omega0 = 0: absolute speeds, no scale to cap them against
+        error, errors = speed, model_speed
+        kept = Resolution(np.ones(k.size, dtype=bool), None)
+        allowance = ROUNDOFF / motion.step
         unit, what = 'rad/s', 'max |ω| (omega0 = 0)'
-    worst = int(np.argmax(error))
-    return _check('angular_speed', float(error[worst]), tolerance, unit, [
-        f'{what}; worst {_where(samples, k[worst])}, {k.size} samples',
+    if not kept.count:
+        return _not_evaluated('angular_speed', kept.note, unit)
+    rows = np.nonzero(kept.keep)[0]
+    worst = rows[int(np.argmax(error[rows]))]
+    fd_error = float(np.max(errors[rows]))
+    return _check('angular_speed', float(error[worst]), FD_MARGIN * fd_error + allowance, unit, [
+        f'{what}; worst {_where(samples, k[worst])}, {rows.size} samples',
         f'FD-limited: the model poses at the recorded phases show {fd_error:.3g}; '
-        f'tolerance {FD_MARGIN:g} × that + solver allowance'])
-
-
-def _nominal_step_ns(series, model):
-    """1/rate in ns from the recorded rate, else the median stamp interval; and its source."""
-    if model is not None and model.rate:
-        return 1e9 / model.rate, f'1/rate, rate = {model.rate:g} Hz'
-    intervals = [np.diff(series[role].stamp_ns) for role in SAMPLED
-                 if role in series and len(series[role]) > 1]
-    if not intervals:
-        return None, 'no intervals'
-    return float(np.median(np.concatenate(intervals))), 'median interval (no valid rate)'
-
-
-def _check_timestamps(series, step_ns, source):
-    roles = [role for role in SAMPLED if role in series]
-    if step_ns is None or not roles:
-        return _check('timestamps', None, STAMP_TOLERANCE, '', ['too few messages'])
-    detail, worst = [], 0.0
-    for role in roles:
-        stamps = series[role].stamp_ns
-        if stamps.size < 2:
-            detail.append(f'{series[role].topic}: {stamps.size} message(s), no interval')
-            worst = math.inf
-            continue
-        intervals = np.diff(stamps)
-        deviation = np.abs(intervals - step_ns) / step_ns
-        bad = np.nonzero(deviation > STAMP_TOLERANCE)[0]
-        worst = max(worst, float(np.max(deviation)))
-        line = f'{series[role].topic}: {stamps.size} stamps'
-        if bad.size:
-            first = int(bad[0])
-            line += (f', {bad.size} bad intervals, the first {intervals[first] * 1e-9:.6g} s '
-                     f'after t = {stamps[first] * 1e-9:.6g} s')
-            if np.any(intervals <= 0):
-                line += f', {int(np.sum(intervals <= 0))} not increasing'
-        detail.append(line)
-    detail.append(f'nominal interval {step_ns * 1e-9:.6g} s ({source}); '
-                  f'tolerance {STAMP_TOLERANCE:.0%} of it')
-    return _check('timestamps', worst, STAMP_TOLERANCE, '', detail)
-
-
-def _check_stamps(series, truncated):
-    roles = [role for role in SAMPLED if role in series and len(series[role])]
-    detail, mismatches = [], 0
-    for role in roles:
-        data = series[role]
-        count = int(np.sum(data.stamp_ns != data.log_ns) + np.sum(data.log_ns != data.publish_ns))
-        if count:
-            detail.append(f'{data.topic}: {count} header stamp / log time / publish time '
-                          'mismatches')
-        mismatches += count
-    if roles:
-        sets = {role: np.unique(series[role].stamp_ns) for role in roles}
-        union = np.unique(np.concatenate(list(sets.values())))
-        if truncated:
-            union = union[union <= min(stamps[-1] for stamps in sets.values())]
-        for role, stamps in sets.items():
-            lacking = union.size - np.intersect1d(union, stamps).size
-            if lacking:
-                detail.append(f'{series[role].topic}: lacks {lacking} stamps of the others')
-            mismatches += lacking
-    if not detail:
-        detail.append('pose, contacts and rolling_state share their stamps; header stamp = '
-                      'log time = publish time'
-                      + (' (the tail cut by the truncation ignored)' if truncated else ''))
-    return _check('stamps', mismatches, 0, 'mismatches', detail)
+        f'tolerance {FD_MARGIN:g} × that + solver allowance'] + _left_out(kept))
 
 
 def _run(checks, name, function, *args):
@@ -389,11 +356,11 @@ def run_checks(recording, problems, chosen, series, samples, model, parameters, 
     _run(checks, 'inputs', _check_inputs, problems, chosen, model)
     _run(checks, 'ground', _check_ground, series, scale,
          None if model is None else model.ground_normal)
-    step_ns, source = _nominal_step_ns(series, model)
+    step_ns, source = nominal_step_ns(series, model)
     motion = _physics_checks(checks, samples, model, step_ns, scale, parameters, events,
                              series)
-    _run(checks, 'timestamps', _check_timestamps, series, step_ns, source)
-    _run(checks, 'stamps', _check_stamps, series, recording.truncated)
+    _run(checks, 'timestamps', check_timestamps, series, step_ns, source)
+    _run(checks, 'stamps', check_stamps, series, recording.truncated)
     return checks, motion
 
 
@@ -429,7 +396,7 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(
     if motion is None:
         _not_evaluated_all(checks, ('no_slip', speed_check), f'no finite differences: {reason}')
         return None
-    _run(checks, 'no_slip', _check_no_slip, samples, motion, scale)
+    _run(checks, 'no_slip', _check_no_slip, samples, motion, scale, model.body)
     timeline = scene_timeline(parameters, events) if model.scene else []
     speed_driven = [state['active'] == 'speed' for _, state in timeline]
     if model.mode == 'kinematic' and not model.scene:
@@ -455,13 +422,17 @@ def _check_energy_balance(samples, motion, model, parameters, events, series):
     normal = ((force_a + force_b) @ model.ground_normal
               if np.all(found_a & found_b) else None)
     scale = model.dynamics.energy_scale
+    _, model_fd, exact = _energies(samples, motion, model)
+    errors = np.abs(model_fd - exact) / scale
+    kept = resolve(2 * FD_MARGIN * errors, motion.index, samples, model.body, minimum=3)
+    if kept.count < 3:
+        return _not_evaluated('energy_balance', kept.note)
     residuals, skipped, quadrature = balance_stretches(
-        samples, motion, model, scene_timeline(parameters, events), normal)
+        samples, motion, model, scene_timeline(parameters, events), normal, kept.keep)
     if not residuals:
         return _not_evaluated('energy_balance', 'no stretch whose drive\'s work is known: '
                               + '; '.join(skipped[:3]))
-    _, model_fd, exact = _energies(samples, motion, model)
-    fd_error = float(np.max(np.abs(model_fd - exact))) / scale
+    fd_error = float(np.max(errors[kept.keep]))
     tolerance = 2 * FD_MARGIN * fd_error + 2 * quadrature / scale + _solver_allowance(model)
     value = max(float(np.max(r)) for _, r in residuals) / scale
     return _check('energy_balance', value, tolerance, '', [
@@ -470,7 +441,10 @@ def _check_energy_balance(samples, motion, model, parameters, events, series):
         f'resistance (recorded N) and the torque commanded (events)',
         f'tolerance 2 × {FD_MARGIN:g} × the FD error of E ({fd_error:.3g}) + 2 × the '
         f'trapezoid error ({quadrature / scale:.3g}) + solver'] + [
-        f'not checked: {line}' for line in skipped[:5]])
+        f'not checked: {line}' for line in skipped[:5]] + (
+        [] if kept.note is None else
+        [kept.note, 'the balance starts again after each stretch left out (t0: its first '
+                    'sample after it)']))
 
 
 def _conservative(parameters):

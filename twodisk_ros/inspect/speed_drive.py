@@ -19,7 +19,9 @@ reference's own difference error enters once more. The claim checked: the record
 obeys the lag rule to the accuracy the poses allow, i.e. the largest |Ω − Ω_rule| / Ω_s
 (Ω_s = max(|Ω| over the stretches, 1 rad/s)) is within 2 × FD_MARGIN × the difference error
 of |ω| (the model's poses at the recorded phases against the exact |ω_u(u)| |u̇|, as the
-``angular_speed`` check) + round-off and the solver's allowance (as ``energy``).
+``angular_speed`` check) + round-off and the solver's allowance (as ``energy``), on the
+samples whose own difference error keeps that within 1e-3 (:mod:`.resolution`; t_r is then
+the first of them).
 """
 
 import math
@@ -27,6 +29,7 @@ import re
 
 import numpy as np
 
+from .resolution import resolve
 from .results import Check, json_ready
 
 __all__ = ['TITLE', 'speed_drive_check', 'speed_stretches']
@@ -58,8 +61,12 @@ def _lag_at(lags, stamp):
     return lag
 
 
-def speed_stretches(samples, motion, model, timeline, lags):
+def speed_stretches(samples, motion, model, timeline, lags, keep=None):
     """Residuals of the lag rule on every stretch under the speed drive.
+
+    ``keep`` (bool over the rows of ``motion.index``, :mod:`.resolution`): the samples the
+    differences resolve; the others are left out and t_r is each stretch's first sample kept
+    (the rule holds from any of its points).
 
     Returns (rows, skipped): rows of (t (s), Ω recorded, Ω by the rule, |ω_fd − ω_exact| of
     the model's poses) arrays per stretch with at least two differenced samples; skipped:
@@ -67,18 +74,14 @@ def speed_stretches(samples, motion, model, timeline, lags):
     """
     k = motion.index
     stamps = samples.stamp_ns[k]
-    omega = np.linalg.norm(motion.angular_velocity, axis=1)
-    model_omega = np.linalg.norm(motion.model_angular_velocity, axis=1)
-    phase = np.unwrap(samples.angles[:, 2])[k]
-    rate = samples.rates[k, 2]
-    exact = np.abs(np.asarray(model.dynamics.angular_speed_per_phase(phase)) * rate)
-    signed = omega * np.where(rate < 0, -1.0, 1.0)
+    signed, fd_errors = _speeds(samples, motion, model)
+    keep = np.ones(k.size, dtype=bool) if keep is None else keep
     starts = [-math.inf if s is None else s for s, _ in timeline] + [math.inf]
     rows, skipped = [], []
     for (start, state), end in zip(zip(starts, (s for _, s in timeline)), starts[1:]):
         if state['active'] != 'speed':
             continue
-        inside = np.nonzero((stamps >= start) & (stamps < end))[0]
+        inside = np.nonzero((stamps >= start) & (stamps < end) & keep)[0]
         if inside.size < 2:
             if start != -math.inf or end != math.inf:
                 skipped.append(f'{inside.size} differenced sample(s) in the stretch from '
@@ -89,8 +92,36 @@ def speed_stretches(samples, motion, model, timeline, lags):
         held = state['command'] is None or model.mode == 'kinematic'
         target = signed[inside[0]] if held else state['command']
         rule = target + (signed[inside[0]] - target) * np.exp(-(t - t[0]) / lag)
-        rows.append((t, signed[inside], rule, np.abs(model_omega[inside] - exact[inside])))
+        rows.append((t, signed[inside], rule, fd_errors[inside]))
     return rows, skipped
+
+
+def _speeds(samples, motion, model):
+    """(Ω = |ω| sgn(u̇) from the recorded poses, |ω_fd − ω_exact| of the model's poses) at
+    the rows of ``motion.index`` (rad/s)."""
+    k = motion.index
+    omega = np.linalg.norm(motion.angular_velocity, axis=1)
+    model_omega = np.linalg.norm(motion.model_angular_velocity, axis=1)
+    phase = np.unwrap(samples.angles[:, 2])[k]
+    rate = samples.rates[k, 2]
+    with np.errstate(invalid='ignore'):
+        exact = np.abs(np.asarray(model.dynamics.angular_speed_per_phase(phase)) * rate)
+    return omega * np.where(rate < 0, -1.0, 1.0), np.abs(model_omega - exact)
+
+
+def _resolution(samples, motion, model, timeline, margin):
+    """The samples whose own FD error is within the cap (:func:`.resolution.resolve`):
+    2 × margin × |ω_fd − ω_exact| / Ω_s, Ω_s = max(|Ω| under the speed drive, 1 rad/s)."""
+    k = motion.index
+    signed, fd_errors = _speeds(samples, motion, model)
+    stamps = samples.stamp_ns[k]
+    starts = [-math.inf if s is None else s for s, _ in timeline] + [math.inf]
+    driven = np.zeros(k.size, dtype=bool)
+    for (start, state), end in zip(zip(starts, (s for _, s in timeline)), starts[1:]):
+        if state['active'] == 'speed':
+            driven |= (stamps >= start) & (stamps < end)
+    scale = max(1.0, float(np.max(np.abs(signed[driven]))) if np.any(driven) else 1.0)
+    return resolve(2 * margin * fd_errors / scale, k, samples, model.body, minimum=2)
 
 
 def speed_drive_check(samples, motion, model, timeline, parameters, events, margin,
@@ -102,11 +133,15 @@ def speed_drive_check(samples, motion, model, timeline, parameters, events, marg
     """
     if not any(state['active'] == 'speed' for _, state in timeline):
         return None
-    rows, skipped = speed_stretches(samples, motion, model, timeline, _lags(parameters, events))
+    kept = _resolution(samples, motion, model, timeline, margin)
+    if kept.count < 2:
+        return Check('speed_drive', TITLE, False, None, None, '', [kept.note])
+    rows, skipped = speed_stretches(samples, motion, model, timeline,
+                                    _lags(parameters, events), kept.keep)
     if not rows:
         return Check('speed_drive', TITLE, False, None, None, '', [
             'not evaluated: no stretch under the speed drive with two differenced samples'] +
-            skipped[:3])
+            skipped[:3] + ([] if kept.note is None else [kept.note]))
     scale = max(1.0, max(float(np.max(np.abs(r[1]))) for r in rows))
     errors = [np.abs(r[1] - r[2]) / scale for r in rows]
     worst_row = int(np.argmax([float(np.max(e)) for e in errors]))
@@ -124,4 +159,5 @@ def speed_drive_check(samples, motion, model, timeline, parameters, events, marg
         f'FD-limited: |ω| of the model\'s poses at the recorded phases is within '
         f'{fd_error:.3g} of the exact |ω_u(u)| |u̇|; tolerance 2 × {margin:g} × that (the '
         f'sample and the reference) + {roundoff:.3g} (round-off and solver)'] + [
-        f'not checked: {line}' for line in skipped[:5]])
+        f'not checked: {line}' for line in skipped[:5]] + (
+        [] if kept.note is None else [kept.note]))

@@ -4,7 +4,8 @@ Levels: ERROR once the motion has left the rolling model (lift-off, slip, or a s
 cannot stand on: from t = 0, with the reason), WARN when the invariant drifts beyond
 ``tolerance``, the rate is not held, or the contacts are close to their limits, else OK.
 The invariant is the energy E (dynamic mode, flat free scene), the angular speed (kinematic
-mode, flat) or the energy balance E + W − W_d (any other scene: W the work done against
+mode, flat; in the other modes it is a value too, ``angular_speed`` |w| = |ω_u| |u̇| about
+AB: finite and exact also where a contact sits on a flat vertex) or the energy balance E + W − W_d (any other scene: W the work done against
 damping and rolling resistance, W_d the drive's work, both from the run's start or its last
 reset). With losses and no drive the body comes to rest on a stable pose: the values give the
 energy above it and, once at rest, the time it came to rest (``at_rest_since``, s).
@@ -52,6 +53,8 @@ def status(node, sample, i):
     if name != 'energy':
         values = [v for v in values if v[0] != 'energy'] + [
             ('energy', simulation.energy(sample, i))]
+    if name != 'angular_speed':     # |w| about AB: finite also on a flat vertex (u̇ is not)
+        values.append(('angular_speed', abs(float(sample.angular_speed[i]))))
     if sample.scene is not None:
         values += scene_values(node, sample, i)
     return level, message, values + simulation.equilibrium_values()

@@ -92,6 +92,9 @@ class Roller(Node):
         if cost.message:      # an extreme body: say what the tables cost while it is paid
             self.get_logger().info(cost.message)
         self.simulation = Simulation(self.settings, run)
+        note = run_summary.start_note(run.body, self.simulation.initial_state())
+        if note:
+            self.get_logger().info(note)
         if self.simulation.invalid is not None:    # a slope the body cannot stand on
             self.get_logger().error(self.simulation.invalid.reason)
         if (self.settings.method == 'table' and self.simulation.scene is None

@@ -3,12 +3,19 @@
 As ``ros2 bag record`` says what it records, the node logs one INFO line when it is ready
 (the body, the motion, the rate, how it runs, the output file) and one when the run ends
 (samples published, simulated and wall time, the file and its size, the first sample outside
-the rolling model, samples dropped to keep real time).
+the rolling model, samples dropped to keep real time); and one more at the start if that is
+on a flat vertex of the laminae (:func:`start_note`).
 """
 
+import math
 import os
 
-__all__ = ['start_line', 'end_line', 'file_size']
+import numpy as np
+
+__all__ = ['start_line', 'start_note', 'end_line', 'file_size']
+
+#: rad: a start this close to a flat vertex's phase is on it (the phases are exact to rounding)
+VERTEX_GAP = 1e-9
 
 
 def start_line(settings):
@@ -22,6 +29,25 @@ def start_line(settings):
     output = f'recording to {s.record}' if s.record else 'not recording'
     return (f'rolling a={s.a:g} m, b={s.b:g} m, delta={s.delta:g} m ({s.mass_model} mass '
             f'model, {s.mode} mode, method {s.method}) at {s.rate:g} Hz {timing}; {output}')
+
+
+def start_note(body, start):
+    """One line if the start is a phase where the body does not turn in u (a contact on a flat
+    vertex of its laminae), else None. ``start``: the run's
+    :class:`~twodisk_ros.physics.dynamics.PhaseState`."""
+    finder = getattr(body, 'flat_vertex_phases', None)
+    vertices = np.asarray(finder() if finder is not None else [], dtype=float)
+    gap = np.abs(np.remainder(start.phase - vertices + math.pi, 2 * math.pi) - math.pi)
+    if not vertices.size or float(np.min(gap)) > VERTEX_GAP:
+        return None
+    vertex = float(vertices[int(np.argmin(gap))])
+    where = (f'the start is on a flat vertex (phase u0 = {vertex:.9g} rad), where the body '
+             'does not turn in u')
+    if start.angular_speed == 0:
+        return f'{where}: it starts at rest there'
+    return (f'{where} (u̇ is infinite there): it starts from the angular speed '
+            f'{start.angular_speed:g} rad/s about the contact line AB, and the contact forces '
+            'are unbounded at that instant')
 
 
 def file_size(nbytes):

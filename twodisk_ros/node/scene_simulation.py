@@ -117,8 +117,10 @@ class SceneMotion:
         Reused by the scene's tables.
     drive, command : str, float or None
         The drive in force and its command (:func:`scene_of`; None: none yet).
-    start : (float, float)
-        (u (rad), u̇ (rad/s)) at the stretch's t = 0.
+    start : PhaseState
+        (u (rad), u̇ (rad/s), w (rad/s)) at the stretch's t = 0
+        (:class:`~twodisk_ros.physics.dynamics.PhaseState`; a body other than the ellipse
+        starts from w, finite also where it stops turning in u).
     carry : (float, float, float), optional
         (W, W_d, E₀) (J) at the stretch's start: the work done before it and the energy
         balance's constant; None for the start of a run.
@@ -128,8 +130,8 @@ class SceneMotion:
 
     def __init__(self, dynamics, settings, model, *, drive=None, command=None, start,
                  carry=None, terms=None):
-        u0, u_dot0 = (float(x) for x in start)
-        speed = u_dot0 * float(dynamics.angular_speed_per_phase(u0))
+        u0, u_dot0, speed = (float(x) for x in start)
+        general = dynamics.general
         self.scene = scene = scene_of(settings, drive, command, speed)
         if terms is None or (terms.scene.slope, terms.scene.heading0) != (scene.slope,
                                                                           scene.heading0):
@@ -138,12 +140,16 @@ class SceneMotion:
             terms = copy(terms)
             terms.scene = scene
         self.terms = terms
+        regular = speed if general else None      # the ellipse: today's (u, u̇)
         if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
-            self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance)
+            self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance,
+                                      angular_speed=regular)
         else:
             self.stream = scene_stream(dynamics, scene, u0, u_dot0, method=settings.method,
-                                       tolerance=settings.tolerance, terms=terms)
-        energy = float(terms.energy(u0, u_dot0))
+                                       tolerance=settings.tolerance, terms=terms,
+                                       angular_speed=regular)
+        energy = float(terms.energy_turning(u0, speed) if general
+                       else terms.energy(u0, u_dot0))
         self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x) for x in carry)
         self.energy0 = self.carry[2]
         self.standing = (True, '')
@@ -157,21 +163,26 @@ class SceneMotion:
         return self.stream.solver
 
     def sample(self, t):
-        """(u, u̇, ü, SceneValues, (G, A, B, q)) at times t (s, increasing)."""
+        """(u, u̇, ü, w, SceneValues, (G, A, B, q)) at times t (s, increasing); w = |ω_u| u̇
+        the angular speed about AB (rad/s), finite also where the body stops turning in u."""
         t = np.asarray(t, dtype=float)
         w0, wd0, _ = self.carry
         if hasattr(self.stream, 'samples'):
             s = self.stream.samples(t)
-            u, u_dot, u_ddot = s.phase, s.phase_rate, s.phase_acceleration
+            u, u_dot, u_ddot, speed = (s.phase, s.phase_rate, s.phase_acceleration,
+                                       s.rolling_speed)
             values = SceneValues(s.energy, s.dissipated + w0, s.drive_work + wd0,
                                  s.drive_torque, s.power)
         else:         # today's MotionStream (flat, free, conservative from here on)
-            u, u_dot = self.stream.sample(t)
+            u, u_dot, speed = self.stream.sample_with_speed(t)
             m, v, dm, dv = np.moveaxis(self.terms.energy_jet(u)[..., :4], -1, 0)
-            u_ddot = -(0.5 * dm * u_dot**2 + dv) / m
+            with np.errstate(divide='ignore', invalid='ignore'):
+                u_ddot = -(0.5 * dm * u_dot**2 + dv) / m
+            energy = (self.terms.energy_turning(u, speed) if self.terms.dynamics.general
+                      else 0.5 * m * u_dot**2 + v)
             zero = np.zeros(t.shape)
-            values = SceneValues(0.5 * m * u_dot**2 + v, zero + w0, zero + wd0, zero, zero)
-        return u, u_dot, u_ddot, values, self.terms.poses(u)
+            values = SceneValues(energy, zero + w0, zero + wd0, zero, zero)
+        return u, u_dot, u_ddot, speed, values, self.terms.poses(u)
 
     def forces(self, u, u_dot, u_ddot):
         """The ground's forces (:class:`~twodisk_ros.physics.scene_terms.SceneForces`)."""

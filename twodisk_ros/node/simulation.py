@@ -13,6 +13,7 @@ import numpy as np
 from ..model.outline import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
+from ..physics.dynamics import PhaseState
 from ..run.description import RunDescription
 from .scene_simulation import SceneMotion, flat_free
 
@@ -67,6 +68,9 @@ class Sample:
     quaternion: np.ndarray
     forces: object = None      #: ContactForces of the block (None if not asked for)
     scene: object = None       #: SceneValues (energy balance, drive) of a scene's motion
+    #: w = |ω_u| u̇ (rad/s, signed as u̇): the angular speed about AB, finite also where the
+    #: body stops turning in u (u̇ infinite there: a contact on a flat vertex)
+    angular_speed: np.ndarray = None
 
     def __len__(self):
         return len(self.t)
@@ -83,7 +87,9 @@ class Simulation:
         The description of these settings if already built (else built here).
     drive, command, start, carry, terms
         A scene's motion (:class:`~twodisk_ros.node.scene_simulation.SceneMotion`): the drive
-        in force and its command, the state (u, u̇) at t = 0 (None: ``theta0``), the work
+        in force and its command, the state at t = 0 (a
+        :class:`~twodisk_ros.physics.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
+        ``omega0``), the work
         done before and the balance's E₀, reused tables. Today's path is taken where the
         settings are flat, free and conservative and ``start`` is None.
     orientation : array (4,), optional
@@ -160,7 +166,8 @@ class Simulation:
             carry = (0.0, 0.0, self.energy0)
         nxt = Simulation(settings, self.run if self.run.settings == settings else None,
                          drive=drive, command=command,
-                         start=(sample.phase[i], sample.phase_rate[i]), carry=carry,
+                         start=PhaseState(float(sample.phase[i]), float(sample.phase_rate[i]),
+                                          float(sample.angular_speed[i])), carry=carry,
                          terms=self.scene.terms if self.scene is not None else None,
                          orientation=sample.quaternion[i])
         if self.invalid is not None and settings.friction == self.settings.friction:
@@ -170,7 +177,8 @@ class Simulation:
         return nxt
 
     def initial_state(self):
-        """(u0, u̇0): the phase and phase rate this stretch starts from."""
+        """The :class:`~twodisk_ros.physics.dynamics.PhaseState` (u0, u̇0, w0) this stretch
+        starts from: w0 the angular speed about AB, finite also at a flat vertex."""
         return self.run.start() if self.start is None else self.start
 
     def sample(self, t, forces=False, time_offset=0.0):
@@ -183,7 +191,7 @@ class Simulation:
         t = np.asarray(t, dtype=float)
         if self.scene is not None:
             return self._scene_sample(t, forces, time_offset)
-        u, u_dot = self.stream.sample(t)
+        u, u_dot, speed = self.stream.sample_with_speed(t)
         poses = self.dynamics.cycle.poses(u)
         quaternion = continuous_quaternions(poses.quaternion, self._last_quaternion)
         if len(quaternion):
@@ -191,13 +199,18 @@ class Simulation:
         theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
         contact = None
         if forces:
-            contact = (self.forces.kinematic(u, self.angular_speed0)
-                       if self.settings.mode == 'kinematic' else self.forces.dynamic(u, u_dot))
+            if self.settings.mode == 'kinematic':
+                contact = self.forces.kinematic(u, self.angular_speed0)
+            elif self.dynamics.general:      # w: finite where u̇ is not
+                contact = self.forces.dynamic(u, angular_speed=speed)
+            else:
+                contact = self.forces.dynamic(u, u_dot)
             self._check(t + time_offset, contact)
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,
                       position_g=poses.position_g, contact_a=poses.contact_a,
-                      contact_b=poses.contact_b, quaternion=quaternion, forces=contact)
+                      contact_b=poses.contact_b, quaternion=quaternion, forces=contact,
+                      angular_speed=speed)
 
     def _check(self, times, contact):
         if self.invalid is None and len(times):
@@ -206,7 +219,7 @@ class Simulation:
                 self.invalid = report
 
     def _scene_sample(self, t, forces, time_offset):
-        u, u_dot, u_ddot, values, (g, a, b, q) = self.scene.sample(t)
+        u, u_dot, u_ddot, speed, values, (g, a, b, q) = self.scene.sample(t)
         self.scene.track_rest(t + time_offset, u, u_dot, u_ddot, values.energy)
         quaternion = continuous_quaternions(q, self._last_quaternion)
         if len(quaternion):
@@ -219,7 +232,7 @@ class Simulation:
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot, position_g=g,
                       contact_a=a, contact_b=b, quaternion=quaternion, forces=contact,
-                      scene=values)
+                      scene=values, angular_speed=speed)
 
     def update(self, settings):
         """Take settings that leave the motion unchanged (e.g. friction, frame_id).
@@ -259,22 +272,24 @@ class Simulation:
         angular speed |ω| (rad/s), drift ||ω| − |omega0|| / |omega0| (|ω| itself if
         omega0 = 0). Energy is not conserved there: the motor does work.
         """
-        u, u_dot = sample.phase[i], sample.phase_rate[i]
         if sample.scene is not None:
             balance = float(sample.scene.balance[i])
             return ('energy_balance', balance,
                     abs(balance - self.energy0) / self.dynamics.energy_scale)
         if self.settings.mode == 'kinematic':
-            speed = float(self.dynamics.tabulated(u)[2] * abs(u_dot))
+            speed = abs(float(sample.angular_speed[i]))
             scale = self.angular_speed0 if self.angular_speed0 > 0 else 1.0
             return 'angular_speed', speed, abs(speed - self.angular_speed0) / scale
-        energy = float(self.dynamics.energy(u, u_dot))
+        energy = self.energy(sample, i)
         return 'energy', energy, abs(energy - self.energy0) / self.dynamics.energy_scale
 
     def energy(self, sample, i):
-        """E (J) at sample i."""
+        """E (J) at sample i: ½ m u̇² + V for the ellipse, ½ J w² + V for any other body (the
+        regular chart: finite and exact also where it stops turning in u)."""
         if sample.scene is not None:
             return float(sample.scene.energy[i])
+        if self.dynamics.general:
+            return float(self.dynamics.energy_turning(sample.phase[i], sample.angular_speed[i]))
         return float(self.dynamics.energy(sample.phase[i], sample.phase_rate[i]))
 
     def rotation(self, sample, i):

@@ -14,6 +14,7 @@ solved in :mod:`twodisk_ros.physics.motion`.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -27,9 +28,25 @@ from .spectral import spectral_derivative
 from .tables import HermiteTable
 from .wells import LocalWell, TabulatedWell
 
-__all__ = ['RollingDynamics']
+__all__ = ['PhaseState', 'RollingDynamics']
 
 _FD_STEP = 1e-3   # rad: step of the 5-point difference of m(u), times the feature width
+
+
+class PhaseState(NamedTuple):
+    """A state of the motion in both charts (SI units).
+
+    ``angular_speed`` w = |ω_u| u̇ (rad/s, signed as u̇: + for increasing phase) is the body's
+    angular speed about the contact line AB: finite wherever the body is, also where it stops
+    turning in u (|ω_u| = 0: a contact on a superellipse's flat vertex), so it is the state
+    the motion starts from and continues from. ``phase_rate`` u̇ (rad/s) is derived from it:
+    infinite where |ω_u| = 0 (at a flat vertex's phase |ω_u| is rounding, ~1e-13, and u̇ ~1e13
+    rad/s stands for that infinity; nothing is computed from it there).
+    """
+
+    phase: float            #: u (rad)
+    phase_rate: float       #: u̇ (rad/s)
+    angular_speed: float    #: w = |ω_u| u̇ (rad/s)
 
 
 class RollingDynamics:
@@ -304,5 +321,19 @@ class RollingDynamics:
         return abs(float(self.potential_slope(u))) <= 1e-13 * self.energy_scale
 
     def initial_phase_rate(self, u0, omega0):
-        """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0."""
-        return float(omega0) / float(self.angular_speed_per_phase(u0))
+        """u̇₀ (rad/s) giving the body the signed angular speed ``omega0`` (rad/s) at u0
+        (±inf where the body does not turn in u: :meth:`initial_state` is the regular form)."""
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return float(np.float64(omega0) / np.float64(self.angular_speed_per_phase(u0)))
+
+    def initial_state(self, u0, omega0):
+        """The :class:`PhaseState` at phase u0 (rad) with the signed angular speed ``omega0``
+        (rad/s): w0 = omega0, u̇0 = :meth:`initial_phase_rate`."""
+        return PhaseState(float(u0), self.initial_phase_rate(u0, omega0), float(omega0))
+
+    def energy_turning(self, u, angular_speed):
+        """E = ½ J(u) w² + V(u) (J) from the tables, w = |ω_u| u̇ (rad/s): the energy in the
+        regular chart (J = m/|ω_u|², :meth:`tabulated_inertia`), finite also where the body
+        stops turning in u; equal to :meth:`energy` elsewhere (to the tables' rounding)."""
+        return (0.5 * self.tabulated_inertia(u) * np.square(angular_speed)
+                + self.tabulated(u)[..., 1])

@@ -32,7 +32,7 @@ from scipy.integrate import solve_ivp
 
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
-from .motion_general import SundmanSolution, general_closed_form, sundman
+from .motion_general import SundmanSolution, general_closed_form, sundman, turning_state
 from .solvers import (LibrationSolution, OdeSolution, QuadratureSolution, RestSolution)
 from .spectral import STALL, spectral_tail
 from .turning import TurningPointSolution, turning_points
@@ -231,6 +231,7 @@ class MotionStream:
                   else float(u_dot0) * float(dynamics.angular_speed_per_phase(u0)))
             closed = general_closed_form(dynamics, mode, method, u0, w0, _REGULAR_FORMS)
             self._end_state = (u0, w0)
+            self._speed = abs(w0)
             self.initial_energy = float(0.5 * dynamics.tabulated_inertia(u0) * w0**2
                                         + dynamics.tabulated(u0)[1])
             self._sol = closed if closed is not None else SundmanSolution(
@@ -241,6 +242,7 @@ class MotionStream:
             #: the solution from ``_start`` on: closed form, or the ODE's segment so far
             self._sol = closed if closed is not None else OdeSolution(None, [u0, u_dot0], 0.0)
             self._end_state = (u0, u_dot0)
+            self._speed = abs(u_dot0 * float(dynamics.angular_speed_per_phase(u0)))
             self.initial_energy = float(dynamics.energy(u0, u_dot0))
         #: right-hand-side evaluations of the ODE segments so far (0 for a closed form)
         self.nfev = 0
@@ -252,12 +254,20 @@ class MotionStream:
 
     def sample(self, t):
         """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
+        return self.sample_with_speed(t)[:2]
+
+    def sample_with_speed(self, t):
+        """(u, u̇, w) at times t (s, increasing, not before earlier calls): w = |ω_u| u̇ the
+        angular speed about AB (rad/s, signed as u̇), finite also where the body stops
+        turning in u (:func:`~twodisk_ros.physics.motion_general.turning_state`)."""
         t = np.asarray(t, dtype=float)
         pieces = []
         while True:
             end = self._start + self._sol.t_end
             inside = t <= end
-            pieces.append(self._sol(t[inside] - self._start))
+            pieces.append(np.stack(turning_state(
+                self.dynamics, self._sol, t[inside] - self._start, self.mode,
+                self.initial_energy, self._speed)))
             t = t[~inside]
             if not t.size:
                 break
@@ -272,7 +282,7 @@ class MotionStream:
                 self.dynamics, self.mode, self.method, span, *self._end_state, self.tolerance)
             self.nfev += nfev
         joined = np.concatenate(pieces, axis=1)
-        return joined[0], joined[1]
+        return joined[0], joined[1], joined[2]
 
 
 def _motion(dynamics, mode, method, t, sol, nfev=0):

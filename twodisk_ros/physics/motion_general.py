@@ -23,7 +23,7 @@ from scipy.integrate import solve_ivp
 
 from .solvers import QuadratureSolution, RestSolution, SundmanSolution
 
-__all__ = ['SundmanSolution', 'general_closed_form', 'sundman']
+__all__ = ['SundmanSolution', 'general_closed_form', 'sundman', 'turning_state']
 
 
 def general_closed_form(dynamics, mode, method, u0, w0, regular_forms):
@@ -122,3 +122,29 @@ def sundman(dynamics, mode, method, t_end, u0, w0, tolerance):
         if result.t_events[0].size:
             return SundmanSolution(result.sol, y0, float(result.t_events[0][0]), rate_of), nfev
         span *= 4.0
+
+
+def turning_state(dynamics, sol, t, mode, energy, speed):
+    """(u, u̇, w) of a solution at times t (s, from its start): w = |ω_u| u̇ (rad/s, signed as
+    u̇) in the regular chart, finite where the body stops turning in u.
+
+    DOP853 in τ (:class:`SundmanSolution`) integrates w itself; u̇ = w/|ω_u| as it reports.
+    A closed form gives (u, u̇); then w is |ω_u| u̇ for the ellipse (|ω_u| > 0 everywhere) and,
+    for any other body, what the solution conserves, evaluated where it is regular: |w| = Ω
+    (``speed``, kinematic) or √(2(E − V(u))/J(u)) (``energy`` E, J the inertia about AB), with
+    the sign of u̇. (At a flat vertex |ω_u| and m are rounding, ~1e-13 and ~1e-27, so |ω_u| u̇
+    and ½ m u̇² are not: 2.17 rad/s and a 2e-5 error of E at the vertex of the n = 4
+    square at 3 rad/s.)
+    """
+    state = getattr(sol, 'state', None)
+    if state is not None:
+        u, w = state(t)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return u, w / dynamics.angular_speed_per_phase(u), w
+    u, u_dot = sol(t)
+    if not dynamics.general:
+        return u, u_dot, dynamics.tabulated(u)[..., 2] * u_dot
+    if mode == 'kinematic':
+        return u, u_dot, np.sign(u_dot) * abs(speed)
+    twice = np.maximum(2.0 * (energy - dynamics.tabulated(u)[..., 1]), 0.0)
+    return u, u_dot, np.sign(u_dot) * np.sqrt(twice / dynamics.tabulated_inertia(u))

@@ -135,17 +135,23 @@ class RunDescription:
         return RollingDynamics(self.body, self.mass, self.settings.gravity)
 
     def start(self):
-        """(u0 (rad), u̇0 (rad/s)): the phase and phase rate of theta0, branch and omega0."""
+        """The :class:`~twodisk_ros.physics.dynamics.PhaseState` of theta0, branch and omega0:
+        u0 (rad), the angular speed w0 = omega0 about AB (rad/s: the regular chart, well
+        defined also at a flat vertex, where the body does not turn in u) and u̇0 = w0/|ω_u(u0)|
+        (rad/s; infinite there)."""
         s = self.settings
         u0 = float(self.body.phase_from_theta(s.theta0, s.branch))
-        return u0, self.dynamics.initial_phase_rate(u0, s.omega0)
+        return self.dynamics.initial_state(u0, s.omega0)
 
     def stream(self):
-        """A new :class:`~twodisk_ros.physics.motion.MotionStream` of the run from t = 0."""
+        """A new :class:`~twodisk_ros.physics.motion.MotionStream` of the run from t = 0
+        (started from w0 for any body but the ellipse, as :func:`~twodisk_ros.physics.simulate`
+        does: u̇0 is infinite where the body does not turn in u)."""
         s = self.settings
-        u0, u_dot0 = self.start()
-        return MotionStream(self.dynamics, u0, u_dot0, mode=s.mode, method=s.method,
-                            tolerance=s.tolerance)
+        start = self.start()
+        speed = start.angular_speed if self.dynamics.general else None
+        return MotionStream(self.dynamics, start.phase, start.phase_rate, mode=s.mode,
+                            method=s.method, tolerance=s.tolerance, angular_speed=speed)
 
     def metadata(self):
         """{key: text}: the recording's ``twodisk_ros`` metadata of the run.
