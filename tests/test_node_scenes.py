@@ -249,6 +249,17 @@ class Driver:
                 return True
         return False
 
+    def quiet(self, gap, timeout=20.0):
+        """Spin until no pose has arrived for ``gap`` seconds (a node behind real time on a
+        loaded machine still delivers what it published before a pause); the pose count."""
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            count = len(self.poses)
+            self.spin(gap, lambda: len(self.poses) > count)
+            if len(self.poses) == count:
+                return count
+        raise AssertionError(f'poses kept arriving for {timeout} s after the pause')
+
     def command(self, publisher, value):
         publisher.publish(self.Float64(data=float(value)))
 
@@ -302,8 +313,7 @@ def test_driven_from_a_second_node(tmp_path):
         live.spin(0.3)
         live.call(live.pause, live.SetBool.Request(data=True))
         live.event('pause')
-        live.spin(0.3)                  # what was published before the pause arrives
-        held = len(live.poses)
+        held = live.quiet(0.3)          # what was published before the pause has arrived
         live.spin(0.5)
         assert len(live.poses) == held  # paused: nothing more is published
         live.call(live.pause, live.SetBool.Request(data=False))

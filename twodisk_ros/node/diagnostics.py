@@ -54,7 +54,7 @@ def status(node, sample, i):
         values = [v for v in values if v[0] != 'energy'] + [
             ('energy', simulation.energy(sample, i))]
     if name != 'angular_speed':     # |w| about AB: finite also on a flat vertex (u̇ is not)
-        values.append(('angular_speed', abs(float(sample.angular_speed[i]))))
+        values.append(('angular_speed', abs(simulation.angular_speed(sample, i))))
     if sample.scene is not None:
         values += scene_values(node, sample, i)
     return level, message, values + simulation.equilibrium_values()

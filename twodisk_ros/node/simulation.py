@@ -167,7 +167,7 @@ class Simulation:
         nxt = Simulation(settings, self.run if self.run.settings == settings else None,
                          drive=drive, command=command,
                          start=PhaseState(float(sample.phase[i]), float(sample.phase_rate[i]),
-                                          float(sample.angular_speed[i])), carry=carry,
+                                          self.angular_speed(sample, i)), carry=carry,
                          terms=self.scene.terms if self.scene is not None else None,
                          orientation=sample.quaternion[i])
         if self.invalid is not None and settings.friction == self.settings.friction:
@@ -191,7 +191,10 @@ class Simulation:
         t = np.asarray(t, dtype=float)
         if self.scene is not None:
             return self._scene_sample(t, forces, time_offset)
-        u, u_dot, speed = self.stream.sample_with_speed(t)
+        if self.dynamics.general:      # w: finite where u̇ is not
+            u, u_dot, speed = self.stream.sample_with_speed(t)
+        else:                           # w = |ω_u| u̇ read where it is needed (angular_speed)
+            (u, u_dot), speed = self.stream.sample(t), None
         poses = self.dynamics.cycle.poses(u)
         quaternion = continuous_quaternions(poses.quaternion, self._last_quaternion)
         if len(quaternion):
@@ -277,11 +280,19 @@ class Simulation:
             return ('energy_balance', balance,
                     abs(balance - self.energy0) / self.dynamics.energy_scale)
         if self.settings.mode == 'kinematic':
-            speed = abs(float(sample.angular_speed[i]))
+            speed = abs(self.angular_speed(sample, i))
             scale = self.angular_speed0 if self.angular_speed0 > 0 else 1.0
             return 'angular_speed', speed, abs(speed - self.angular_speed0) / scale
         energy = self.energy(sample, i)
         return 'energy', energy, abs(energy - self.energy0) / self.dynamics.energy_scale
+
+    def angular_speed(self, sample, i):
+        """w (rad/s, signed as u̇) at sample i: the angular speed about AB (the ellipse's
+        samples carry none: |ω_u| u̇ there, |ω_u| > 0 everywhere)."""
+        if sample.angular_speed is None:
+            return (float(self.dynamics.angular_speed_per_phase(sample.phase[i]))
+                    * float(sample.phase_rate[i]))
+        return float(sample.angular_speed[i])
 
     def energy(self, sample, i):
         """E (J) at sample i: ½ m u̇² + V for the ellipse, ½ J w² + V for any other body (the

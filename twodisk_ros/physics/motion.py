@@ -254,12 +254,15 @@ class MotionStream:
 
     def sample(self, t):
         """(u, u̇) at times t (s, array, increasing, not before earlier calls)."""
-        return self.sample_with_speed(t)[:2]
+        return self._sample(t, False)
 
     def sample_with_speed(self, t):
         """(u, u̇, w) at times t (s, increasing, not before earlier calls): w = |ω_u| u̇ the
         angular speed about AB (rad/s, signed as u̇), finite also where the body stops
         turning in u (:func:`~twodisk_ros.physics.motion_general.turning_state`)."""
+        return self._sample(t, True)
+
+    def _sample(self, t, with_speed):
         t = np.asarray(t, dtype=float)
         pieces = []
         while True:
@@ -267,7 +270,8 @@ class MotionStream:
             inside = t <= end
             pieces.append(np.stack(turning_state(
                 self.dynamics, self._sol, t[inside] - self._start, self.mode,
-                self.initial_energy, self._speed)))
+                self.initial_energy, self._speed) if with_speed
+                else self._sol(t[inside] - self._start)))
             t = t[~inside]
             if not t.size:
                 break
@@ -282,7 +286,7 @@ class MotionStream:
                 self.dynamics, self.mode, self.method, span, *self._end_state, self.tolerance)
             self.nfev += nfev
         joined = np.concatenate(pieces, axis=1)
-        return joined[0], joined[1], joined[2]
+        return tuple(joined)
 
 
 def _motion(dynamics, mode, method, t, sol, nfev=0):
