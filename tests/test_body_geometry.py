@@ -28,6 +28,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0
+from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 
 # -- tolerances (all measured with the reference below; the margin is ~100x) ----------------
@@ -277,10 +278,11 @@ def test_heights_at_the_equilibria(drawn):
     assert_allclose(geo.height, v0, rtol=0, atol=100 * tol)
     assert_allclose(geo.psi[[0, 2]], 0.0, atol=ANGLE_ATOL)
     assert_allclose(geo.ground_normal[[0, 2], 2], 0.0, atol=ANGLE_ATOL)
-    # V′ vanishes there; cos(π/2) is 6e-17 in floating point, so |V′| ≲ |V″|·1e-16
+    # V′ vanishes there; cos(π/2) is 6e-17 in floating point, so |V′| ≲ |V″|·1e-16, plus
+    # the rounding of V′'s closed form (terms of the size per radian): 16 ulps of both
     v2 = abs(curvature_at_theta0(*shape)) + abs(curvature_at_half_pi(*shape))
     assert_allclose(body.height_derivative(np.array([0.0, math.pi / 2])), 0.0,
-                    atol=1e-15 * (v2 + ref.size))
+                    atol=ulps(16, v2 + ref.size))
 
 
 def test_theta_max_matches_q_root_named():
@@ -296,7 +298,8 @@ def test_theta_max_full_precision():
     for a, b, delta in [(1.0, 0.01, 1e-3), (1.0, 0.05, 0.01), (1.0, 0.01, 1e-5)]:
         body = TwoDiskBody(a, b, delta)
         exact = math.atan2(2 * b * math.sqrt(delta * (a + delta)), -a * a)
-        assert_allclose(body.theta_max, exact, rtol=4e-16)
+        # to rounding (16 ulps; arccos of ≈ −1 was 2.5e-9 off)
+        assert_allclose(body.theta_max, exact, rtol=ulps(16))
 
 
 # -- the phase form ---------------------------------------------------------------------------
@@ -360,17 +363,18 @@ def test_branches_mirror_each_other(drawn):
     thetas = np.linspace(-1, 1, 21) * body.theta_max
     plus, minus = body.geometry(thetas, 1), body.geometry(thetas, -1)
     mirror = np.array([1.0, 1.0, -1.0])
-    tol = 1e-15 * body.size
-    assert_allclose(minus.psi, -plus.psi, rtol=0, atol=1e-15)
+    # the branches' closed forms, rounded: 16 ulps of the size, of |ψ| ≤ π, of a unit vector
+    tol = ulps(16, body.size)
+    assert_allclose(minus.psi, -plus.psi, rtol=0, atol=ulps(16, math.pi))
     assert_allclose(minus.contact_a, plus.contact_a, rtol=0, atol=tol)
     assert_allclose(minus.contact_b, plus.contact_b * mirror, rtol=0, atol=tol)
-    assert_allclose(minus.ground_normal, plus.ground_normal * mirror, rtol=0, atol=1e-15)
+    assert_allclose(minus.ground_normal, plus.ground_normal * mirror, rtol=0, atol=ulps(16))
     assert_allclose(minus.height, plus.height, rtol=0, atol=tol)
     # and θ → −θ reflects x1 → −x1 (the shape is symmetric in its plane)
     flipped = body.geometry(-thetas, 1)
     assert_allclose(flipped.contact_b, plus.contact_b, rtol=0, atol=tol)
     assert_allclose(flipped.ground_normal, plus.ground_normal * [-1.0, 1.0, 1.0], rtol=0,
-                    atol=1e-15)
+                    atol=ulps(16))
 
 
 # -- other closed forms of the paper ----------------------------------------------------------
@@ -400,7 +404,8 @@ def test_extreme_shapes(shape):
     geo = body.phase_geometry(u)
     for field in ('theta', 'psi', 'contact_a', 'contact_b', 'ground_normal', 'height', 'tilt'):
         assert np.all(np.isfinite(getattr(geo, field))), field
-    assert_allclose(np.linalg.norm(geo.ground_normal, axis=-1), 1.0, rtol=1e-15)
+    # a normalised vector's norm, 3 rounded squares summed: 16 ulps of 1
+    assert_allclose(np.linalg.norm(geo.ground_normal, axis=-1), 1.0, rtol=ulps(16))
     v0 = height_at_theta0(*shape)
     assert_allclose(geo.height[:4], v0, rtol=EXTREME_HEIGHT_RTOL)
     assert_allclose(body.height(math.pi / 2), b / SQRT2, rtol=1e-14)

@@ -33,6 +33,7 @@ from hypothesis import given, settings, strategies as st
 from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
+from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics import RollingDynamics, simulate
 from twodisk_ros.physics.equilibria import STABLE, equilibria
@@ -66,11 +67,10 @@ STATIC_ATOL = 5e-15
 #: M g; torques to M g L): measured ≤ 6.1e-13, μ_required ≤ 1.8e-12 relative.
 SYMMETRY_ATOL = 2e-12
 SYMMETRY_MU_RTOL = 5e-12
-#: world vectors against their components (relative to M g): measured ≤ 2e-16; the unit
-#: vector ê against B − A from the cycle's positions: ≤ 5e-15.
-WORLD_ATOL = 1e-15
+#: world vectors against their components: sums of 3 rounded products, so 16 ulps of the
+#: largest force (world_atol; measured ≤ 2e-16 M g); the unit vector ê against B − A from the
+#: cycle's positions: ≤ 5e-15.
 DIRECTION_ATOL = 2e-14
-EPS = np.finfo(float).eps
 #: μ_required against the one from Newton–Euler by finite differences, times N_min / (M g)
 #: (an error δF in the forces moves μ by ~δF/N_min): measured ≤ 2.8e-9, near lift-off.
 MU_FD_TOL = 1e-8
@@ -78,8 +78,16 @@ MU_FD_TOL = 1e-8
 #: max(N_A/N_B, N_B/N_A): B's share S − x of a split stored as A's share x carries the rounding
 #: of S, amplified by N_A/N_B when B is nearly unloaded. Measured ≤ 6.6e-16 over 8e5 random
 #: loads with N_A/N_B up to 1e4 (before the discriminant was formed without cancellation:
-#: 3.3e-13, i.e. 7.6e-10 at N_A/N_B = 2300).
-SQUEEZE_RTOL = 2e-15
+#: 3.3e-13, i.e. 7.6e-10 at N_A/N_B = 2300): 16 ulps, a sum of rounded terms.
+SQUEEZE_RTOL = ulps(16)
+#: The friction ratios √(T² + x²)/N of the split against np.hypot(T, x)/N: ≤ 4 rounded
+#: operations each side, but libm's hypot has no stated last bit: 16 ulps, relative.
+RATIO_RTOL = ulps(16)
+
+
+def world_atol(*forces):
+    """16 ulps of the largest of the forces (N), each of shape (..., 3)."""
+    return ulps(16, max(np.max(np.linalg.norm(f, axis=-1)) for f in forces))
 
 
 def make(shape, model='laminae', gravity=GRAVITY):
@@ -266,9 +274,9 @@ def test_world_vectors_match_components_and_contact_line():
     p = np.cross([0.0, 0.0, 1.0], unit)
     for f, n, t, x in ((forces.force_a, forces.normal_a, forces.tangential_a, forces.along_a),
                        (forces.force_b, forces.normal_b, forces.tangential_b, forces.along_b)):
-        assert_allclose(f @ [0, 0, 1.0], n, atol=WORLD_ATOL * model.weight)
-        assert_allclose(np.sum(f * p, -1), t, atol=WORLD_ATOL * model.weight)
-        assert_allclose(np.sum(f * unit, -1), x, atol=WORLD_ATOL * model.weight)
+        assert_allclose(f @ [0, 0, 1.0], n, atol=world_atol(f))
+        assert_allclose(np.sum(f * p, -1), t, atol=world_atol(f))
+        assert_allclose(np.sum(f * unit, -1), x, atol=world_atol(f))
 
 
 def test_drive_torque_supplies_the_power():
@@ -436,10 +444,10 @@ def test_squeeze_split_minimises_the_friction_needed():
     rtol = SQUEEZE_RTOL * np.maximum(n_a / n_b, n_b / n_a)
     assert np.all(np.abs(mu / least_friction(n_a, n_b, t_a, t_b, s) - 1) <= rtol)
     # the reported split needs no more than that: f_A, f_B computed here from x
-    assert np.all(np.hypot(t_a, x) / n_a <= mu * (1 + 4 * EPS))
-    assert np.all(np.hypot(t_b, s - x) / n_b <= mu * (1 + 4 * EPS))
-    assert_allclose(ratio_a, np.hypot(t_a, x) / n_a, rtol=4 * EPS)
-    assert_allclose(ratio_b, np.hypot(t_b, s - x) / n_b, rtol=4 * EPS)
+    assert np.all(np.hypot(t_a, x) / n_a <= mu * (1 + RATIO_RTOL))
+    assert np.all(np.hypot(t_b, s - x) / n_b <= mu * (1 + RATIO_RTOL))
+    assert_allclose(ratio_a, np.hypot(t_a, x) / n_a, rtol=RATIO_RTOL)
+    assert_allclose(ratio_b, np.hypot(t_b, s - x) / n_b, rtol=RATIO_RTOL)
     lifted = squeeze_split([-1.0, 1.0], [1.0, 0.0], [0.1, 0.1], [0.1, 0.1], [1.0, 1.0])
     assert np.all(np.isinf(lifted[3]))
 
@@ -507,7 +515,7 @@ def test_extreme_shapes_are_finite(shape):
                  'drive_torque', 'force_a', 'force_b'):
         assert np.all(np.isfinite(getattr(forces, name))), name
     assert_allclose(forces.normal_a + forces.normal_b - forces.force_a[:, 2]
-                    - forces.force_b[:, 2], 0.0, atol=WORLD_ATOL * model.weight)
+                    - forces.force_b[:, 2], 0.0, atol=world_atol(forces.force_a, forces.force_b))
     speed = liftoff_speed(model)[0]
     assert 0 < speed < np.inf
 

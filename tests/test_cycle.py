@@ -29,6 +29,7 @@ from numpy.testing import assert_allclose
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
+from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
 
@@ -46,16 +47,18 @@ NO_SLIP_RTOL = 1e-8
 #: make the same differences truncation-limited, measured ≤ 1e-7.
 EXTREME_NO_SLIP_RTOL = 1e-6
 #: Lowest point of the body relative to its size: measured ≥ −4.7e-16 over the named, extreme
-#: and 40 random shapes of the hypothesis range (1500 samples per rim).
-GROUND_RTOL = 2e-15
+#: and 40 random shapes of the hypothesis range (1500 samples per rim); a rim point's height
+#: is a sum of rounded products of the size: 16 ulps.
+GROUND_RTOL = ulps(16)
 #: R is a rotation: RᵀR = 1 and det R = 1, measured ≤ 1.3e-15.
 ROTATION_ATOL = 5e-15
 #: A and B, mapped back to the body frame by R, lie on their ellipses (relative to size).
 #: Positions come from the cycle tables, R from the closed forms. Measured over 3 cycles:
 #: ≤ 2.7e-14 (named and 40 random shapes), ≤ 1.5e-13 at the extremes ((1, 0.01, 1e-3)).
 MATERIAL_RTOL = {'regular': 1e-13, 'extreme': 5e-13}
-#: Constant height of G for the neutral bodies (TCR, Figure 4), m: measured ≤ 4.4e-16.
-NEUTRAL_HEIGHT_ATOL = 2e-15
+#: Constant height of G for the neutral bodies (TCR, Figure 4), relative to the size:
+#: measured ≤ 4.4e-16 m; the tables' rounding, 16 ulps of the size.
+NEUTRAL_HEIGHT_RTOL = ulps(16)
 #: Composition over N ≤ 50 cycles against an explicit loop, relative to size and per cycle:
 #: measured ≤ 2.4e-14 (rounding of the loop and of the closed-form power; docs/physics.md).
 COMPOSE_RTOL = 1e-13
@@ -76,7 +79,9 @@ OLOID_ATOL = 1.5e-14
 #: Turn per cycle against 2π (Gauss–Bonnet), rad. docs/physics.md: ≤ 1e-14 for the named
 #: bodies (measured 0 for b/a near 1, 2e-14 for (1, 0.05, 0.01)), ≤ 1.4e-14 over the hypothesis
 #: range (200 random shapes), ≤ 5e-14 at the extremes (measured 4.7e-14 at (1, 0.01, 1 − 1e-6)).
-TURN_ATOL = {'named': 4e-15, 'range': 5e-14, 'extreme': 1.5e-13}
+#: For the named bodies that is rounding: the turn is a quadrature's sum of rounded terms,
+#: 16 ulps of 2π (2.2e-14).
+TURN_ATOL = {'named': ulps(16, TWO_PI), 'range': 5e-14, 'extreme': 1.5e-13}
 #: u → −u mirrors the trace in the Y axis: measured ≤ 2.2e-14 of the size (trace) and
 #: ≤ 1.3e-14 rad (heading) over 100 random shapes; Im S ≤ 8e-15 of the size over 200.
 MIRROR_ATOL = 1e-13
@@ -290,15 +295,16 @@ def test_neutral_bodies_keep_g_at_constant_height(name):
                         np.arange(-2, 11) * math.pi / 2])
     height = cycle.state(u).position_g[:, 2]
     # b/√2 (= V(π/2) for every shape) with b = 1
-    assert_allclose(height, 1 / SQRT2, rtol=0, atol=NEUTRAL_HEIGHT_ATOL)
+    assert_allclose(height, 1 / SQRT2, rtol=0, atol=NEUTRAL_HEIGHT_RTOL * _size(*NAMED[name]))
 
 
 def test_oloid_height_range():
     cycle = _cycle(NAMED['oloid'])
     u = np.linspace(0, TWO_PI, 20001)
     height = cycle.state(u).position_g[:, 2]
-    assert height.min() >= 1 / SQRT2 - 1e-15
-    assert height.max() <= 0.75 + 1e-15
+    rounding = ulps(16, _size(*NAMED['oloid']))      # the tables' rounding (m)
+    assert height.min() >= 1 / SQRT2 - rounding
+    assert height.max() <= 0.75 + rounding
     # dense grid: within its own resolution of the bounds (the bounds are quadratic extrema)
     assert height.min() - 1 / SQRT2 < 1e-6
     assert 0.75 - height.max() < 1e-12
@@ -307,8 +313,8 @@ def test_oloid_height_range():
     top = cycle.state(np.array([0.0, math.pi / 2, math.pi, 1.5 * math.pi])).position_g[:, 2]
     bottom = cycle.state(np.array([u_half_pi, math.pi - u_half_pi, math.pi + u_half_pi,
                                    TWO_PI - u_half_pi])).position_g[:, 2]
-    assert_allclose(top, 0.75, rtol=0, atol=1e-15)
-    assert_allclose(bottom, 1 / SQRT2, rtol=0, atol=1e-15)
+    assert_allclose(top, 0.75, rtol=0, atol=rounding)
+    assert_allclose(bottom, 1 / SQRT2, rtol=0, atol=rounding)
 
 
 # -- the oloid in closed form ------------------------------------------------------------------
@@ -348,7 +354,8 @@ def test_oloid_cycle_displacement():
     assert_allclose(disp.turn, TWO_PI, rtol=0, atol=TURN_ATOL['named'])
     assert_allclose(abs(disp.shift), 4.8368, rtol=0, atol=5e-5)          # physics notes
     assert_allclose(disp.shift.real, 8 * SQRT3 * math.pi / 9, rtol=1e-14)  # closed form
-    assert_allclose(disp.shift.imag, 0.0, atol=4e-15)                    # measured 7.8e-16
+    # measured 7.8e-16: the shift is a quadrature's sum, 16 ulps of |S|
+    assert_allclose(disp.shift.imag, 0.0, atol=ulps(16, abs(disp.shift)))
 
 
 # -- every shape: one cycle is a pure translation along X --------------------------------------

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from rounding import ulps
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.outline import DEFAULT_TOLERANCE, disk_rims
@@ -97,7 +98,8 @@ def test_marker_fans_fill_the_egg():
         phi = np.linspace(0, 2 * np.pi, 4001)
         n = np.stack([np.cos(phi), np.sin(phi)], -1)
         gap = lamina.support(n).height[None, :] - lam @ n.T
-        assert gap.min() >= -1e-15 * lamina.size
+        # rounding of the placement, of p·n and of h(n): 16 ulps of the size
+        assert gap.min() >= -ulps(16, lamina.size)
         assert gap.min(axis=1).max() <= 1e-5 * lamina.size
         # the fan covers the outline's polygon
         triangles = np.asarray(fan.points).reshape(-1, 3, 3)
@@ -130,8 +132,9 @@ def test_animation_outlines_and_still(body, tmp_path):
     disk1, disk2 = run.outlines(0)
     rim_1, rim_2 = disk_rims(body)
     rotation, g = run.rotation[0], run.position_g[0]
-    np.testing.assert_allclose(disk1, rim_1 @ rotation.T + g, atol=1e-15)
-    np.testing.assert_allclose(disk2, rim_2 @ rotation.T + g, atol=1e-15)
+    # a rotation and a shift of the size, rounded (16 ulps)
+    np.testing.assert_allclose(disk1, rim_1 @ rotation.T + g, atol=ulps(16, body.size))
+    np.testing.assert_allclose(disk2, rim_2 @ rotation.T + g, atol=ulps(16, body.size))
     # resting: nothing below the ground, and both rims touch it (at A and at B)
     for rim in (disk1, disk2):
         assert rim[:, 2].min() >= -DEFAULT_TOLERANCE * body.size

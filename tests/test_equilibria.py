@@ -19,6 +19,7 @@ from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0, height_slope
+from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.cycle import RollingCycle
 from twodisk_ros.physics.equilibria import NEUTRAL, STABLE, UNSTABLE, equilibria, stability_map
@@ -55,10 +56,11 @@ PHASE_CURVATURE_RTOL = 1e-10
 EXTREME_HEIGHT_RTOL = 5e-13
 EXTREME_THETA_CURVATURE_RTOL = 1.5e-13
 EXTREME_TURNING_RTOL = 2e-8
-#: Constant z_G of the neutral shapes, relative to a: the reference height at many θ and the
-#: code's phase_height both measured ≤ 6.6e-16 (300 random neutral shapes); the cycle tables
-#: of the Two-Circle-Roller ≤ 1.1e-16 m at a = 0.3 m.
-NEUTRAL_ATOL = 3e-15
+#: Constant z_G of the neutral shapes, relative to the size: the reference height at many θ
+#: and the code's phase_height both measured ≤ 6.6e-16 of a (300 random neutral shapes); the
+#: cycle tables of the Two-Circle-Roller ≤ 1.1e-16 m at a = 0.3 m. Sums of rounded terms of
+#: the size: 16 ulps.
+NEUTRAL_RTOL = ulps(16)
 
 SHAPES = st.tuples(st.floats(0.1, 10.0), st.floats(math.log(0.05), math.log(20.0)),
                    st.floats(0.01, 0.99))
@@ -240,16 +242,17 @@ def test_neutral_shapes(scale, b_over_a):
     thetas = np.linspace(-0.999, 0.999, 41) * ref.theta_max
     for branch in (1, -1):
         heights = [ref.height(t, branch) for t in thetas]
-        assert_allclose(heights, b / SQRT2, rtol=0, atol=NEUTRAL_ATOL * scale)
+        assert_allclose(heights, b / SQRT2, rtol=0, atol=NEUTRAL_RTOL * body.size)
     u = np.linspace(-math.pi, math.pi, 201)
-    assert_allclose(body.phase_height(u), b / SQRT2, rtol=0, atol=NEUTRAL_ATOL * scale)
+    assert_allclose(body.phase_height(u), b / SQRT2, rtol=0, atol=NEUTRAL_RTOL * body.size)
 
 
 def test_neutral_cycle_keeps_g_level():
     """The TCR through RollingCycle: G at b/√2 at every phase, also at the turning points."""
     cycle = RollingCycle(TwoDiskBody.two_circle_roller(0.3))
     u = np.concatenate([np.linspace(0, 2 * math.pi, 721), np.arange(4) * math.pi / 2])
-    assert_allclose(cycle.state(u).position_g[:, 2], 0.3 / SQRT2, rtol=0, atol=NEUTRAL_ATOL * 0.3)
+    assert_allclose(cycle.state(u).position_g[:, 2], 0.3 / SQRT2, rtol=0,
+                    atol=NEUTRAL_RTOL * cycle.body.size)
     assert [e.stability for e in equilibria(cycle.body)] == [NEUTRAL] * 8
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
+from rounding import ulps
 from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
 from twodisk_ros.physics.lamina_fit import Outline, read_outline
 
@@ -56,15 +57,16 @@ def test_ellipse_against_closed_forms():
     a, b = 2.0, 0.7
     e = Ellipse(a, b)
     m = e.moments
-    # the claims: area πab, ∫x² = πab³/4, ∫y² = πa³b/4, exact to rounding (1e-15 relative)
-    assert m.area == pytest.approx(math.pi * a * b, rel=1e-15)
-    assert m.second_xx == pytest.approx(math.pi * a * b**3 / 4, rel=1e-15)
-    assert m.second_yy == pytest.approx(math.pi * a**3 * b / 4, rel=1e-15)
-    assert m.polar == pytest.approx(math.pi * a * b * (a * a + b * b) / 4, rel=1e-15)
+    # the claims: area πab, ∫x² = πab³/4, ∫y² = πa³b/4, exact to rounding (16 ulps)
+    rounding = ulps(16)
+    assert m.area == pytest.approx(math.pi * a * b, rel=rounding)
+    assert m.second_xx == pytest.approx(math.pi * a * b**3 / 4, rel=rounding)
+    assert m.second_yy == pytest.approx(math.pi * a**3 * b / 4, rel=rounding)
+    assert m.polar == pytest.approx(math.pi * a * b * (a * a + b * b) / 4, rel=rounding)
     assert np.all(m.centroid == 0.0)
     # curvature at the vertices: a/b² at the tips on the common axis, b/a² at the sides
-    assert e.curvature(0.0) == pytest.approx(a / b**2, rel=1e-15)
-    assert e.curvature(np.pi / 2) == pytest.approx(b / a**2, rel=1e-15)
+    assert e.curvature(0.0) == pytest.approx(a / b**2, rel=rounding)
+    assert e.curvature(np.pi / 2) == pytest.approx(b / a**2, rel=rounding)
     # the point lies on x²/b² + y²/a² = 1, with normal ∝ (x/b², y/a²) (gradient of the form)
     s = np.linspace(-np.pi, np.pi, 101)
     x, y = e.point(s).T
@@ -75,7 +77,7 @@ def test_ellipse_against_closed_forms():
     # support in direction n: √(b² n_x² + a² n_y²) (the ellipse's classical support function)
     n = np.stack([np.cos(s), np.sin(s)], axis=-1)
     assert np.allclose(e.support(n).height, np.sqrt(b**2 * n[:, 0]**2 + a**2 * n[:, 1]**2),
-                       rtol=1e-15, atol=0)
+                       rtol=rounding, atol=0)
     assert e.size == a and e.extents == (b, -a, a)
 
 
@@ -153,8 +155,8 @@ def test_support_by_brute_force(lamina):
     assert np.max(np.abs(np.sum(support.point * n, axis=-1) - support.height)) < 1e-14 * size
     assert np.max(np.abs(lamina.point(support.parameter) - support.point)) < 1e-14 * size
     assert np.max(np.abs(lamina.normal(support.parameter) - n)) < 1e-13
-    # homogeneous of degree 1 in the direction
-    assert np.allclose(lamina.support(3 * n).height, 3 * support.height, rtol=1e-15)
+    # homogeneous of degree 1 in the direction, to rounding (16 ulps)
+    assert np.allclose(lamina.support(3 * n).height, 3 * support.height, rtol=ulps(16))
 
 
 # -- the superellipse ------------------------------------------------------------------------
@@ -185,23 +187,26 @@ def test_superellipse_area_gamma_formula_and_vertices(n):
     area, _ = quad(lambda x: a * (1 - (x / b) ** n) ** (1 / n), 0, b, epsabs=0, epsrel=1e-13,
                    limit=200)
     assert 4 * area == pytest.approx(gamma, rel=1e-10)
-    # the four vertices: the support point is exactly the vertex, curvature 0 for n > 2
+    # the four vertices: the support point is the vertex, curvature 0 for n > 2 (to rounding:
+    # 16 ulps of the size, of a height, of |s| ≤ π and of a unit normal)
     axes = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
     support = se.support(axes)
-    assert np.allclose(support.point, [[0, -a], [b, 0], [0, a], [-b, 0]], rtol=0, atol=4e-16)
-    assert np.allclose(support.height, [a, b, a, b], rtol=4e-16, atol=0)
-    assert np.allclose(support.parameter, [0, np.pi / 2, np.pi, -np.pi / 2], atol=1e-15)
-    assert np.max(np.abs(se.normal(support.parameter) - axes)) < 1e-15
+    assert np.allclose(support.point, [[0, -a], [b, 0], [0, a], [-b, 0]], rtol=0,
+                       atol=ulps(16, se.size))
+    assert np.allclose(support.height, [a, b, a, b], rtol=ulps(16), atol=0)
+    assert np.allclose(support.parameter, [0, np.pi / 2, np.pi, -np.pi / 2], rtol=0,
+                       atol=ulps(16, np.pi))
+    assert np.max(np.abs(se.normal(support.parameter) - axes)) < ulps(16)
     kappa = se.curvature(np.array([0.0, np.pi / 2, np.pi]))
     if n > 2:   # exactly 0 at s = 0; fl(π/2), fl(π) miss the vertex by ~1e-16 rad
         assert kappa[0] == 0.0 and np.all(kappa <= 10 * n * 1.3e-16 ** (n - 2) / min(a, b))
     else:
-        assert kappa == pytest.approx([a / b**2, b / a**2, a / b**2], rel=1e-15)
+        assert kappa == pytest.approx([a / b**2, b / a**2, a / b**2], rel=ulps(16))
     # near a vertex the support point stays exact: on the curve |x/b|ⁿ + |y/a|ⁿ = 1
     phi = np.array([1e-12, 1e-6, 1e-3, np.pi / 2 - 1e-9])
     p = se.support(np.stack([np.sin(phi), -np.cos(phi)], axis=-1)).point
-    # (the form multiplies a point's relative rounding error by n)
-    assert np.max(np.abs(np.abs(p[:, 0] / b) ** n + np.abs(p[:, 1] / a) ** n - 1)) < 4e-16 * n + 1e-15
+    # (the form multiplies a point's relative rounding error, 16 ulps, by n)
+    assert np.max(np.abs(np.abs(p[:, 0] / b) ** n + np.abs(p[:, 1] / a) ** n - 1)) < ulps(16, n)
 
 
 # -- the egg ---------------------------------------------------------------------------------
@@ -212,9 +217,9 @@ def test_egg_convex_and_asymmetric():
     assert np.min(egg.radius_of_curvature(phi)) > 0
     # turning of the tangent is monotone (convex) and symmetric about the common axis
     p = egg.point(phi)
-    assert np.max(np.abs(egg.point(-phi) - p * [-1, 1])) < 1e-15 * 4
+    assert np.max(np.abs(egg.point(-phi) - p * [-1, 1])) < ulps(16, egg.size)   # rounding
     # not symmetric about the x axis: the ends reach −(a + ε) and a − ε, centroid off-centre
-    assert egg.extents == pytest.approx((b, -(a + eps), a - eps), rel=1e-15)
+    assert egg.extents == pytest.approx((b, -(a + eps), a - eps), rel=ulps(16))
     assert egg.moments.centroid[1] > 1e-3
     # curvature of the sharp end (−y) exceeds that of the blunt end (+y)
     assert egg.curvature(0.0) > 1.5 * egg.curvature(np.pi)

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.cycle import RollingCycle
 from twodisk_ros.physics.dynamics import RollingDynamics
@@ -46,32 +47,33 @@ def test_moved_point_sees_translated_vectors_and_its_own_height():
     of the size (measured 2.3e-15 here)."""
     body, c = _egg(), 3e-3
     moved = body.about(c)
+    rounding = ulps(16, body.size)        # a few rounded sums of lengths of the size (m)
     theta = np.linspace(-0.99, 0.99, 41) * body.theta_max
     for branch in (1, -1):
         u = body.phase_from_theta(theta, branch)
         r1, r2, n, t1, z = body.phase_vectors(u)
         q1, q2, m, s1, zp = moved.phase_vectors(u)
         shift = np.array([0.0, c, 0.0])
-        assert np.max(np.abs(q1 - (r1 - shift))) <= 1e-17
-        assert np.max(np.abs(q2 - (r2 - shift))) <= 1e-17
+        assert np.max(np.abs(q1 - (r1 - shift))) <= rounding
+        assert np.max(np.abs(q2 - (r2 - shift))) <= rounding
         assert np.array_equal(m, n) and np.array_equal(s1, t1)
         exact = body.general.geometry(theta, branch)
         reference = exact.support_height + np.sum(exact.ground_normal * moved.origin, axis=-1)
         assert np.max(np.abs(zp - reference)) <= 1e-13 * body.size
         assert np.max(np.abs(moved.phase_height(u) - zp)) == 0.0
-        assert np.max(np.abs(zp - z - c * n[..., 1])) <= 1e-17
+        assert np.max(np.abs(zp - z - c * n[..., 1])) <= rounding
         # the θ chart moves with it
         pose = moved.geometry(theta, branch)
-        assert np.max(np.abs(pose.height - reference)) <= 1e-15 * body.size
+        assert np.max(np.abs(pose.height - reference)) <= rounding
         assert np.max(np.abs(pose.contact_a + moved.origin
-                             - (exact.contact_a + body.centroid))) <= 1e-16
+                             - (exact.contact_a + body.centroid))) <= rounding
 
 
 def test_moved_body_keeps_phase_rates_and_angular_velocity():
     """What does not depend on the reference point is shared bit for bit."""
     body = _egg()
     moved = body.about(-2e-3).about(5e-3)
-    assert moved.offset == pytest.approx(3e-3, abs=1e-18)
+    assert moved.offset == pytest.approx(3e-3, abs=ulps(16, 5e-3))    # −2e-3 + 5e-3, rounded
     u = np.linspace(0, TWO_PI, 97)
     for name in ('phase_rates', 'phase_angles_with_rates'):
         for x, y in zip(getattr(body, name)(u), getattr(moved, name)(u)):
@@ -111,7 +113,8 @@ def test_mass_properties_of_a_moved_body_are_from_its_point():
         at_g = mass_properties_of(model, body, 1.0)
         at_p = mass_properties_of(model, body.about(c), 1.0)
         assert np.array_equal(at_p.inertia, at_g.inertia)
-        assert at_p.center_of_mass == pytest.approx(at_g.center_of_mass - [0, c, 0], abs=1e-18)
+        assert at_p.center_of_mass == pytest.approx(at_g.center_of_mass - [0, c, 0],
+                                                    abs=ulps(16, c))     # a rounded shift
 
 
 def test_centred_on_mass_moves_the_egg_and_leaves_symmetric_bodies():
@@ -127,7 +130,7 @@ def test_centred_on_mass_moves_the_egg_and_leaves_symmetric_bodies():
     assert np.array_equal(props.center_of_mass, np.zeros(3))
     assert np.array_equal(props.inertia, solid.inertia)
     square, _ = centred_on_mass('solid', _square(), 1.0)
-    assert abs(square.offset) <= 1e-15 * square.size
+    assert abs(square.offset) <= ulps(16, square.size)     # the quadrature's rounding
     ellipse = TwoDiskBody(0.1, 0.08, 0.04)
     same, props = centred_on_mass('solid', ellipse, 1.0)
     assert same is ellipse

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
+from rounding import ulps
 from twodisk_ros.physics.lamina import Egg, Ellipse, Lamina, Superellipse
 from twodisk_ros.physics.lamina_fit import Outline
 from twodisk_ros.physics.symmetric_stability import symmetric_equilibria
@@ -25,11 +26,11 @@ def test_ellipse_vertices(a, b):
                                             ('+y', a, b * b / a, (0, a)),
                                             ('+x', b, a * a / b, (b, 0))):
             v = lamina.vertex(axis)
-            # claim: closed forms to rounding
-            assert v.extent == pytest.approx(extent, rel=1e-15)
+            # claim: closed forms to rounding (16 ulps)
+            assert v.extent == pytest.approx(extent, rel=ulps(16))
             assert v.radius == pytest.approx(radius, rel=1e-14)
             assert (v.order, v.coefficient) == (2.0, pytest.approx(radius / 2, rel=1e-14))
-            np.testing.assert_allclose(v.point, point, rtol=0, atol=1e-15 * max(a, b))
+            np.testing.assert_allclose(v.point, point, rtol=0, atol=ulps(16, max(a, b)))
 
 
 @pytest.mark.parametrize('epsilon', [0.08, -0.05, 0.0])
@@ -40,7 +41,7 @@ def test_egg_vertices(epsilon):
                 '+y': (a - epsilon, b * b / a + 8 * epsilon), '+x': (b, a * a / b)}
     for axis, (extent, radius) in expected.items():
         v = lamina.vertex(axis)
-        assert v.extent == pytest.approx(extent, rel=1e-15)
+        assert v.extent == pytest.approx(extent, rel=ulps(16))
         assert v.radius == pytest.approx(radius, rel=1e-14)
     # the widest point, by brute force over the boundary: y = 3ε
     s = np.linspace(0.0, np.pi, 20001)
@@ -48,7 +49,8 @@ def test_egg_vertices(epsilon):
     found = minimize_scalar(lambda x: -float(lamina.point(x)[0]), method='bounded',
                             bounds=(s[j - 1], s[j + 1]), options={'xatol': 1e-12})
     assert float(lamina.point(found.x)[1]) == pytest.approx(3 * epsilon, abs=1e-6)
-    assert float(lamina.vertex('+x').point[1]) == pytest.approx(3 * epsilon, abs=1e-15)
+    assert float(lamina.vertex('+x').point[1]) == pytest.approx(3 * epsilon,
+                                                                abs=ulps(16, lamina.size))
 
 
 def _support_by_points(lamina, direction):
@@ -66,16 +68,16 @@ def _support_by_points(lamina, direction):
 def test_superellipse_flat_vertex_order_and_coefficient(n, axis):
     lamina = Superellipse(1.0, 0.6, n)
     v = lamina.vertex(axis)
-    assert v.radius == math.inf and v.order == pytest.approx(n / (n - 1), rel=1e-15)
+    assert v.radius == math.inf and v.order == pytest.approx(n / (n - 1), rel=ulps(16))
     d, d_perp = np.array(v.direction), np.array([-v.direction[1], v.direction[0]])
     excess = {}
     for t in (1e-2, 1e-3):
         excess[t] = _support_by_points(lamina, d + t * d_perp) - v.extent
         # claim: h = e + c|t|^q + O(|t|^2q): relative remainder ≤ (1/q)·(c/e)|t|^q (the next
-        # term of (1 + x)^(1/q)), plus the brute force's rounding (1e-15 / (c|t|^q))
+        # term of (1 + x)^(1/q)), plus the brute force's rounding (16 ulps of e, / (c|t|^q))
         relative = v.coefficient / v.extent * t**v.order / v.order
-        assert excess[t] == pytest.approx(v.coefficient * t**v.order,
-                                          rel=relative + 1e-15 / (v.coefficient * t**v.order))
+        rounding = ulps(16, v.extent) / (v.coefficient * t**v.order)
+        assert excess[t] == pytest.approx(v.coefficient * t**v.order, rel=relative + rounding)
     slope = math.log(excess[1e-2] / excess[1e-3]) / math.log(10.0)
     assert slope == pytest.approx(v.order, abs=1e-2)
 
@@ -89,7 +91,7 @@ def test_outline_vertex_radius_from_three_points():
         sides = [np.linalg.norm(p1 - p0), np.linalg.norm(p2 - p1), np.linalg.norm(p0 - p2)]
         cross = abs((p1 - p0)[0] * (p2 - p0)[1] - (p1 - p0)[1] * (p2 - p0)[0])
         assert v.radius == pytest.approx(np.prod(sides) / (2 * cross), rel=1e-6)
-        assert v.extent == pytest.approx(float(np.dot(v.point, v.direction)), rel=1e-15)
+        assert v.extent == pytest.approx(float(np.dot(v.point, v.direction)), rel=ulps(16))
 
 
 class _NoOrder(Superellipse):

@@ -33,6 +33,7 @@ from hypothesis import given, settings, strategies as st
 from numpy.polynomial import chebyshev
 from scipy.integrate import solve_ivp
 
+from rounding import ulps
 from twodisk_ros.physics import TwoDiskBody, RollingDynamics, simulate, simulate_phase
 from twodisk_ros.physics.mass_models import laminae
 
@@ -185,8 +186,8 @@ def _check(name, method, u0, rate0, delta0, d_rate0, error_max=ERROR_MAX):
     rate_error = float(np.max(np.abs(rate - rate_ref))) / (amplitude * 2 * math.pi / period)
     assert error <= error_max, (method, amplitude, error)
     assert rate_error <= 10 * error_max, (method, amplitude, rate_error)
-    # u itself is centre + δ, to its rounding
-    assert np.max(np.abs(motion.phase - (centre + delta))) <= 4e-16 * max(1.0, abs(centre))
+    # u itself is centre + δ, to its rounding (16 ulps of |u|)
+    assert np.max(np.abs(motion.phase - (centre + delta))) <= ulps(16, max(1.0, abs(centre)))
     return motion, error
 
 

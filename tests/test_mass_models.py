@@ -21,6 +21,7 @@ from numpy.testing import assert_allclose
 from scipy.spatial import ConvexHull
 from scipy.special import ellipe, ellipk
 
+from rounding import ulps
 from twodisk_ros.physics import hull, mass_models
 from twodisk_ros.physics.mass_models import MassProperties, custom, laminae, mass_properties, solid_hull
 
@@ -133,13 +134,15 @@ def second_moments(props):
 # its limits") that it checks, and what was measured on this machine.
 
 #: The Oloid's volume against its closed form: docs claim a relative 6e-16; measured 6.7e-16
-#: (3 ulps; the trapezoidal sums are converged far below rounding).
-OLOID_VOLUME_RTOL = 2e-15
-#: The Oloid's surface area against 4 pi r**2 (a check of the ruled surface): measured 6.7e-16.
-OLOID_AREA_RTOL = 2e-15
+#: (3 ulps; the trapezoidal sums are converged far below rounding). A sum of rounded terms:
+#: 16 ulps.
+OLOID_VOLUME_RTOL = ulps(16)
+#: The Oloid's surface area against 4 pi r**2 (a check of the ruled surface): measured 6.7e-16;
+#: a sum of rounded terms, 16 ulps.
+OLOID_AREA_RTOL = ulps(16)
 #: The solid depends on delta / a only and is mapped by diag(b, a, b) (docs): scaling is exact
-#: up to rounding. Measured 6.7e-16 (volume), 9e-17 (inertia, of its largest moment).
-SCALING_RTOL = 2e-15
+#: up to rounding. Measured 6.7e-16 (volume), 9e-17 (inertia, of its largest moment): 16 ulps.
+SCALING_RTOL = ulps(16)
 #: Quantities that vanish or agree by the body's symmetries, which the quadrature keeps on its
 #: grid (every grid is mapped onto itself by the disk swap): centre of mass (of the size),
 #: products of inertia and I1 - I3 (of the moments). Measured <= 7e-16 over BODIES, EXTREMES
@@ -148,9 +151,10 @@ SYMMETRY_ATOL = 4e-15
 #: The laminae model is exact (closed form); the reference is Green's theorem on the rims,
 #: exact to rounding. Measured <= 8.9e-16 relative over 20 000 random bodies (a in
 #: [1e-4, 1e4] m, b / a in [0.01, 100], delta / a in [1e-6, 1 - 1e-9]); products of inertia
-#: 0 in the code, <= 6.4e-17 of the largest moment in the reference (its rounding).
-LAMINAE_RTOL = 2e-15
-LAMINAE_OFF_ATOL = 4e-16
+#: 0 in the code, <= 6.4e-17 of the largest moment in the reference (its rounding). Sums of
+#: rounded terms: 16 ulps (of each moment; of the largest for the products).
+LAMINAE_RTOL = ulps(16)
+LAMINAE_OFF_ATOL = ulps(16)
 
 
 # ----------------------------------------------------------------------------- the solid
@@ -370,7 +374,8 @@ def test_laminae_across_shapes(a, b_over_a, delta_over_a, mass):
     assert np.all(np.linalg.eigvalsh(props.inertia) > 0.0)
     i1, i2, i3 = np.diag(props.inertia)
     # plates: I3 = I1' + I2' per plate, so the triangle inequality is tight up to rounding
-    assert i1 + i2 >= i3 * (1 - 1e-15) and i2 + i3 >= i1 * (1 - 1e-15)
+    # (16 ulps of the moments)
+    assert i1 + i2 >= i3 * (1 - ulps(16)) and i2 + i3 >= i1 * (1 - ulps(16))
 
 
 # ----------------------------------------------------------------------------- custom, dispatch

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from rounding import ulps
 from twodisk_ros.model.frames import check_frame_id, disk_frames
 from twodisk_ros.physics import TwoDiskBody
 
@@ -32,8 +33,9 @@ def test_contact_points_lie_on_each_disk_rim_in_its_frame(abd):
         # the disk frame's pose, applied by scipy: p_body = R p_disk + t
         rotation = Rotation.from_quat(frame.quaternion)
         local = rotation.inv().apply(points - frame.translation)
-        # in the disk's plane, to rounding of the size (the closed forms' accuracy, 2e-14 L)
-        assert np.max(np.abs(local[:, 2])) <= 1e-15 * body.size
+        # in the disk's plane, to rounding of the size (16 ulps: a rotated difference of
+        # lengths of the size; the closed forms' accuracy, 2e-14 L, is along the rim)
+        assert np.max(np.abs(local[:, 2])) <= ulps(16, body.size)
         # on its rim x²/a² + y²/b² = 1 (rim points to 2e-14 of the size → 1e-13 relative)
         assert np.max(np.abs(local[:, 0] ** 2 / a**2 + local[:, 1] ** 2 / b**2 - 1)) <= 1e-13
         # and the contact angle is the polar angle from x towards y (to the 3e-13 rad of ψ)
@@ -56,8 +58,10 @@ def test_frames_of_the_oloid_exactly():
         axes = np.array(expected[id(frame)], dtype=float).T
         assert np.array_equal(frame.axes, axes)
         matrix = Rotation.from_quat(frame.quaternion).as_matrix()
-        np.testing.assert_allclose(matrix, axes, rtol=0, atol=4e-16)   # rounding of √½
-        assert math.isclose(np.linalg.norm(frame.quaternion), 1.0, rel_tol=0, abs_tol=2e-16)
+        # rounding of √½ and of its products and sums: 16 ulps of 1
+        np.testing.assert_allclose(matrix, axes, rtol=0, atol=ulps(16))
+        assert math.isclose(np.linalg.norm(frame.quaternion), 1.0, rel_tol=0,
+                            abs_tol=ulps(16))
         assert frame.quaternion[3] > 0
         np.testing.assert_allclose(frame.to_disk(frame.translation + axes[:, 0]), [1, 0, 0],
                                    atol=0)

@@ -20,6 +20,7 @@ import pytest
 import trimesh
 from scipy.spatial import ConvexHull
 
+from rounding import ulps
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import body_mesh, mesh_parts
 from twodisk_ros.model.outline import disk_rims, frame_rims, lamina_outline
@@ -51,8 +52,9 @@ def test_outline_misses_the_support_function_by_at_most_its_tolerance(lamina, to
     h = lamina.support(DIRECTIONS).height
     reach = (DIRECTIONS @ points.T).max(axis=1)
     size = lamina.size
-    # inscribed: no vertex beyond the curve (rounding of h and of the points, 1e-15 L) ...
-    assert np.max(reach - h) <= 1e-15 * size
+    # inscribed: no vertex beyond the curve (rounding of h, of the points and of p·n:
+    # 16 ulps of the size) ...
+    assert np.max(reach - h) <= ulps(16, size)
     # ... and the polygon reaches the curve to the stated error in every direction
     assert np.max(h - reach) <= tolerance * size
     # not far finer than asked for: the error is at least a tenth of it somewhere
@@ -75,7 +77,7 @@ def test_outline_of_a_fitted_outline():
     points = lamina_outline(lamina, 1e-4)
     h = lamina.support(DIRECTIONS).height
     reach = (DIRECTIONS @ points.T).max(axis=1)
-    assert np.max(reach - h) <= 1e-15 * lamina.size
+    assert np.max(reach - h) <= ulps(16, lamina.size)              # rounding, as above
     assert 1e-5 * lamina.size <= np.max(h - reach) <= 1e-4 * lamina.size
 
 
@@ -124,7 +126,7 @@ def test_rims_sit_where_general_body_puts_the_laminae(body):
     for frame, rim, contact in zip(disk_frames(general), frame_rims(general, 1e-6),
                                    (pose.contact_a, pose.contact_b)):
         local = frame.to_disk(contact)
-        assert np.max(np.abs(local[:, 2])) <= 1e-15 * general.size
+        assert np.max(np.abs(local[:, 2])) <= ulps(16, general.size)     # rounding
         distance = np.min(np.linalg.norm(local[:, None, :2] - rim[None], axis=-1), axis=1)
         step = np.max(np.linalg.norm(np.diff(rim, axis=0), axis=1))
         assert np.max(distance) <= 0.5 * step + 1e-6 * lamina.size
@@ -153,7 +155,7 @@ def test_ruled_hull_is_closed_outward_and_converges_to_the_convex_hull(body):
         assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0
         # the vertices are ends of rulings: on the rims (disk 1: x3 = 0, disk 2: x1 = 0)
         on_plane = np.minimum(np.abs(part.vertices[:, 2]), np.abs(part.vertices[:, 0]))
-        assert on_plane.max() <= 1e-15 * general.size
+        assert on_plane.max() <= ulps(16, general.size)                # rounding
         errors.append(mesh.volume / reference - 1)
     errors = np.array(errors)
     assert np.all(errors < 0)                   # inscribed in the hull

@@ -20,6 +20,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 import yourdfpy
 
+from rounding import ulps
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.stl import stl_bytes
@@ -80,9 +81,11 @@ def test_urdf_read_back_by_urdfdom_and_yourdfpy(abd, model, tmp_path):
         assert (joint.type, joint.parent, joint.child) == ('fixed', 'rover',
                                                            frame.child_frame_id)
         np.testing.assert_array_equal(joint.origin[:3, 3], frame.translation)
+        # rpy → matrix against quaternion → matrix, each of rounded products of sines and
+        # cosines (cos(π/2) in float64: 6e-17): 16 ulps of 1
         np.testing.assert_allclose(joint.origin[:3, :3],
                                    Rotation.from_quat(frame.quaternion).as_matrix(),
-                                   rtol=0, atol=4e-16)     # cos(π/2) in float64: 6e-17
+                                   rtol=0, atol=ulps(16))
         assert np.allclose(urdf.get_transform(frame.child_frame_id, 'rover'), joint.origin,
                            rtol=0, atol=0)
     # one visual and one collision per mesh part, each the part's STL in the cache
@@ -98,7 +101,7 @@ def test_urdf_read_back_by_urdfdom_and_yourdfpy(abd, model, tmp_path):
         assert file.stem == hashlib.sha256(data).hexdigest()
         colour = {'disk_a': palette.A, 'disk_b': palette.B, 'hull': palette.HULL}[visual.name]
         np.testing.assert_allclose(visual.material.color.rgba, palette.rgb(colour) + (1.0,),
-                                   rtol=0, atol=1e-15)
+                                   rtol=0, atol=ulps(16))            # a decimal round trip
     # yourdfpy resolved the file:// URIs and loaded the parts' triangles (float32 in STL)
     assert set(urdf.scene.geometry) == set(parts)
     for name, loaded in urdf.scene.geometry.items():
@@ -115,7 +118,8 @@ def test_urdf_disk_frames_put_the_contact_points_on_the_rims(abd, tmp_path):
                           ('twodisk_body_disk_b', geometry.contact_b)):
         pose = urdf.get_transform(child, 'twodisk_body')
         local = (points - pose[:3, 3]) @ pose[:3, :3]
-        assert np.abs(local[:, 2]).max() <= 2e-15 * body.size
+        # a rotated difference of lengths of the size: 16 ulps
+        assert np.abs(local[:, 2]).max() <= ulps(16, body.size)
         rim = local[:, 0] ** 2 / body.a**2 + local[:, 1] ** 2 / body.b**2 - 1
         assert np.abs(rim).max() <= 1e-12
 
@@ -126,9 +130,10 @@ def test_inertial_block_holds_the_closed_forms(tmp_path):
     root = ElementTree.fromstring(robot_description(TwoDiskBody(a, b, d),
                                                     _mass('laminae', (a, b, d), m)))
     inertia = root.find("link[@name='twodisk_body']/inertial/inertia").attrib
+    # the closed forms to rounding (16 ulps; the code may group the terms otherwise)
     assert math.isclose(float(inertia['ixx']), m * (2 * a * a + b * b) / 8 + m * d * d,
-                        rel_tol=1e-15)
-    assert math.isclose(float(inertia['iyy']), m * b * b / 4, rel_tol=1e-15)
+                        rel_tol=ulps(16))
+    assert math.isclose(float(inertia['iyy']), m * b * b / 4, rel_tol=ulps(16))
     assert float(inertia['izz']) == float(inertia['ixx'])
     assert all(float(inertia[k]) == 0 for k in ('ixy', 'ixz', 'iyz'))
     assert float(root.find('link/inertial/mass').attrib['value']) == m
@@ -202,17 +207,17 @@ def test_urdf_of_a_non_elliptic_body(model, arrangement, tmp_path):
     for child, points in (('rover_disk_a', pose.contact_a), ('rover_disk_b', pose.contact_b)):
         frame = urdf.get_transform(child, 'rover')
         local = (points - frame[:3, 3]) @ frame[:3, :3]
-        assert np.abs(local[:, 2]).max() <= 2e-15 * body.size
+        assert np.abs(local[:, 2]).max() <= ulps(16, body.size)          # as above
         # frames.py: disk 1's lamina point (x, y) is (−y, x); disk 2's is (σy, −x)
         if child.endswith('_a'):
             x, y = local[:, 1], -local[:, 0]
-            # the translation's rounding (a few ulp of the size) and nothing else
+            # the translation's rounding (16 ulps of the size) and nothing else
             np.testing.assert_allclose(np.stack([x, y], -1), expected_a, rtol=0,
-                                       atol=1e-15 * body.size)
+                                       atol=ulps(16, body.size))
         else:
             x, y = -local[:, 1], sigma * local[:, 0]
         # on the egg's boundary: p·n = h(n) for its outward normal n (best of 20 001)
         phi = np.linspace(0, 2 * np.pi, 20001)
         n = np.stack([np.cos(phi), np.sin(phi)], -1)
         gap = lamina.support(n).height[None, :] - np.stack([x, y], -1) @ n.T
-        assert gap.min() >= -1e-15 * body.size and gap.min(axis=1).max() <= 1e-7 * body.size
+        assert gap.min() >= -ulps(16, body.size) and gap.min(axis=1).max() <= 1e-7 * body.size

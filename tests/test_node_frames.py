@@ -32,6 +32,8 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
+from rounding import ulps  # noqa: E402
+
 # yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
 pytestmark = [pytest.mark.ros,
               pytest.mark.filterwarnings('ignore:.*Scene.dump.*:DeprecationWarning')]
@@ -236,8 +238,8 @@ def assert_urdf(text, body_frame, static=None, mass=1.0):
         if static is not None:
             parent, translation, axes = static[body_frame + suffix]
             np.testing.assert_array_equal(joint.origin[:3, 3], translation)
-            # rpy → matrix in float64: the 0/±1 entries to a few ulp
-            np.testing.assert_allclose(joint.origin[:3, :3], axes, rtol=0, atol=1e-15)
+            # rpy → matrix in float64: the 0/±1 entries to rounding (16 ulps of 1)
+            np.testing.assert_allclose(joint.origin[:3, :3], axes, rtol=0, atol=ulps(16))
     return robot
 
 
