@@ -204,10 +204,10 @@ class Simulation:
         if forces:
             if self.settings.mode == 'kinematic':
                 contact = self.forces.kinematic(u, self.angular_speed0)
-            elif self.dynamics.general:      # w: finite where u̇ is not
-                contact = self.forces.dynamic(u, angular_speed=speed)
-            else:
+            elif speed is None:              # the ellipse: u̇ is finite everywhere
                 contact = self.forces.dynamic(u, u_dot)
+            else:
+                contact = self.forces.dynamic(u, angular_speed=speed)
             self._check(t + time_offset, contact)
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,

@@ -268,10 +268,10 @@ class MotionStream:
         while True:
             end = self._start + self._sol.t_end
             inside = t <= end
-            pieces.append(np.stack(turning_state(
-                self.dynamics, self._sol, t[inside] - self._start, self.mode,
-                self.initial_energy, self._speed) if with_speed
-                else self._sol(t[inside] - self._start)))
+            local = t[inside] - self._start
+            pieces.append(np.stack(turning_state(self.dynamics, self._sol, local, self.mode,
+                                                 self.initial_energy, self._speed)
+                                   if with_speed else self._sol(local)))
             t = t[~inside]
             if not t.size:
                 break
