@@ -193,3 +193,30 @@ def test_resolved_recordings_keep_every_sample(tmp_path):
                 assert checks[name].passed, (name, checks[name].detail)
                 assert not any(line.startswith('left out') for line in checks[name].detail)
                 assert checks[name].tolerance < 1e-4, (name, checks[name].tolerance)
+
+
+@pytest.mark.parametrize('samples', [5, 6, 7])
+@pytest.mark.parametrize('name, needed, scene', [('energy', 2, {}),
+                                                 ('energy_balance', 3, {'damping': 0.002})])
+def test_a_recording_too_short_for_the_stencils_says_so(tmp_path, capsys, samples, name,
+                                                        needed, scene):
+    """The 5-point stencils leave ``samples - 4`` rows; the energy check needs 2 (a drift
+    against its first row), energy_balance 3. Fewer: "not evaluated ... too short", a FAIL
+    with its reason, never a PASS on one row and never a crash of the report (before: the
+    check's detail was None and twodisk-inspect raised AttributeError in its report)."""
+    from twodisk_ros.inspect import cli
+    path, _ = record(tmp_path, 'short', (samples - 1) / 200.0, **dict(
+        SQUARE, shape='ellipse', exponent=2.0, theta0=0.9, rate=200.0, **scene))
+    check = {c.name: c for c in inspect_recording(path).checks}[name]
+    rows = samples - 4
+    if rows >= needed:
+        assert check.passed, check.detail
+    else:
+        assert not check.passed and check.value is None
+        assert check.detail == [
+            f'not evaluated: {rows} sample(s) with central differences, {needed} needed '
+            f'(the stencils reach 2 samples either side): the recording is too short']
+    status = cli.main([str(path)])
+    out = capsys.readouterr().out
+    assert status == (0 if rows >= needed else 1), out
+    assert ('the recording is too short' in out) == (rows < needed), out

@@ -52,15 +52,27 @@ def finish(process, timeout=30.0):
     return process.returncode, out, err
 
 
+#: Samples the checks need to evaluate every central difference: the 5-point stencils leave
+#: n - 4 rows, and energy_balance needs 3 of them (inspect/resolution.py).
+EVALUATED_FROM = 7
+
+
 def assert_complete(path, detail):
-    """A finished, indexed recording that passes every check, every topic on the same sample."""
+    """A finished, indexed recording, every topic on the same sample, that passes every check.
+    A signal soon after the first sample leaves fewer samples than the finite differences
+    need: then the FD checks (and only they) say they were not evaluated, and why."""
     recording = read_recording(path, decode=lambda topic: False)
     assert not recording.truncated, detail
     counts = {t: recording.topics[t].message_count for t in SAMPLED}
-    assert len(set(counts.values())) == 1 and min(counts.values()) >= 5, (detail, counts)
+    assert len(set(counts.values())) == 1 and min(counts.values()) >= 1, (detail, counts)
     inspection = inspect_recording(path)
     failed = [f'{c.name}: {c.detail}' for c in inspection.checks if not c.passed]
-    assert inspection.passed, (detail, failed)
+    if min(counts.values()) >= EVALUATED_FROM:
+        assert inspection.passed, (detail, failed)
+    else:
+        assert all(not c.passed and c.value is None and (
+            'central differences' in c.detail[0]) for c in inspection.checks
+            if not c.passed), (detail, counts, failed)
 
 
 # -- signals ---------------------------------------------------------------------------------

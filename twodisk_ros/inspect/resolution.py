@@ -99,7 +99,10 @@ def resolve(fd_tolerance, index, samples, body=None, minimum=1):
     keep = np.isfinite(fd_tolerance) & (fd_tolerance <= CAP)
     dropped = np.nonzero(~keep)[0]
     if dropped.size == 0:
-        return Resolution(keep, None)
+        count = int(np.sum(keep))
+        return Resolution(keep, None if count >= minimum else (
+            f'not evaluated: {count} sample(s) with central differences, {minimum} needed '
+            f'(the stencils reach {_REACH} samples either side): the recording is too short'))
     stretches = np.split(dropped, np.nonzero(np.diff(index[dropped]) > 1)[0] + 1)
     spans = [_span(samples.t, index[rows]) for rows in stretches]
     shown = ', '.join(spans[:_LISTED]) + (f' and {len(spans) - _LISTED} more'
