@@ -165,3 +165,36 @@ def test_runs_moved_out_of_plotting_and_the_old_import_still_works():
     for name in old.__all__:
         assert getattr(old, name) is getattr(new, name), name
     assert not hasattr(animation, 'main')
+
+
+def _full_redraw(figure):
+    """The frame as matplotlib's PillowWriter grabbed it: a full ``savefig`` (RGBA)."""
+    import io
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format='rgba', dpi=animation.DPI, facecolor='white')
+    width, height = figure.canvas.get_width_height()
+    return np.frombuffer(buffer.getvalue(), np.uint8).reshape(height, width, 4)
+
+
+@pytest.mark.parametrize('config, view, camera', [
+    ('oloid.yaml', '3d', 'fit'), ('oloid.yaml', 'top', 'fit'), ('slope.yaml', '3d', 'fit'),
+    ('slope.yaml', 'top', 'follow'), ('oloid.yaml', '3d', 'follow')])
+def test_frames_are_the_pictures_of_a_full_redraw(config, view, camera):
+    """A GIF frame drawn over the still background (animation._render) is, pixel for pixel,
+    the picture a full redraw of the same figure gives (matplotlib's own ``savefig``, what
+    PillowWriter wrote per frame): both draw the same artists with the same Agg renderer in
+    the same order, so no difference at all is allowed. Several frames: the background is
+    drawn once, the moving artists (forces, slope ground, clock) change."""
+    run = library_run(settings_from(REPO / 'config' / config), stop=0.4, forces=True)
+    frames = np.array([0, len(run.t) // 2, len(run.t) - 1])
+    # two figures of the same scene: one drawn as animate draws it, one redrawn in full
+    scenes = [animation._Scene(run, animation._figure(SIZE), view, camera, True, frames)
+              for _ in range(2)]
+    width, height = scenes[0].figure.canvas.get_width_height()
+    for frame in range(len(frames)):
+        for scene in scenes:
+            scene.draw(frame)
+        fast = np.array(animation._render(scenes[0])).reshape(height, width, 4)
+        full = _full_redraw(scenes[1].figure)
+        assert np.array_equal(fast, full), (
+            f'frame {frame}: {np.count_nonzero((fast != full).any(axis=2))} pixels differ')

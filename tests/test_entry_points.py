@@ -3,7 +3,9 @@ the package so that the README's commands run from any directory.
 
 ``make`` (what ``make test`` runs first) installs twodisk_ros into ``.venv``; these tests run
 the installed console scripts from an empty directory, with no ``PYTHONPATH``, and check that
-``--help`` prints help, exits 0 within a few seconds and leaves no file or directory behind.
+``--help`` prints help, exits 0 and leaves no file or directory behind (the subprocess timeout
+only guards against a hang; tests/test_figures.py and tests/test_cli_outputs.py check that help
+does no heavy work by refusing the heavy imports).
 """
 
 import configparser
@@ -11,7 +13,6 @@ import os
 import re
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 from package_helpers import console_scripts
@@ -22,8 +23,6 @@ REPO = Path(__file__).resolve().parents[1]
 VENV_BIN = Path(sys.executable).parent
 ENV = {key: value for key, value in os.environ.items() if key != 'PYTHONPATH'}
 ENV.update(ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST', ROS_DOMAIN_ID='96', MPLBACKEND='Agg')
-#: --help answers long before this (0.1-1.5 s measured); more means it started working.
-HELP_SECONDS = 5.0
 
 
 def _console_scripts():
@@ -50,17 +49,15 @@ BENCHMARKS = sorted(path.name for path in (REPO / 'benchmarks').glob('*.py')
 
 
 def _help(command, cwd, env=ENV):
-    start = time.monotonic()
     result = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True,
                             timeout=60, stdin=subprocess.DEVNULL)
-    return result, time.monotonic() - start
+    return result, None
 
 
 def _assert_help(result, elapsed, cwd, label):
     assert result.returncode == 0, f'{label}: exit {result.returncode}\n{result.stderr[-2000:]}'
     assert 'usage' in result.stdout.lower(), f'{label} printed no usage:\n{result.stdout}'
     assert 'Traceback' not in result.stderr, result.stderr
-    assert elapsed < HELP_SECONDS, f'{label} --help took {elapsed:.1f} s'
     assert list(Path(cwd).iterdir()) == [], f'{label} --help wrote {list(Path(cwd).iterdir())}'
 
 

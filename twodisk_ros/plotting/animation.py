@@ -20,6 +20,7 @@ import textwrap
 import numpy as np
 
 from . import palette
+from .frames import gif_frame as _gif_frame, render as _render
 from ..runs import Run, RunError, library_run
 
 __all__ = ['VIEWS', 'CAMERAS', 'animate', 'drawn', 'frame_times', 'still']
@@ -120,6 +121,8 @@ class _Scene:
         self.clock = figure.text(0.03, 0.93, '', ha='left', va='top', fontsize=fontsize,
                                  family='monospace')
         self._legend()
+        self.background = None                     # the still parts, once drawn (blitting)
+        self.overlays = []                         # still artists drawn over moving ones
 
     # -- set-up -------------------------------------------------------------------------------
     def _setup_3d(self):
@@ -385,12 +388,21 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     times = frame_times(start, stop, fps)
     shown = run.span(start, stop)
     frames = np.clip(np.searchsorted(shown.t, times - 1e-9), 0, len(shown) - 1)
-    from matplotlib.animation import FFMpegWriter, PillowWriter
     figure = _figure(size)
     scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None, frames)
-    writer = PillowWriter(fps=fps) if kind == 'gif' else FFMpegWriter(
-        fps=fps, codec='libx264', extra_args=['-pix_fmt', 'yuv420p'])
     try:
+        if kind == 'gif':
+            # as matplotlib's PillowWriter, with each frame drawn by _render
+            pixels = tuple(int(x) for x in figure.canvas.get_width_height())
+            images = []
+            for frame in range(len(frames)):
+                scene.draw(frame)
+                images.append(_gif_frame(_render(scene), pixels))
+            images[0].save(os.fspath(path), format='GIF', save_all=True,
+                           append_images=images[1:], duration=int(1000 / fps), loop=0)
+            return len(frames)
+        from matplotlib.animation import FFMpegWriter
+        writer = FFMpegWriter(fps=fps, codec='libx264', extra_args=['-pix_fmt', 'yuv420p'])
         with writer.saving(figure, os.fspath(path), dpi=DPI):
             for frame in range(len(frames)):
                 scene.draw(frame)

@@ -11,9 +11,6 @@ import math
 import os
 import sys
 
-import matplotlib
-matplotlib.use('Agg')
-import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
@@ -40,6 +37,15 @@ NAMES = ('contact_forces_cycle.png', 'contact_forces_speed.png')
 SAME_LINE = 0.005
 
 
+def _pyplot():
+    """matplotlib.pyplot on Agg, imported on first use (``--help`` answers without it)."""
+    import matplotlib
+    if 'matplotlib.pyplot' not in sys.modules:
+        matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    return plt
+
+
 def force_model(shape, mass=1.0, model='laminae', gravity=9.81):
     """A :class:`ContactForceModel` for (a, b, Δ) in m."""
     body = TwoDiskBody(*shape)
@@ -52,6 +58,7 @@ def plot_cycle(path, shape=BODIES[0][1], fractions=(0.0, 0.5, 0.8, 0.95), sample
     model = force_model(shape)
     critical = liftoff_speed(model)[0]
     u = np.linspace(0.0, 2 * math.pi, samples)
+    plt = _pyplot()
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
     colours = plt.cm.viridis(np.linspace(0.0, 0.85, len(fractions)))
     for fraction, colour in zip(fractions, colours):
@@ -85,7 +92,7 @@ def _save(fig, path):
         with replacing(path) as temporary:
             fig.savefig(temporary, dpi=120)
     finally:
-        plt.close(fig)
+        _pyplot().close(fig)
 
 
 def coinciding_speeds(criticals):
@@ -109,6 +116,7 @@ def plot_speed(path, bodies=BODIES, samples=160):
     oloid's 8.2810 and the Fig. 3 body's 8.2796 rad/s) are named together beside their
     shared dotted line.
     """
+    plt = _pyplot()
     fig, axis = plt.subplots(figsize=(8, 5.5))
     colours = plt.cm.tab10(np.arange(len(bodies)))
     criticals, names = [], []

@@ -20,14 +20,7 @@ import math
 import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use('Agg')
-import matplotlib.pyplot as plt  # noqa: E402  (after selecting the backend)
 import numpy as np  # noqa: E402
-from matplotlib.colors import ListedColormap  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
 
 from ..physics.body import TwoDiskBody  # noqa: E402
 from ..physics.lamina import Egg, Superellipse  # noqa: E402
@@ -55,11 +48,26 @@ COLOR_A, COLOR_B, COLOR_RULING = palette.A, palette.B, '0.72'
 DPI = 150
 TWO_PI = 2.0 * math.pi
 
-plt.rcParams.update({
+#: The figures' matplotlib style, set when matplotlib is first needed (:func:`_pyplot`).
+STYLE = {
     'font.size': 9, 'axes.titlesize': 10, 'axes.labelsize': 9, 'legend.fontsize': 8,
     'xtick.direction': 'in', 'ytick.direction': 'in', 'axes.grid': True,
     'grid.color': '0.9', 'grid.linewidth': 0.6, 'savefig.dpi': DPI,
-})
+}
+_styled = []
+
+
+def _pyplot():
+    """matplotlib.pyplot on the Agg backend with :data:`STYLE` (set once). matplotlib is
+    imported here, on first use, not with this module: ``--help`` answers without it."""
+    import matplotlib
+    if not _styled:
+        matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    if not _styled:
+        plt.rcParams.update(STYLE)
+        _styled.append(True)
+    return plt
 
 
 def _describe(body):
@@ -78,6 +86,7 @@ def plot_outline(lamina, ax, samples=721):
     x across (e1), y along the common axis (e2), origin at the disk centre; the ellipse has
     semi-axes b = the largest x and a = the lamina's half length along y (dashed).
     """
+    _pyplot()                                   # the figures' style (STYLE)
     s = np.linspace(-math.pi, math.pi, samples)
     rim = lamina.point(s)
     x_max, y_min, y_max = lamina.extents
@@ -127,6 +136,7 @@ def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, 
     matplotlib.axes.Axes
         ``ax``; the traces are the lines with gid ``'trace A'`` and ``'trace B'``.
     """
+    _pyplot()                                   # the figures' style (STYLE)
     cycle = RollingCycle(body)
     u = np.linspace(0.0, TWO_PI * cycles, samples_per_cycle * cycles + 1)
     _, a_world, b_world = cycle.positions(u)
@@ -193,8 +203,9 @@ def plot_height(bodies, ax, samples=1441, annotate=0):
     matplotlib.axes.Axes
         ``ax``; each curve has gid ``'height <label>'``.
     """
+    _pyplot()                                   # the figures' style (STYLE)
     u = np.linspace(0.0, TWO_PI, samples)
-    colors = plt.rcParams['axes.prop_cycle'].by_key()['color']
+    colors = _pyplot().rcParams['axes.prop_cycle'].by_key()['color']
     for k, (label, body) in enumerate(bodies):
         color = colors[k % len(colors)]
         ax.plot(u, body.phase_height(u), color=color, lw=1.4, gid=f'height {label}',
@@ -226,6 +237,8 @@ def plot_height(bodies, ax, samples=1441, annotate=0):
                        title='body')
     ax.add_artist(curves)
     # two keys: the shape gives the kind of equilibrium, the fill its stability
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
     shapes = [Line2D([], [], marker=m, color='0.35', ls='none', mfc='0.8', mec='0.35',
                      label=text) for m, text in _FAMILY_LABELS.items()]
     kinds = ax.legend(handles=shapes, loc='center left', bbox_to_anchor=(1.01, 0.5),
@@ -260,9 +273,11 @@ def plot_stability_map(ax, b_range=(0.05, 3.0), resolution=400):
     matplotlib.axes.Axes
         ``ax``; the neutral curve has gid ``'neutral curve'``.
     """
+    _pyplot()                                   # the figures' style (STYLE)
     b = np.linspace(b_range[0], b_range[1], resolution)
     d = np.linspace(0.0, 1.0, resolution + 1)[1:-1]
     grid = stability_map(b[None, :], d[:, None])
+    from matplotlib.colors import ListedColormap
     cmap = ListedColormap(['#f3d9c4', '#ffffff', '#cfe0f1'])
     ax.pcolormesh(b, d, grid, cmap=cmap, vmin=-1.5, vmax=1.5, shading='auto',
                   rasterized=True)
@@ -301,7 +316,7 @@ def _save(fig, path):
         with replacing(path) as temporary:
             fig.savefig(temporary, dpi=DPI, bbox_inches='tight')
     finally:
-        plt.close(fig)
+        _pyplot().close(fig)
     return path
 
 
@@ -313,6 +328,7 @@ def write_figures(out_dir):
     list of pathlib.Path
         The files written.
     """
+    plt = _pyplot()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
