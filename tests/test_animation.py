@@ -1,4 +1,9 @@
-"""``twodisk-animate``: GIFs from the library and from a recording, and its input errors."""
+"""``twodisk-animate``: GIFs from the library and from a recording, and its input errors.
+
+The recording is the roller node's batch run, made in this process (domain 94 unless
+ROS_DOMAIN_ID is set). The command runs as a process of its own for a GIF of the recording
+and for one refusal; the other refusals call its ``main`` in this process.
+"""
 
 import os
 from pathlib import Path
@@ -10,6 +15,7 @@ import numpy as np
 import pytest
 from PIL import Image, ImageChops
 
+from batch_recording import record
 from twodisk_ros.plotting import animation
 from twodisk_ros.runs import RunError, library_run, recorded_run, settings_from
 
@@ -39,13 +45,8 @@ def _check_gif(path, count):
 
 @pytest.fixture(scope='module')
 def recording(tmp_path_factory):
-    out = tmp_path_factory.mktemp('anim') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'duration:=1.0', '-p', f'record:={out}'],
-        cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
-    assert made.returncode == 0, made.stderr
-    return out
+    return record(tmp_path_factory.mktemp('anim') / 'run.mcap',
+                  domain=int(ENV['ROS_DOMAIN_ID']), duration=1.0)
 
 
 def test_frame_times():
@@ -93,6 +94,23 @@ def _cli(*args):
                           cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
 
 
+def _assert_one_line(status, stderr, words, folder):
+    assert status == 2, stderr
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], stderr
+    assert not (folder / 'x.gif').exists()
+
+
+def test_bad_input_one_line_exit_2_by_the_process(tmp_path):
+    """The command's own process: one line, exit 2, nothing written."""
+    result = subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli',
+                             '/nonexistent/run.mcap', '-o', 'x.gif'],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=120,
+                            env=dict(ENV, PYTHONPATH=str(REPO)))
+    _assert_one_line(result.returncode, result.stderr, 'cannot read', tmp_path)
+    assert result.stdout == ''
+
+
 @pytest.mark.parametrize('args, words', [
     (['/nonexistent/run.mcap', '-o', 'x.gif'], 'cannot read'),
     (['--params-file', '/nonexistent.yaml', '-o', 'x.gif'],
@@ -105,14 +123,14 @@ def _cli(*args):
     (['-o', 'x.gif', '--delta', '0.5'], 'delta/a'),
     (['-o', 'x.gif', '--fps', '0'], 'fps'),
 ])
-def test_bad_input_one_line_exit_2(tmp_path, args, words):
-    result = subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli', *args],
-                            cwd=tmp_path, capture_output=True, text=True, timeout=120,
-                            env=dict(ENV, PYTHONPATH=str(REPO)))
-    assert result.returncode == 2, result.stderr
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and words in lines[0], result.stderr
-    assert not (tmp_path / 'x.gif').exists()
+def test_bad_input_one_line_exit_2(tmp_path, monkeypatch, capsys, args, words):
+    """``main`` in this process, in a fresh working directory."""
+    from twodisk_ros.plotting.animate_cli import main
+    monkeypatch.chdir(tmp_path)
+    status = main(list(args))
+    out, err = capsys.readouterr()
+    _assert_one_line(status, err, words, tmp_path)
+    assert out == ''
 
 
 def test_recording_span_past_its_end(recording, tmp_path):

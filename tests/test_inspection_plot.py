@@ -1,18 +1,17 @@
 """The figure of ``twodisk-inspect --plot`` (plotting/inspection.py) shows what it says.
 
-Recordings are made by the real node in batch mode (1 s, 100 Hz): the Two-Circle-Roller
+Recordings are made by the real node in batch mode (1 s, 100 Hz; in this process, domain 14): the Two-Circle-Roller
 (constant height of G), the oloid driven at constant |ω| (kinematic), and the oloid thrown at
 ω0 = 9 rad/s, which lifts off and slips. The references are recomputed here from the
 recorded rolling_state with the physics (E(u, u̇), |ω_u(u)|) and from the recorded wrenches.
 """
 
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from batch_recording import record
 from twodisk_ros.inspect import inspect_recording
 from twodisk_ros.io.reader import read_recording
 from twodisk_ros.node.parameters import parse_recorded
@@ -23,28 +22,19 @@ from twodisk_ros.plotting.inspection import align_zeros, inspection_figure, plot
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RUNS = {
-    'tcr': ['--params-file', os.path.join(REPO, 'config', 'two_circle_roller.yaml')],
-    'kinematic': ['--params-file', os.path.join(REPO, 'config', 'oloid.yaml'),
-                  '-p', 'mode:=kinematic', '-p', 'omega0:=5.0'],
-    'liftoff': ['--params-file', os.path.join(REPO, 'config', 'oloid.yaml'),
-                '-p', 'omega0:=9.0'],
+    'tcr': (os.path.join(REPO, 'config', 'two_circle_roller.yaml'), {}),
+    'kinematic': (os.path.join(REPO, 'config', 'oloid.yaml'),
+                  {'mode': 'kinematic', 'omega0': 5.0}),
+    'liftoff': (os.path.join(REPO, 'config', 'oloid.yaml'), {'omega0': 9.0}),
 }
 
 
 @pytest.fixture(scope='module')
 def recordings(tmp_path_factory):
     folder = tmp_path_factory.mktemp('runs')
-    env = dict(os.environ, PYTHONPATH=REPO, ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
-               ROS_DOMAIN_ID=os.environ.get('ROS_DOMAIN_ID', '14'), MPLBACKEND='Agg')
-    paths = {}
-    for name, args in RUNS.items():
-        path = folder / f'{name}.mcap'
-        subprocess.run([sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', *args,
-                        '-p', 'realtime:=false', '-p', 'duration:=1.0',
-                        '-p', f'record:={path}'], env=env, check=True, timeout=60,
-                       capture_output=True)
-        paths[name] = str(path)
-    return paths
+    return {name: str(record(folder / f'{name}.mcap', params_file, domain=14, duration=1.0,
+                             **values))
+            for name, (params_file, values) in RUNS.items()}
 
 
 @pytest.fixture(scope='module')

@@ -10,13 +10,12 @@ slope as the flat ground (the body's contacts at Z = 0, off the sloped plane by 
 import math
 import os
 from pathlib import Path
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 import yaml
 
+from batch_recording import record
 from twodisk_ros.model.outline import DEFAULT_TOLERANCE
 from twodisk_ros.plotting.animation import drawn
 from twodisk_ros.runs import library_run, recorded_run, settings_from
@@ -105,13 +104,10 @@ def test_a_flat_run_draws_no_ground_quad():
 
 def test_a_recording_on_the_slope_is_drawn_on_its_slope(tmp_path):
     """A batch recording of config/slope.yaml: the run reads the slope from the recorded
-    parameters, and the drawn rims touch the drawn slope at the recorded contacts."""
-    out = tmp_path / 'slope.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
-         str(SLOPE_FILE), '-p', 'realtime:=false', '-p', 'duration:=0.5', '-p',
-         f'record:={out}'], cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
-    assert made.returncode == 0, made.stderr[-800:]
+    parameters, and the drawn rims touch the drawn slope at the recorded contacts (the node
+    runs in this process, domain 74)."""
+    out = record(tmp_path / 'slope.mcap', SLOPE_FILE, domain=int(ENV['ROS_DOMAIN_ID']),
+                 duration=0.5)
     run = recorded_run(out)
     assert run.slope == _file_slope()
     _touches(drawn(run, size=(320, 240)), run.body.lamina.size)

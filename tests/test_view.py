@@ -1,15 +1,22 @@
 """``twodisk-view``: a Foxglove WebSocket server of the rolling body, without ROS.
 
-Each test starts the command in its own process, with rclpy made unimportable (the whole
-path of the command must run without ROS), on a free port (``--port 0``, the port read from
-its first line), and reads it with the headless client of ``foxglove_client`` (``websockets``
+The servers run as the command in a process of their own, with rclpy made unimportable (the
+whole path of the command must run without ROS), on a free port (``--port 0``, the port read
+from its first line), and are read with the headless client of ``foxglove_client`` (``websockets``
 and ``google.protobuf``, nothing of twodisk_ros or foxglove-sdk). The values received are
 compared with the physics library called independently at the same times, or with the
-recording read by ``mcap_ros2``. The server is killed by its PID in a finally.
+recording read by ``mcap_ros2``. The server is killed by its PID in a finally. A server
+answers several claims: the live oloid those of the channels, the values, the subprotocols
+and SIGINT; a solid body at one sample per 20 s those of the hull, the static content and
+SIGTERM. Bad input is refused by ``main`` called in this process (one line, exit 2), and once
+by the command's own process.
 
-The roller node (for the recording) runs with ROS_DOMAIN_ID 46, loopback discovery only.
+The roller node (for the recording) runs in this process with ROS_DOMAIN_ID 46, loopback
+discovery only.
 """
 
+import contextlib
+import io
 import math
 from pathlib import Path
 import signal
@@ -21,6 +28,7 @@ import numpy as np
 import pytest
 import yaml
 
+from batch_recording import record
 from foxglove_client import SUBPROTOCOL, collect, refused, stamp_ns
 from view_process import ENV, RUNNER, View, wait_for_handlers
 from twodisk_ros.model.mesh import mesh_parts
@@ -79,15 +87,48 @@ def _live_enough(received):
             and len(received.messages['/traces'][-1][1].entities[0].lines[0].points) >= 2)
 
 
+def _port_is_free(port):
+    """True if nobody listens on ``port`` any more: it can be bound and listened on."""
+    with socket.socket() as again:
+        again.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)   # as servers do
+        try:
+            again.bind(('127.0.0.1', port))
+            again.listen()
+        except OSError:
+            return False
+    return True
+
+
 @pytest.fixture(scope='module')
 def live():
-    """A live oloid (config/oloid.yaml) and what a client received from it."""
+    """A live oloid (config/oloid.yaml): the subprotocols it refuses and accepts, what a
+    client received from it, and its stop by SIGINT."""
     view = View('--params-file', OLOID, '--port', 0)
     try:
         port = view.wait_serving()
+        handshakes = {'foxglove.websocket.v1': refused(port, 'foxglove.websocket.v1'),
+                      SUBPROTOCOL: refused(port, SUBPROTOCOL)}
         received = collect(port, TOPICS, _live_enough, request_parameters=True)
         status, stderr = view.stop(signal.SIGINT)
+        view.handshakes, view.freed = handshakes, _port_is_free(port)
         yield received, status, stderr, view
+    finally:
+        view.kill()
+
+
+@pytest.fixture(scope='module')
+def sparse_solid():
+    """A solid oloid at one sample per 20 s: a first client subscribes to /tf until the
+    first sample, a second one then to /body and /parameters; stopped by SIGTERM."""
+    view = View('--params-file', OLOID, '--mass-model', 'solid', '--rate', 0.05, '--port', 0)
+    try:
+        port = view.wait_serving()
+        first = collect(port, ['/tf'], lambda r: r.count('/tf'))   # a sample was just shown
+        received = collect(port, ['/body', '/parameters'],
+                           lambda r: r.count('/body') and r.count('/parameters'), timeout=10.0)
+        status, stderr = view.stop(signal.SIGTERM)
+        view.freed = _port_is_free(port)
+        yield first, received, status, stderr, view
     finally:
         view.kill()
 
@@ -238,39 +279,24 @@ def test_live_body_mesh_and_parameters(live):
     assert served['a'] == p['a'] and served['mass_model'] == p['mass_model']
 
 
-def test_solid_body_is_the_grey_hull():
+def test_solid_body_is_the_grey_hull(sparse_solid):
+    _, received, status, stderr, _ = sparse_solid
+    assert status == 0, stderr
     p = dict(_oloid_parameters(), mass_model='solid')
-    view = View('--params-file', OLOID, '--mass-model', 'solid', '--port', 0)
-    try:
-        port = view.wait_serving()
-        received = collect(port, ['/body'], lambda r: r.count('/body'))
-        assert view.stop()[0] == 0
-    finally:
-        view.kill()
     parts = mesh_parts(TwoDiskBody(p['a'], p['b'], p['delta']), 'solid')
     assert set(parts) == {'hull'}
     _check_body(received.messages['/body'][0][1], p, parts)
 
 
-def test_old_subprotocol_is_refused_and_the_sdk_one_accepted():
-    view = View('--params-file', OLOID, '--port', 0)
-    try:
-        port = view.wait_serving()
-        assert refused(port, 'foxglove.websocket.v1') == 400
-        assert refused(port, SUBPROTOCOL) is None
-        assert view.stop()[0] == 0
-    finally:
-        view.kill()
+def test_old_subprotocol_is_refused_and_the_sdk_one_accepted(live):
+    *_, view = live
+    assert view.handshakes['foxglove.websocket.v1'] == 400
+    assert view.handshakes[SUBPROTOCOL] is None
 
 
 def _recording(tmp_path, duration=2.0):
-    out = tmp_path / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file', str(OLOID),
-         '-p', 'realtime:=false', '-p', f'duration:={duration}', '-p', f'record:={out}'],
-        cwd=REPO, env=ENV, capture_output=True, text=True, timeout=300)
-    assert made.returncode == 0, made.stderr
-    return out
+    return record(tmp_path / 'run.mcap', OLOID, domain=int(ENV['ROS_DOMAIN_ID']),
+                  duration=duration)
 
 
 def _recorded_poses(path):
@@ -290,7 +316,7 @@ def _recorded_poses(path):
 def test_replay_transforms_equal_the_recording(tmp_path):
     """Replayed transforms carry the recorded poses and stamps, bit for bit, every sample
     from the client's subscription on to the end of the recording."""
-    recording = _recording(tmp_path)
+    recording = _recording(tmp_path, duration=1.0)
     poses = _recorded_poses(recording)
     last = max(poses)
 
@@ -322,18 +348,47 @@ def test_replay_transforms_equal_the_recording(tmp_path):
     assert f'the run ended after {len(recorded)} samples' in ''.join(view.stdout)
 
 
-def _one_line_refusal(*args):
+def _one_line(status, stderr):
+    assert status == 2, (status, stderr)
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('twodisk-view: '), stderr
+    assert 'Traceback' not in stderr
+    return lines[0]
+
+
+def _one_line_refusal_by_the_process(*args):
+    """The command's own process (rclpy unimportable; RUNNER exits 9 if rclpy or matplotlib
+    were imported)."""
     result = subprocess.run([sys.executable, '-c', RUNNER, *map(str, args)], cwd=REPO, env=ENV,
                             capture_output=True, text=True, timeout=120)
-    assert result.returncode == 2, (result.returncode, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith('twodisk-view: '), result.stderr
-    assert 'Traceback' not in result.stderr
-    return lines[0]
+    return _one_line(result.returncode, result.stderr)
+
+
+@contextlib.contextmanager
+def _own_signal_handlers():
+    """main installs its SIGINT/SIGTERM handlers: pytest's are put back afterwards."""
+    saved = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for number, handler in saved.items():
+            signal.signal(number, handler)
+
+
+def _one_line_refusal(*args):
+    """``main`` called in this process: its exit status and stderr (nothing on stdout)."""
+    from twodisk_ros.view.cli import main
+    out, err = io.StringIO(), io.StringIO()
+    with _own_signal_handlers(), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(err):
+        status = main([str(arg) for arg in args])
+    assert out.getvalue() == '', out.getvalue()
+    return _one_line(status, err.getvalue())
 
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path):
     missing = tmp_path / 'missing.mcap'
+    assert 'missing.mcap' in _one_line_refusal_by_the_process(missing)
     assert 'missing.mcap' in _one_line_refusal(missing)
     text = tmp_path / 'text.mcap'
     text.write_text('not a recording\n')
@@ -358,21 +413,18 @@ def test_a_port_in_use_is_refused():
 
 
 @pytest.mark.parametrize('number', [signal.SIGINT, signal.SIGTERM])
-def test_signal_stops_the_server_and_frees_the_port(number):
-    view = View('--params-file', OLOID, '--port', 0)
-    try:
-        port = view.wait_serving()
-        received = collect(port, ['/tf'], lambda r: r.count('/tf') >= 5)
-        assert received.count('/tf') >= 5
-        status, stderr = view.stop(number)
-        assert status == 0, stderr
-        assert 'stopped after' in ''.join(view.stdout)
-        with socket.socket() as again:       # the port is free: nobody listens on it
-            again.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)   # as servers do
-            again.bind(('127.0.0.1', port))
-            again.listen()
-    finally:
-        view.kill()
+def test_signal_stops_the_server_and_frees_the_port(number, request):
+    """SIGINT stopped the live oloid after >= 40 samples on /tf, SIGTERM the sparse solid
+    one (idle between its samples) after its first: exit 0, the last line said, the port
+    free (bound again by the fixture once the process had exited)."""
+    if number == signal.SIGINT:
+        received, status, stderr, view = request.getfixturevalue('live')
+    else:
+        received, _, status, stderr, view = request.getfixturevalue('sparse_solid')
+    assert received.count('/tf') >= 1
+    assert status == 0, stderr
+    assert 'stopped after' in ''.join(view.stdout)
+    assert view.freed
 
 
 def test_signal_before_serving_exits_0():
@@ -397,18 +449,11 @@ def test_help_states_the_protocol_and_the_viewers(tmp_path):
     assert 'foxglove.websocket.v1' in text and list(tmp_path.iterdir()) == []
 
 
-def test_static_content_reaches_a_client_between_sparse_samples():
+def test_static_content_reaches_a_client_between_sparse_samples(sparse_solid):
     """With 20 s between samples, a client that subscribes just after a sample gets the body
     and the parameters at once, not at the next sample (it waits 10 s at most)."""
-    view = View('--params-file', OLOID, '--rate', 0.05, '--port', 0)
-    try:
-        port = view.wait_serving()
-        first = collect(port, ['/tf'], lambda r: r.count('/tf'))   # a sample was just shown
-        assert first.count('/tf') == 1
-        received = collect(port, ['/body', '/parameters'],
-                           lambda r: r.count('/body') and r.count('/parameters'), timeout=10.0)
-        assert view.stop()[0] == 0
-    finally:
-        view.kill()
+    first, received, status, stderr, _ = sparse_solid
+    assert first.count('/tf') == 1
+    assert status == 0, stderr
     assert received.count('/body') and received.count('/parameters')
     assert received.messages['/parameters'][0][1]['run']['rate'] == 0.05
