@@ -35,14 +35,18 @@ from twodisk_ros.io import McapRecorder, cdr, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 TFMessage = tf2_msgs.TFMessage
-PARAMS = dict(OLOID, body_frame='twodisk_body')
+#: test_inspect's oloid run, 1.5 s instead of 3 s (151 samples at 100 Hz): every claim here
+#: is about single samples or about all of them, none about the length of the run
+RUN = dict(OLOID, duration='1.5')
+SAMPLES = 151
+PARAMS = dict(RUN, body_frame='twodisk_body')
 K = 137          # the sample each fault is injected at
 
 
 @pytest.fixture(scope='module')
 def old_file(tmp_path_factory):
     """A recording as the node wrote it before /tf (no body_frame in its metadata either)."""
-    return write_run(tmp_path_factory.mktemp('old') / 'old.mcap', simulate_run(OLOID), OLOID)
+    return write_run(tmp_path_factory.mktemp('old') / 'old.mcap', simulate_run(RUN), RUN)
 
 
 def _class(type_name):
@@ -142,7 +146,7 @@ def test_exact_tf_passes(capsys, tmp_path, old_file, encoder):
     assert inspection.verdict == 'PASS', [c for c in inspection.checks if not c.passed]
     assert checks['tf'].passed and checks['tf'].value == 0
     samples = inspection.summary['samples']
-    assert inspection.summary['tf']['transforms'] == samples == 301
+    assert inspection.summary['tf']['transforms'] == samples == SAMPLES
     status, out, _ = run_main(capsys, path, '--json')
     document = json.loads(out)
     assert status == 0 and document['summary']['tf']['different'] == 0
@@ -167,9 +171,9 @@ def _opposite_quaternion(i, values):
     ('translation z one ulp down', {'edit': _ulp(2, -np.inf)}, 'different', 1),
     ('rotation w one ulp down', {'edit': _ulp(6, -np.inf)}, 'different', 1),
     ('a stamp missing', {'drop': {K}}, 'missing', 1),
-    ('parent not frame_id', {'parent': 'map'}, 'wrong_parent', 301),
+    ('parent not frame_id', {'parent': 'map'}, 'wrong_parent', SAMPLES),
     ('child not the metadata body_frame', {'params': dict(PARAMS, body_frame='base_link')},
-     'missing', 301),
+     'missing', SAMPLES),
 ])
 def test_fault_fails_the_tf_check_only(tmp_path, old_file, fault, kwargs, counted, value):
     path = with_tf(old_file, tmp_path / 'bad.mcap', **kwargs)
@@ -210,7 +214,7 @@ def test_cut_recording_with_tf_is_incomplete_not_fail(tmp_path, old_file):
 
 
 # -- frame_id and body_frame changed at run time (the node accepts both) ---------------------
-CHANGE = 150     # the first sample after the change: /tf_static is sent again at its stamp
+CHANGE = 75      # the first sample after the change: /tf_static is sent again at its stamp
 RENAMED = dict(PARAMS, frame_id='odom', body_frame='oloid')   # the metadata: the last values
 
 
@@ -220,13 +224,13 @@ def _renamed(i):
 
 def test_frames_changed_at_run_time_pass(capsys, tmp_path, old_file):
     """The parent is each pose's own frame_id, the child the body frame of the latest
-    /tf_static: a rename of both at sample 150 PASSes (the metadata only holds the last)."""
+    /tf_static: a rename of both at sample 75 PASSes (the metadata only holds the last)."""
     path = with_tf(old_file, tmp_path / 'renamed.mcap', params=RENAMED, frames=_renamed,
                    statics={0: 'twodisk_body', CHANGE: 'oloid'})
     inspection, checks = verdict(path)
     assert inspection.verdict == 'PASS', [c for c in inspection.checks if not c.passed]
     summary = inspection.summary['tf']
-    assert checks['tf'].value == 0 and summary['transforms'] == 301
+    assert checks['tf'].value == 0 and summary['transforms'] == SAMPLES
     assert (summary['parents'], summary['children']) == (['world', 'odom'],
                                                          ['twodisk_body', 'oloid'])
     assert (summary['parent'], summary['child']) == ('odom', 'oloid')
@@ -245,6 +249,6 @@ def test_old_frame_after_the_change_fails(tmp_path, old_file, fault, frames, cou
     inspection, checks = verdict(path)
     assert inspection.verdict == 'FAIL', fault
     assert [c.name for c in inspection.checks if not c.passed] == ['tf'], fault
-    # every sample from the change on (301 - 150), and only those
-    assert inspection.summary['tf'][counted] == checks['tf'].value == 301 - CHANGE, fault
+    # every sample from the change on (151 - 75), and only those
+    assert inspection.summary['tf'][counted] == checks['tf'].value == SAMPLES - CHANGE, fault
     assert f't = {CHANGE / 100:.9g} s' in ' '.join(checks['tf'].detail), checks['tf'].detail
