@@ -1,8 +1,9 @@
 """``twodisk-animate``: GIFs from the library and from a recording, and its input errors.
 
 The recording is the roller node's batch run, made in this process (domain 94 unless
-ROS_DOMAIN_ID is set). The command runs as a process of its own for a GIF of the recording
-and for one refusal; the other refusals call its ``main`` in this process.
+ROS_DOMAIN_ID is set). The command runs as a process of its own for a GIF of the recording;
+the refusals call its ``main`` in this process (test_cli_outputs refuses bad requests to the
+command's own process).
 """
 
 import os
@@ -101,16 +102,6 @@ def _assert_one_line(status, stderr, words, folder):
     assert not (folder / 'x.gif').exists()
 
 
-def test_bad_input_one_line_exit_2_by_the_process(tmp_path):
-    """The command's own process: one line, exit 2, nothing written."""
-    result = subprocess.run([sys.executable, '-m', 'twodisk_ros.plotting.animate_cli',
-                             '/nonexistent/run.mcap', '-o', 'x.gif'],
-                            cwd=tmp_path, capture_output=True, text=True, timeout=120,
-                            env=dict(ENV, PYTHONPATH=str(REPO)))
-    _assert_one_line(result.returncode, result.stderr, 'cannot read', tmp_path)
-    assert result.stdout == ''
-
-
 @pytest.mark.parametrize('args, words', [
     (['/nonexistent/run.mcap', '-o', 'x.gif'], 'cannot read'),
     (['--params-file', '/nonexistent.yaml', '-o', 'x.gif'],
@@ -124,7 +115,8 @@ def test_bad_input_one_line_exit_2_by_the_process(tmp_path):
     (['-o', 'x.gif', '--fps', '0'], 'fps'),
 ])
 def test_bad_input_one_line_exit_2(tmp_path, monkeypatch, capsys, args, words):
-    """``main`` in this process, in a fresh working directory."""
+    """``main`` in this process, in a fresh working directory: one line, exit 2, nothing
+    written."""
     from twodisk_ros.plotting.animate_cli import main
     monkeypatch.chdir(tmp_path)
     status = main(list(args))
