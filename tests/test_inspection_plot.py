@@ -2,8 +2,9 @@
 
 Recordings are made by the real node in batch mode (1 s, 100 Hz; in this process, domain
 14): the Two-Circle-Roller (constant height of G), the oloid driven at constant |ω|
-(kinematic), and the oloid thrown at ω0 = 9 rad/s, which lifts off and slips. The references are recomputed here from the
-recorded rolling_state with the physics (E(u, u̇), |ω_u(u)|) and from the recorded wrenches.
+(kinematic), and the oloid thrown at ω0 = 9 rad/s, which lifts off and slips. The references
+are recomputed here from the recorded rolling_state with the physics (E(u, u̇), |ω_u(u)|) and
+from the recorded wrenches.
 """
 
 import os
