@@ -47,6 +47,22 @@ def client():
         yield c
 
 
+@pytest.fixture
+def shared(client, monkeypatch):
+    """The command line (cli.main, in this process) runs on the module's cluster instead of
+    starting a LocalCluster of its own: for tests about outputs and refusals, not about the
+    cluster's life (each LocalCluster costs seconds of CPU in its worker processes)."""
+    import contextlib
+    import twodisk_ros.sweep.run as run
+
+    @contextlib.contextmanager
+    def on_the_module_cluster(scheduler=None, workers=None, **kwargs):
+        assert scheduler is None
+        yield client
+
+    monkeypatch.setattr(run, 'dask_client', on_the_module_cluster)
+
+
 @pytest.fixture(scope='module')
 def reference(client):
     """The undisturbed sweep, in memory (no output file)."""
@@ -259,24 +275,30 @@ def _hooked(action, after, argv, timeout=180):
 
 
 @pytest.mark.slow
-def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(reference, tmp_path):
+def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, reference, shared,
+                                                                tmp_path, capsys):
+    # the interrupted command runs on the module's cluster (no LocalCluster of its own to
+    # start), then the rerun: the command line in this process, on the same cluster
     store = tmp_path / 'map.zarr'
-    argv = _argv(store, '--chunk-size', '1', '--workers', '1')
-    stopped = _hooked('SIGINT', 5, argv)
+    argv = _argv(store, '--chunk-size', '2')
+    blocks = len(SweepSpec(np.linspace(0.5, 1.5, 6), np.linspace(0.3, 1.0, 8),
+                           chunk_size=2).blocks())
+    assert blocks == TOTAL // 2
+    stopped = _hooked('SIGINT', 5, [*argv, '--scheduler', client.scheduler.address])
     assert stopped.returncode == 130, stopped.stderr
     assert stopped.stderr.strip().splitlines() == [
         f'twodisk-sweep: interrupted; finished chunks are kept in {store} - run the same '
         'command again to resume']
+    _wait_until_idle(client)    # a cancelled task still finishes on its worker
     flags = _flags(store)
-    finished = int(flags.sum())       # 5, or a few more finished by the worker meanwhile
-    assert 5 <= finished < TOTAL
+    finished = int(flags.sum()) // 2   # 5, or a few more finished by the workers meanwhile
+    assert 5 <= finished < blocks
     kept = {p: v for p, v in _tree(store).items() if '/computed/c/' in str(p)}
     assert len(kept) == finished
-    again = subprocess.run([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
-                           capture_output=True, text=True, timeout=180)
-    assert again.returncode == 0, again.stderr
-    assert (f'{TOTAL - finished} chunks computed, {finished} resumed'
-            in again.stderr.strip().splitlines()[-1])
+    capsys.readouterr()
+    assert main([*argv, '--quiet']) == 0
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f'{blocks - finished} chunks computed, {finished} resumed' in last, last
     tree = _tree(store)
     assert all(tree[p] == v for p, v in kept.items())     # the finished chunks untouched
     _same(read_sweep(store), reference)
@@ -311,7 +333,8 @@ def _fails_in_one_line(argv, capsys, *words):
 
 
 @pytest.mark.slow
-def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, tmp_path, capsys):
+def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, shared, tmp_path,
+                                                           capsys):
     store = tmp_path / 'map.zarr'
     argv = _argv(store, '--chunk-size', '5', '--workers', '1', '--quiet')
     assert main(argv) == 0
@@ -379,7 +402,7 @@ def test_bad_input_for_a_zarr_store_one_line_exit_2(override, words, tmp_path, c
 
 
 @pytest.mark.slow
-def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
+def test_a_grid_without_any_computable_body_leaves_no_store(shared, tmp_path, capsys):
     # Delta/a = 1e-300 passes the command line, but the body refuses a length below its range
     _fails_in_one_line(['--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300', '1e-300', '1',
                         '--out', str(tmp_path / 'x.zarr'), '--workers', '1', '--quiet'],
@@ -388,53 +411,53 @@ def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_unreachable_scheduler_creates_no_store(tmp_path):
+def test_unreachable_scheduler_creates_no_store(tmp_path, capsys):
+    # the command line in this process (tests/test_sweep.py runs it as a command)
     from dask_helpers import free_port
-    result = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.sweep', *_argv(tmp_path / 'x.zarr'),
-         '--scheduler', f'tcp://127.0.0.1:{free_port()}'],
-        env=ENV, capture_output=True, text=True, timeout=60)
-    assert result.returncode == 2, result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
-    assert 'cannot reach the Dask scheduler' in result.stderr
+    _fails_in_one_line([*_argv(tmp_path / 'x.zarr'), '--scheduler',
+                        f'tcp://127.0.0.1:{free_port()}'], capsys, 'cannot reach the Dask scheduler')
     assert list(tmp_path.iterdir()) == []
 
 
 # -- progress --------------------------------------------------------------------------------
 
-def _stderr_on_a_terminal(argv):
-    """(exit status, text) of the command with its stderr on a pseudo-terminal."""
+def _stderr_on_a_terminal(argv, monkeypatch):
+    """(exit status, text) of the command line (cli.main, in this process) with its stderr on
+    a pseudo-terminal of 100 columns (a reader thread empties the terminal meanwhile)."""
+    import threading
     leader, follower = pty.openpty()
     fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack('HHHH', 24, 100, 0, 0))
-    proc = subprocess.Popen([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                            stderr=follower)
-    os.close(follower)
     chunks = []
-    try:
+
+    def read():
         while True:
             try:
                 data = os.read(leader, 65536)
-            except OSError:          # EIO: the command closed the terminal (it ended)
-                break
+            except OSError:          # EIO: the terminal's other side is closed
+                return
             if not data:
-                break
+                return
             chunks.append(data)
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    terminal = open(follower, 'w', encoding='utf-8')
+    try:
+        with monkeypatch.context() as patch:
+            patch.setattr(sys, 'stderr', terminal)
+            status = main(argv)
     finally:
+        terminal.close()
+        reader.join(timeout=60)
         os.close(leader)
-        try:
-            proc.wait(timeout=120)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait(timeout=10)
-    return proc.returncode, b''.join(chunks).decode('utf-8', 'replace')
+    assert not reader.is_alive()
+    return status, b''.join(chunks).decode('utf-8', 'replace')
 
 
 @pytest.mark.slow
-def test_progress_bar_on_a_terminal_only(tmp_path):
-    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'a.nc', '--chunk-size', '8',
-                                               '--workers', '1'))
+def test_progress_bar_on_a_terminal_only(shared, tmp_path, monkeypatch):
+    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'a.nc', '--chunk-size', '8'),
+                                         monkeypatch)
     assert status == 0, text
     # tqdm's bar, ending at 100 % of the bodies, then the summary line
     assert '100%' in text and f'{TOTAL}/{TOTAL}' in text and 'body/s' in text, text
@@ -443,5 +466,5 @@ def test_progress_bar_on_a_terminal_only(tmp_path):
                            f'6 masked; 6 chunks computed, 0 resumed; '), last
     assert last.endswith(' bodies/s)'), last
     status, text = _stderr_on_a_terminal(_argv(tmp_path / 'b.nc', '--chunk-size', '8',
-                                               '--workers', '1', '--quiet'))
+                                               '--quiet'), monkeypatch)
     assert status == 0 and '%' not in text and len(text.strip().splitlines()) == 1, text
