@@ -25,7 +25,7 @@ from dask_helpers import ENV, cluster
 from harsh_start import harshly
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
-from twodisk_ros.sweep.run import SweepSpec, dask_client, run_sweep
+from twodisk_ros.sweep.run import SweepSpec, run_sweep
 from twodisk_ros.sweep.spec import block_shape
 
 # 6 x 8 = 48 bodies, both stable families, and Delta/a = 1 (masked) in the last column
@@ -43,8 +43,22 @@ def _argv(out, *more):
 
 @pytest.fixture(scope='module')
 def client():
-    with dask_client(workers=2) as c:
+    """A cluster of two worker threads of this process, its scheduler on 127.0.0.1 (TCP: the
+    commands a test starts connect to it); no worker processes to start (the LocalCluster
+    of worker processes, dask_client's default, is tested in tests/test_sweep.py)."""
+    import logging
+    from distributed import Client, LocalCluster
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                           protocol='tcp://', host='127.0.0.1', dashboard_address=None,
+                           silence_logs=logging.CRITICAL,
+                           scheduler_kwargs={'dashboard': False,
+                                             'dashboard_address': '127.0.0.1:0'})
+    c = Client(cluster, set_as_default=False)
+    try:
         yield c
+    finally:
+        c.close()
+        cluster.close()
 
 
 @pytest.fixture
@@ -233,34 +247,21 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
 
 # -- interrupted and resumed -----------------------------------------------------------------
 
-#: The sweep's command line with a hook after the client's k-th finished chunk (argv[1]).
-#: SIGINT: the client signals itself (a real SIGINT through Python's handler, which the
+#: The sweep's command line with a hook after the client's k-th finished chunk (argv[2]):
+#: SIGINT, the client signals itself (a real SIGINT through Python's handler, which the
 #: script installs first: a suite started in the background or under nohup hands its
-#: children SIGINT ignored, and then Python installs none). KILL: the client kills the
-#: `dask worker` command (nanny and worker, its process group) of a worker that is busy, then
-#: goes on; only a group that the test's cluster started in a session of its own (the
-#: group's leader leads a session), never the client's own group.
+#: children SIGINT ignored, and then Python installs none).
 _HOOKED_CLI = """
-import os, signal, sys
+import signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
 import twodisk_ros.sweep.run as run
 real, action, after = run.run_sweep, sys.argv[1], int(sys.argv[2])
+assert action == 'SIGINT', action
 def hooked(spec, client, *args, **kwargs):
     def on_chunk(index, computed):
-        if computed != after:
-            return
-        if action == 'SIGINT':
+        if computed == after:
             signal.raise_signal(signal.SIGINT)
-            sys.exit('SIGINT raised nothing')          # never fall through to the kill
-        busy = [address for address, keys in client.processing().items() if keys]
-        if not busy:
-            sys.exit('no worker busy')
-        pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
-        group = os.getpgid(pid)
-        if group == os.getpgid(0) or os.getsid(group) != group:
-            sys.exit(f'worker {pid} is not in a session of its own: not killed')
-        os.killpg(group, signal.SIGKILL)
-        print(f'killed a busy worker after {computed} chunks', file=sys.stderr)
+            sys.exit('SIGINT raised nothing')
     return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
 run.run_sweep = hooked
 from twodisk_ros.sweep.cli import main
@@ -306,16 +307,37 @@ def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, referenc
 
 
 @pytest.mark.slow
-def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path):
+def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path, capsys, monkeypatch):
+    # the command line runs in this process; its hook kills one busy `dask worker` command
+    import signal
+    import twodisk_ros.sweep.run as run
     store = tmp_path / 'map.zarr'
+    real = run.run_sweep
+
+    def hooked(spec, client, *args, **kwargs):
+        def on_chunk(index, computed):
+            if computed != 3:
+                return
+            busy = [address for address, keys in client.processing().items() if keys]
+            assert busy, 'no worker busy'
+            pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
+            group = os.getpgid(pid)
+            # only a group that the test's cluster started in a session of its own
+            assert group != os.getpgid(0) and os.getsid(group) == group, pid
+            os.killpg(group, signal.SIGKILL)
+            print('killed a busy worker after 3 chunks', file=sys.stderr)
+        return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
+
+    monkeypatch.setattr(run, 'run_sweep', hooked)
     with cluster(tmp_path, workers=2) as (address, procs):
-        result = _hooked('KILL', 3, _argv(store, '--chunk-size', '1', '--scheduler', address))
+        status = main(_argv(store, '--chunk-size', '1', '--scheduler', address))
+        err = capsys.readouterr().err
         dead = [p for p in procs[1:] if p.poll() is not None]
-    assert result.returncode == 0, result.stderr
-    lines = result.stderr.strip().splitlines()
+    assert status == 0, err
+    lines = err.strip().splitlines()
     assert lines[0] == 'killed a busy worker after 3 chunks', lines
     assert len(dead) == 1 and dead[0].returncode == -9       # one `dask worker` is gone
-    assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in result.stderr
+    assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in err
     _same(read_sweep(store), reference)
     assert np.all(_flags(store) == 1)
 
