@@ -210,10 +210,14 @@ class _Killed(BaseException):
 def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
     """A worker killed at any write of a block (the k-th of its chunk objects) leaves the
     block's flags at 0: the flags are the block's last write."""
+    import shutil
     import zarr
     from twodisk_ros.sweep import store as zstore
     spec = SweepSpec(np.array([1.0]), np.array([0.5]), chunk_size=1)
-    path = zstore.create_store(tmp_path / 'one.zarr', spec)
+    # the store as create_store lays it out, copied afresh for each write to kill at
+    pristine = zstore.create_store(tmp_path / 'pristine.zarr', spec)
+    path = tmp_path / 'one.zarr'
+    shutil.copytree(pristine, path)
     real = zarr.Array.__setitem__
     writes = []     # the arrays written by write_block, in order
     kill_at = None  # kill at this write (0: watch only; None: neither)
@@ -233,8 +237,8 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
     assert set(writes) == variables and writes[-1] == 'computed'
     for k in range(1, len(variables) + 1):
         kill_at = None
-        zstore.remove_store(path)
-        zstore.create_store(path, spec)
+        shutil.rmtree(path)
+        shutil.copytree(pristine, path)
         writes.clear()
         kill_at = k
         with pytest.raises(_Killed):
