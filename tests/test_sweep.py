@@ -16,7 +16,7 @@ import time
 import numpy as np
 import pytest
 
-from dask_helpers import free_port, stop
+from dask_helpers import free_port
 from harsh_start import harshly
 from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
@@ -35,7 +35,6 @@ from twodisk_ros.sweep.run import SweepSpec, dask_client, parts_folder, run_swee
 REPO = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get('PYTHONPATH', ''))
 ENV.pop('DASK_SCHEDULER_ADDRESS', None)
-DASK = str(Path(sys.executable).with_name('dask'))
 # b/a = 0.5, 1, 1.5; Δ/a = 0.25, 0.5, 0.75, 1 (the oloid (1, 0.5) and masked Δ/a = 1 points)
 B_GRID = ('0.5', '1.5', '3')
 D_GRID = ('0.25', '1', '4')
@@ -269,57 +268,20 @@ def _listening_hosts(procs):
     return hosts
 
 
-def _wait_for_workers(address, count, timeout=60):
-    from distributed import Client
-    with Client(address, timeout='20s', set_as_default=False) as c:
-        c.wait_for_workers(count, timeout=timeout)
-
-
 @pytest.mark.slow
-def test_distributed_cli_equals_local(local, tmp_path):
-    port = free_port()
-    address = f'tcp://127.0.0.1:{port}'
-    procs = []
-    logs = []
-    try:
-        log = open(tmp_path / 'scheduler.log', 'w')
-        logs.append(log)
-        procs.append(subprocess.Popen(
-            [DASK, 'scheduler', '--host', '127.0.0.1', '--port', str(port), '--no-dashboard',
-             '--dashboard-address', '127.0.0.1:0'],
-            stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=tmp_path,
-            start_new_session=True))
-        for k in range(2):
-            log = open(tmp_path / f'worker{k}.log', 'w')
-            logs.append(log)
-            procs.append(subprocess.Popen(
-                [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
-                 '--nthreads', '1', '--no-dashboard', '--dashboard-address', '127.0.0.1:0'],
-                stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=tmp_path,
-                start_new_session=True))
-        deadline = time.monotonic() + 60
-        while True:
-            try:
-                _wait_for_workers(address, 2)
-                break
-            except (OSError, TimeoutError):
-                if time.monotonic() > deadline:
-                    raise
-                time.sleep(0.5)
+def test_distributed_cli_equals_local(local, tmp_path, capsys):
+    # a `dask scheduler` and a `dask worker` command (one worker: the values travel through
+    # a remote scheduler and worker all the same), the command line in this process
+    from dask_helpers import cluster
+    out = tmp_path / 'remote.nc'
+    with cluster(tmp_path, workers=1) as (address, procs):
         assert _listening_hosts(procs) == {'127.0.0.1'}
-        out = tmp_path / 'remote.nc'
-        result = subprocess.run(
-            [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', *B_GRID,
-             '--delta-over-a', *D_GRID, '--out', str(out), '--chunk-size', str(CHUNK),
-             '--scheduler', address],
-            env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=120)
-        assert result.returncode == 0, result.stderr
-        assert 'Traceback' not in result.stderr
+        status = main(['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out),
+                       '--chunk-size', str(CHUNK), '--scheduler', address])
+        err = capsys.readouterr().err
+        assert status == 0, err
+        assert 'Traceback' not in err
         remote = read_netcdf(out)
-    finally:
-        stop(procs)
-        for log in logs:
-            log.close()
     assert all(p.returncode is not None for p in procs)
     _same(local, remote)
     assert not parts_folder(out).exists()
@@ -398,17 +360,32 @@ def test_bad_input_one_line_exit_2(override, words, capsys, tmp_path):
 @pytest.mark.slow
 def test_unreachable_scheduler_exit_2_fast(tmp_path):
     port = free_port()   # nothing listens there
-    start = time.monotonic()
     result = subprocess.run(
         [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', '1', '1', '1',
          '--delta-over-a', '0.5', '0.5', '1', '--out', str(tmp_path / 'x.nc'),
          '--scheduler', f'tcp://127.0.0.1:{port}'],
-        env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=60)
+        env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=60)   # hang guard
     assert result.returncode == 2, result.stderr
     assert len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert 'cannot reach the Dask scheduler' in result.stderr
-    assert time.monotonic() - start < 30
+    assert 'ConnectionRefusedError' in result.stderr
     assert not (tmp_path / 'x.nc.parts').exists()
+
+
+def test_a_refused_connection_is_final_without_a_client(monkeypatch):
+    # "fast": nothing accepts the connection, so no Client is built at all (a Client retried
+    # the refused connection until its 5 s timeout was over: a wait for nothing)
+    import distributed
+    from twodisk_ros.sweep.request import SweepError
+
+    def no_client(*args, **kwargs):
+        raise AssertionError('a Client was built for a port that refuses connections')
+
+    monkeypatch.setattr(distributed, 'Client', no_client)
+    with pytest.raises(SweepError, match='cannot reach the Dask scheduler at .*: '
+                                         'ConnectionRefusedError'):
+        with dask_client(f'tcp://127.0.0.1:{free_port()}'):
+            pass
 
 
 #: The sweep's command line (cli.main, as ``python -m twodisk_ros.sweep`` runs it) with its
@@ -431,18 +408,21 @@ sys.exit(main(sys.argv[2:]))
 
 
 @pytest.mark.slow
-def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
+def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(client, local, tmp_path, capsys,
+                                                            monkeypatch):
+    # the interrupted command runs on the module's cluster (no LocalCluster of its own to
+    # start); the rerun is the command line in this process, on the same cluster
     out = tmp_path / 'map.nc'
     args = ['--b-over-a', *B_GRID, '--delta-over-a', *D_GRID, '--out', str(out),
-            '--chunk-size', '1', '--workers', '1', '--quiet']
+            '--chunk-size', '1', '--quiet']
     saved_before_signal = 2
     parts = parts_folder(out)
     proc = subprocess.Popen(harshly([sys.executable, '-c', _PAUSED_CLI, str(saved_before_signal),
-                                     *args]),
+                                     *args, '--scheduler', client.scheduler.address]),
                             env=ENV, cwd=tmp_path, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)
     try:
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + 60    # hang guard
         while len(list(parts.glob('chunk-*.npz'))) < saved_before_signal:
             assert proc.poll() is None, proc.communicate()[1]
             assert time.monotonic() < deadline, 'the first chunks never appeared'
@@ -458,10 +438,18 @@ def test_sigint_keeps_finished_chunks_and_the_rerun_resumes(local, tmp_path):
     assert len(err.strip().splitlines()) == 1, err
     # the client was paused after saving exactly that many chunks: no more, no fewer
     assert len(list(parts.glob('chunk-*.npz'))) == saved_before_signal and not out.exists()
-    again = subprocess.run([sys.executable, '-m', 'twodisk_ros.sweep', *args], env=ENV,
-                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
-    assert again.returncode == 0, again.stderr
+    import contextlib
+    import twodisk_ros.sweep.run as run
+
+    @contextlib.contextmanager
+    def on_the_module_cluster(scheduler=None, workers=None, **kwargs):
+        yield client
+
+    monkeypatch.setattr(run, 'dask_client', on_the_module_cluster)
+    capsys.readouterr()
+    assert main(args) == 0
+    again = capsys.readouterr().err
     total = len(_spec().b_over_a) * len(_spec().delta_over_a)
     assert (f'{total - saved_before_signal} chunks computed, {saved_before_signal} resumed'
-            in again.stderr)
+            in again), again
     _same(read_netcdf(out), local)

@@ -25,7 +25,7 @@ from dask_helpers import ENV, cluster
 from harsh_start import harshly
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
-from twodisk_ros.sweep.run import SweepSpec, dask_client, run_sweep
+from twodisk_ros.sweep.run import SweepSpec, run_sweep
 from twodisk_ros.sweep.spec import block_shape
 
 # 6 x 8 = 48 bodies, both stable families, and Delta/a = 1 (masked) in the last column
@@ -43,8 +43,38 @@ def _argv(out, *more):
 
 @pytest.fixture(scope='module')
 def client():
-    with dask_client(workers=2) as c:
+    """A cluster of two worker threads of this process, its scheduler on 127.0.0.1 (TCP: the
+    commands a test starts connect to it); no worker processes to start (the LocalCluster
+    of worker processes, dask_client's default, is tested in tests/test_sweep.py)."""
+    import logging
+    from distributed import Client, LocalCluster
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                           protocol='tcp://', host='127.0.0.1', dashboard_address=None,
+                           silence_logs=logging.CRITICAL,
+                           scheduler_kwargs={'dashboard': False,
+                                             'dashboard_address': '127.0.0.1:0'})
+    c = Client(cluster, set_as_default=False)
+    try:
         yield c
+    finally:
+        c.close()
+        cluster.close()
+
+
+@pytest.fixture
+def shared(client, monkeypatch):
+    """The command line (cli.main, in this process) runs on the module's cluster instead of
+    starting a LocalCluster of its own: for tests about outputs and refusals, not about the
+    cluster's life (each LocalCluster costs seconds of CPU in its worker processes)."""
+    import contextlib
+    import twodisk_ros.sweep.run as run
+
+    @contextlib.contextmanager
+    def on_the_module_cluster(scheduler=None, workers=None, **kwargs):
+        assert scheduler is None
+        yield client
+
+    monkeypatch.setattr(run, 'dask_client', on_the_module_cluster)
 
 
 @pytest.fixture(scope='module')
@@ -180,10 +210,14 @@ class _Killed(BaseException):
 def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
     """A worker killed at any write of a block (the k-th of its chunk objects) leaves the
     block's flags at 0: the flags are the block's last write."""
+    import shutil
     import zarr
     from twodisk_ros.sweep import store as zstore
     spec = SweepSpec(np.array([1.0]), np.array([0.5]), chunk_size=1)
-    path = zstore.create_store(tmp_path / 'one.zarr', spec)
+    # the store as create_store lays it out, copied afresh for each write to kill at
+    pristine = zstore.create_store(tmp_path / 'pristine.zarr', spec)
+    path = tmp_path / 'one.zarr'
+    shutil.copytree(pristine, path)
     real = zarr.Array.__setitem__
     writes = []     # the arrays written by write_block, in order
     kill_at = None  # kill at this write (0: watch only; None: neither)
@@ -203,8 +237,8 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
     assert set(writes) == variables and writes[-1] == 'computed'
     for k in range(1, len(variables) + 1):
         kill_at = None
-        zstore.remove_store(path)
-        zstore.create_store(path, spec)
+        shutil.rmtree(path)
+        shutil.copytree(pristine, path)
         writes.clear()
         kill_at = k
         with pytest.raises(_Killed):
@@ -217,34 +251,21 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
 
 # -- interrupted and resumed -----------------------------------------------------------------
 
-#: The sweep's command line with a hook after the client's k-th finished chunk (argv[1]).
-#: SIGINT: the client signals itself (a real SIGINT through Python's handler, which the
+#: The sweep's command line with a hook after the client's k-th finished chunk (argv[2]):
+#: SIGINT, the client signals itself (a real SIGINT through Python's handler, which the
 #: script installs first: a suite started in the background or under nohup hands its
-#: children SIGINT ignored, and then Python installs none). KILL: the client kills the
-#: `dask worker` command (nanny and worker, its process group) of a worker that is busy, then
-#: goes on; only a group that the test's cluster started in a session of its own (the
-#: group's leader leads a session), never the client's own group.
+#: children SIGINT ignored, and then Python installs none).
 _HOOKED_CLI = """
-import os, signal, sys
+import signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
 import twodisk_ros.sweep.run as run
 real, action, after = run.run_sweep, sys.argv[1], int(sys.argv[2])
+assert action == 'SIGINT', action
 def hooked(spec, client, *args, **kwargs):
     def on_chunk(index, computed):
-        if computed != after:
-            return
-        if action == 'SIGINT':
+        if computed == after:
             signal.raise_signal(signal.SIGINT)
-            sys.exit('SIGINT raised nothing')          # never fall through to the kill
-        busy = [address for address, keys in client.processing().items() if keys]
-        if not busy:
-            sys.exit('no worker busy')
-        pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
-        group = os.getpgid(pid)
-        if group == os.getpgid(0) or os.getsid(group) != group:
-            sys.exit(f'worker {pid} is not in a session of its own: not killed')
-        os.killpg(group, signal.SIGKILL)
-        print(f'killed a busy worker after {computed} chunks', file=sys.stderr)
+            sys.exit('SIGINT raised nothing')
     return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
 run.run_sweep = hooked
 from twodisk_ros.sweep.cli import main
@@ -259,24 +280,30 @@ def _hooked(action, after, argv, timeout=180):
 
 
 @pytest.mark.slow
-def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(reference, tmp_path):
+def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, reference, shared,
+                                                                tmp_path, capsys):
+    # the interrupted command runs on the module's cluster (no LocalCluster of its own to
+    # start), then the rerun: the command line in this process, on the same cluster
     store = tmp_path / 'map.zarr'
-    argv = _argv(store, '--chunk-size', '1', '--workers', '1')
-    stopped = _hooked('SIGINT', 5, argv)
+    argv = _argv(store, '--chunk-size', '2')
+    blocks = len(SweepSpec(np.linspace(0.5, 1.5, 6), np.linspace(0.3, 1.0, 8),
+                           chunk_size=2).blocks())
+    assert blocks == TOTAL // 2
+    stopped = _hooked('SIGINT', 5, [*argv, '--scheduler', client.scheduler.address])
     assert stopped.returncode == 130, stopped.stderr
     assert stopped.stderr.strip().splitlines() == [
         f'twodisk-sweep: interrupted; finished chunks are kept in {store} - run the same '
         'command again to resume']
+    _wait_until_idle(client)    # a cancelled task still finishes on its worker
     flags = _flags(store)
-    finished = int(flags.sum())       # 5, or a few more finished by the worker meanwhile
-    assert 5 <= finished < TOTAL
+    finished = int(flags.sum()) // 2   # 5, or a few more finished by the workers meanwhile
+    assert 5 <= finished < blocks
     kept = {p: v for p, v in _tree(store).items() if '/computed/c/' in str(p)}
     assert len(kept) == finished
-    again = subprocess.run([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
-                           capture_output=True, text=True, timeout=180)
-    assert again.returncode == 0, again.stderr
-    assert (f'{TOTAL - finished} chunks computed, {finished} resumed'
-            in again.stderr.strip().splitlines()[-1])
+    capsys.readouterr()
+    assert main([*argv, '--quiet']) == 0
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f'{blocks - finished} chunks computed, {finished} resumed' in last, last
     tree = _tree(store)
     assert all(tree[p] == v for p, v in kept.items())     # the finished chunks untouched
     _same(read_sweep(store), reference)
@@ -284,16 +311,37 @@ def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(reference, tmp_p
 
 
 @pytest.mark.slow
-def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path):
+def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path, capsys, monkeypatch):
+    # the command line runs in this process; its hook kills one busy `dask worker` command
+    import signal
+    import twodisk_ros.sweep.run as run
     store = tmp_path / 'map.zarr'
+    real = run.run_sweep
+
+    def hooked(spec, client, *args, **kwargs):
+        def on_chunk(index, computed):
+            if computed != 3:
+                return
+            busy = [address for address, keys in client.processing().items() if keys]
+            assert busy, 'no worker busy'
+            pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
+            group = os.getpgid(pid)
+            # only a group that the test's cluster started in a session of its own
+            assert group != os.getpgid(0) and os.getsid(group) == group, pid
+            os.killpg(group, signal.SIGKILL)
+            print('killed a busy worker after 3 chunks', file=sys.stderr)
+        return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
+
+    monkeypatch.setattr(run, 'run_sweep', hooked)
     with cluster(tmp_path, workers=2) as (address, procs):
-        result = _hooked('KILL', 3, _argv(store, '--chunk-size', '1', '--scheduler', address))
+        status = main(_argv(store, '--chunk-size', '1', '--scheduler', address))
+        err = capsys.readouterr().err
         dead = [p for p in procs[1:] if p.poll() is not None]
-    assert result.returncode == 0, result.stderr
-    lines = result.stderr.strip().splitlines()
+    assert status == 0, err
+    lines = err.strip().splitlines()
     assert lines[0] == 'killed a busy worker after 3 chunks', lines
     assert len(dead) == 1 and dead[0].returncode == -9       # one `dask worker` is gone
-    assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in result.stderr
+    assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in err
     _same(read_sweep(store), reference)
     assert np.all(_flags(store) == 1)
 
@@ -311,7 +359,8 @@ def _fails_in_one_line(argv, capsys, *words):
 
 
 @pytest.mark.slow
-def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, tmp_path, capsys):
+def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, shared, tmp_path,
+                                                           capsys):
     store = tmp_path / 'map.zarr'
     argv = _argv(store, '--chunk-size', '5', '--workers', '1', '--quiet')
     assert main(argv) == 0
@@ -379,7 +428,7 @@ def test_bad_input_for_a_zarr_store_one_line_exit_2(override, words, tmp_path, c
 
 
 @pytest.mark.slow
-def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
+def test_a_grid_without_any_computable_body_leaves_no_store(shared, tmp_path, capsys):
     # Delta/a = 1e-300 passes the command line, but the body refuses a length below its range
     _fails_in_one_line(['--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300', '1e-300', '1',
                         '--out', str(tmp_path / 'x.zarr'), '--workers', '1', '--quiet'],
@@ -388,53 +437,53 @@ def test_a_grid_without_any_computable_body_leaves_no_store(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_unreachable_scheduler_creates_no_store(tmp_path):
+def test_unreachable_scheduler_creates_no_store(tmp_path, capsys):
+    # the command line in this process (tests/test_sweep.py runs it as a command)
     from dask_helpers import free_port
-    result = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.sweep', *_argv(tmp_path / 'x.zarr'),
-         '--scheduler', f'tcp://127.0.0.1:{free_port()}'],
-        env=ENV, capture_output=True, text=True, timeout=60)
-    assert result.returncode == 2, result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
-    assert 'cannot reach the Dask scheduler' in result.stderr
+    _fails_in_one_line([*_argv(tmp_path / 'x.zarr'), '--scheduler',
+                        f'tcp://127.0.0.1:{free_port()}'], capsys, 'cannot reach the Dask scheduler')
     assert list(tmp_path.iterdir()) == []
 
 
 # -- progress --------------------------------------------------------------------------------
 
-def _stderr_on_a_terminal(argv):
-    """(exit status, text) of the command with its stderr on a pseudo-terminal."""
+def _stderr_on_a_terminal(argv, monkeypatch):
+    """(exit status, text) of the command line (cli.main, in this process) with its stderr on
+    a pseudo-terminal of 100 columns (a reader thread empties the terminal meanwhile)."""
+    import threading
     leader, follower = pty.openpty()
     fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack('HHHH', 24, 100, 0, 0))
-    proc = subprocess.Popen([sys.executable, '-m', 'twodisk_ros.sweep', *argv], env=ENV,
-                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                            stderr=follower)
-    os.close(follower)
     chunks = []
-    try:
+
+    def read():
         while True:
             try:
                 data = os.read(leader, 65536)
-            except OSError:          # EIO: the command closed the terminal (it ended)
-                break
+            except OSError:          # EIO: the terminal's other side is closed
+                return
             if not data:
-                break
+                return
             chunks.append(data)
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    terminal = open(follower, 'w', encoding='utf-8')
+    try:
+        with monkeypatch.context() as patch:
+            patch.setattr(sys, 'stderr', terminal)
+            status = main(argv)
     finally:
+        terminal.close()
+        reader.join(timeout=60)
         os.close(leader)
-        try:
-            proc.wait(timeout=120)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait(timeout=10)
-    return proc.returncode, b''.join(chunks).decode('utf-8', 'replace')
+    assert not reader.is_alive()
+    return status, b''.join(chunks).decode('utf-8', 'replace')
 
 
 @pytest.mark.slow
-def test_progress_bar_on_a_terminal_only(tmp_path):
-    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'a.nc', '--chunk-size', '8',
-                                               '--workers', '1'))
+def test_progress_bar_on_a_terminal_only(shared, tmp_path, monkeypatch):
+    status, text = _stderr_on_a_terminal(_argv(tmp_path / 'a.nc', '--chunk-size', '8'),
+                                         monkeypatch)
     assert status == 0, text
     # tqdm's bar, ending at 100 % of the bodies, then the summary line
     assert '100%' in text and f'{TOTAL}/{TOTAL}' in text and 'body/s' in text, text
@@ -443,5 +492,5 @@ def test_progress_bar_on_a_terminal_only(tmp_path):
                            f'6 masked; 6 chunks computed, 0 resumed; '), last
     assert last.endswith(' bodies/s)'), last
     status, text = _stderr_on_a_terminal(_argv(tmp_path / 'b.nc', '--chunk-size', '8',
-                                               '--workers', '1', '--quiet'))
+                                               '--quiet'), monkeypatch)
     assert status == 0 and '%' not in text and len(text.strip().splitlines()) == 1, text

@@ -83,6 +83,21 @@ def _check_address(address):
                          'tcp://HOST:PORT, tls://HOST:PORT or HOST:PORT') from None
 
 
+def _probe(address, timeout):
+    """SweepError (one line) at once when nothing accepts a TCP connection at ``address``
+    (connection refused, unknown host): a Client retries a refused connection until its
+    ``timeout`` (s) is over, so the user waited ``timeout`` seconds for nothing."""
+    import socket
+    from distributed.comm.addressing import get_address_host_port
+    host, port = get_address_host_port(address)
+    try:
+        socket.create_connection((host, port), timeout=timeout).close()
+    except OSError as error:
+        reason = (f'no answer within {timeout:g} s' if isinstance(error, TimeoutError)
+                  else type(error).__name__)
+        raise SweepError(f'cannot reach the Dask scheduler at {address}: {reason}') from None
+
+
 @contextmanager
 def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
     """A ``distributed.Client``: to ``scheduler``, to Dask's configured address, or local.
@@ -111,6 +126,7 @@ def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
     try:
         if address:
             _check_address(address)
+            _probe(address, timeout)
             try:
                 client = Client(address, timeout=f'{timeout}s', set_as_default=False)
             except (OSError, TimeoutError, ValueError) as error:
