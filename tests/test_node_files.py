@@ -228,16 +228,13 @@ def test_a_signal_ends_a_long_start_up_at_once(tmp_path, sig, phase, count):
     for index in range(count):
         time.sleep(0.05 * index)
         process.send_signal(sig)
-    last = time.monotonic()
-    code, err = finish(process, timeout=5.0)
-    took = time.monotonic() - last
+    code, err = finish(process, timeout=5.0)   # a hang guard (measured 0.06-0.5 s)
     lines = err.strip().splitlines()
     assert code == 0 and 'Traceback' not in err, before + err
-    # measured 0.06-0.5 s; the bound leaves room for a loaded machine and still catches the
-    # old behaviour (the start-up ran to its end: seconds to minutes)
-    assert took < 3.0 + (3.0 if phase == 'during-imports' and count == 1 else 0), \
-        f'{took:.2f} s after the last signal'   # (one signal: the imports end first)
+    # bounded work: the start-up stopped where it was. Had it gone on to its end (the old
+    # behaviour), the node would have logged its start line and run, then its end line
     assert len(lines) == 1 and 'no recording written' in lines[0], before + err
+    assert 'rolling a=' not in err and 'published' not in err, before + err
     assert target.read_bytes() == OLD
     assert left_over(tmp_path, 'run.mcap') == []
 
