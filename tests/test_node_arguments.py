@@ -14,7 +14,6 @@ import difflib  # noqa: E402
 import math  # noqa: E402
 from pathlib import Path  # noqa: E402
 import resource  # noqa: E402
-import signal  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tracemalloc  # noqa: E402
@@ -25,6 +24,7 @@ import pytest  # noqa: E402
 import twodisk_ros  # noqa: E402
 from twodisk_ros.node.arguments import (ArgumentError, check_arguments, node_fqn,  # noqa: E402
                                         params_file_values, rclpy_type_hint)
+from roller_here import run_roller_main  # noqa: E402
 from twodisk_ros.node.params_yaml import (MAX_ENTRIES, load_params_file,  # noqa: E402
                                           node_matches, parse_value)
 
@@ -294,29 +294,16 @@ def hostile_runs(tmp_path_factory):
     return results
 
 
-def main_here(argv, capsys):
-    """(exit code, stderr) of the process's entry function in this process, its signal
-    handlers put back afterwards."""
-    from twodisk_ros.node.main import main
-    handlers = {sig: signal.getsignal(sig)
-                for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGXFSZ)}
-    capsys.readouterr()
-    try:
-        code = main(['roller', *argv])
-    finally:
-        for sig, handler in handlers.items():
-            signal.signal(sig, handler)
-    return code, capsys.readouterr().err
-
-
 @pytest.mark.parametrize('name', list(HOSTILE))
-def test_hostile_params_file_is_refused_in_one_line(hostile_runs, name, tmp_path, capsys):
+def test_hostile_params_file_is_refused_in_one_line(hostile_runs, name, tmp_path, monkeypatch,
+                                                    capfd):
     if name in HOSTILE_PROCESSES:
         code, err = hostile_runs[name]
     else:
         path = tmp_path / f'{name}.yaml'
         path.write_bytes(HOSTILE[name][0])
-        code, err = main_here(['--ros-args', '--params-file', str(path), *BATCH], capsys)
+        code, err = run_roller_main(['--params-file', path, *BATCH], monkeypatch, capfd,
+                                    domain=os.environ['ROS_DOMAIN_ID'])
     assert code == 2, (name, err[-3000:])
     assert HOSTILE[name][1] in one_line(err)
 

@@ -24,6 +24,8 @@ import pytest  # noqa: E402
 from twodisk_ros.inspect import inspect_recording  # noqa: E402
 from twodisk_ros.io import read_recording  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
+
 pytestmark = pytest.mark.ros
 
 REPO = Path(__file__).resolve().parents[1]
@@ -216,25 +218,8 @@ BAD_START_VALUES = [
     ('frame_id:=has space', 'frame_id'),
 ]
 #: Run as real processes: one refused by the argument check (before rclpy), one by the node
-#: (after rclpy.init); the others run the same entry function in this process.
+#: (after rclpy.init); the others run the same entry function in this process (domain 86).
 IN_A_PROCESS = ('rate:=50', 'theta0:=3.0')
-
-
-def run_main_here(argv, monkeypatch, capfd):
-    """(exit code, stderr) of the process's entry function called in this process: the
-    subprocess cases prove the process path; a refused start builds nothing, so this is the
-    same code. The signal handlers it sets are put back, its rclpy context is on domain 86."""
-    from twodisk_ros.node.main import main
-    monkeypatch.setenv('ROS_DOMAIN_ID', '86')
-    handlers = {sig: signal.getsignal(sig)
-                for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGXFSZ)}
-    capfd.readouterr()
-    try:
-        code = main(['roller', '--ros-args', *argv])
-    finally:
-        for sig, handler in handlers.items():
-            signal.signal(sig, handler)
-    return code, capfd.readouterr().err
 
 
 @pytest.mark.parametrize('argument, words', BAD_START_VALUES)
@@ -243,8 +228,8 @@ def test_bad_start_values_exit_2_with_one_line(argument, words, monkeypatch, cap
     if argument in IN_A_PROCESS:
         code, _, err = finish(roller(*params), timeout=60.0)
     else:
-        code, err = run_main_here(('--params-file', 'config/oloid.yaml', *params),
-                                  monkeypatch, capfd)
+        code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *params),
+                                    monkeypatch, capfd, domain=86, cwd=REPO)
     lines = err.strip().splitlines()
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err

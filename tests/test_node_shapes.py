@@ -10,7 +10,6 @@ import os
 
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 
-import signal  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -20,6 +19,8 @@ import pytest  # noqa: E402
 
 from twodisk_ros.physics.lamina import Egg, Superellipse  # noqa: E402
 from twodisk_ros.physics import lamina_body  # noqa: E402
+
+from roller_here import run_roller_main  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -87,7 +88,8 @@ def test_bad_shape_values_at_start_up_exit_2_in_one_line(tmp_path, params, says,
         result = roller(*args, cwd=tmp_path)
         code, err = result.returncode, result.stderr
     else:
-        code, err = main_here(args, tmp_path, monkeypatch, capfd)
+        code, err = run_roller_main(args, monkeypatch, capfd, domain=IN_PROCESS_DOMAIN,
+                                    cwd=tmp_path)
     lines = err.splitlines()
     assert code == 2, err
     assert len(lines) == 1 and 'Traceback' not in lines[0], err
@@ -97,23 +99,6 @@ def test_bad_shape_values_at_start_up_exit_2_in_one_line(tmp_path, params, says,
 #: Cases run as real processes: one refused by the argument check (before rclpy), one by the
 #: node (after rclpy.init); the others call the same entry function in this process.
 IN_A_PROCESS = ('exponent:=6', 'shape_file:=/dev/zero')
-
-
-def main_here(args, cwd, monkeypatch, capfd):
-    """(exit code, stderr) of the process's entry function run in this process, in ``cwd``
-    and on the in-process domain; the signal handlers it sets are put back."""
-    from twodisk_ros.node.main import main
-    monkeypatch.chdir(cwd)
-    monkeypatch.setenv('ROS_DOMAIN_ID', str(IN_PROCESS_DOMAIN))
-    handlers = {sig: signal.getsignal(sig)
-                for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGXFSZ)}
-    capfd.readouterr()
-    try:
-        code = main(['roller', '--ros-args', *args])
-    finally:
-        for sig, handler in handlers.items():
-            signal.signal(sig, handler)
-    return code, capfd.readouterr().err
 
 
 def test_a_shape_file_that_cannot_be_fitted_names_the_file(tmp_path):
