@@ -1,6 +1,8 @@
 """``roller``'s command line: help, arguments outside ``--ros-args``, declared types, hostile
-parameter files. The node's real entry point runs in subprocesses; the loader's typing is
-compared with rclpy's own parse (rcl_yaml_param_parser) in process.
+parameter files. The node's real entry point runs in subprocesses (refusals of most kinds:
+one or two as processes, the others through the same entry function in process,
+tests/roller_here.py); the loader's typing is compared with rclpy's own parse
+(rcl_yaml_param_parser) in process.
 
 Subprocess nodes use ROS_DOMAIN_ID from the environment (88 if unset), localhost only.
 """
@@ -66,6 +68,12 @@ def roller(*args, cwd=REPO, timeout=30.0, light=False):
     except subprocess.TimeoutExpired as error:
         pytest.fail(f'roller {" ".join(args)} still running after {timeout} s: {error.stderr}')
     return result.returncode, result.stdout, result.stderr
+
+
+def here(args, monkeypatch, capfd):
+    """(exit code, stderr) of ``roller --ros-args *args`` refused through the entry function
+    in this process (tests/roller_here.py), on this module's domain."""
+    return run_roller_main(args, monkeypatch, capfd, domain=os.environ['ROS_DOMAIN_ID'])
 
 
 def one_line(stderr):
@@ -147,25 +155,30 @@ def test_several_ros_args_sections_run(tmp_path):
                                      '[1.0, 2.0, 3.0], not [1, 2, 3]'),
     ('frame_id:=12', "frame_id is a string, got the integer 12: quote it to make it one: '12'"),
 ])
-def test_type_mismatch_hint_quotes_the_value_and_the_declared_type(argument, expected):
-    code, _, err = roller('--ros-args', '-p', argument, *BATCH, timeout=60.0)
+def test_type_mismatch_hint_quotes_the_value_and_the_declared_type(argument, expected,
+                                                                   monkeypatch, capfd):
+    """rate:=50 as a real process; the others through the entry function in this process."""
+    if argument == 'rate:=50':
+        code, _, err = roller('--ros-args', '-p', argument, *BATCH, timeout=60.0)
+    else:
+        code, err = here(['-p', argument, *BATCH], monkeypatch, capfd)
     assert code == 2
     assert expected in one_line(err)
 
 
-def test_type_mismatch_in_a_params_file_names_file_and_line(tmp_path):
+def test_type_mismatch_in_a_params_file_names_file_and_line(tmp_path, monkeypatch, capfd):
     params = tmp_path / 'p.yaml'
     params.write_text('/**:\n  ros__parameters:\n    a: 0.1\n    rate: 50\n')
-    code, _, err = roller('--ros-args', '--params-file', str(params), *BATCH, timeout=60.0)
+    code, err = here(['--params-file', str(params), *BATCH], monkeypatch, capfd)
     assert code == 2
     assert one_line(err) == (f'roller: --params-file {params}, line 4: rate is a double: write '
                              '50.0, not 50 (a double needs a decimal point)')
 
 
-def test_a_repeated_parameter_with_an_invalid_last_value_is_refused():
+def test_a_repeated_parameter_with_an_invalid_last_value_is_refused(monkeypatch, capfd):
     """rcl keeps 0.05 here and drops 'abc' silently (see test_rcl_keeps_a_value_of_another_type)."""
-    code, _, err = roller('--ros-args', '-p', 'duration:=0.05', '-p', 'duration:=abc',
-                             '-p', 'realtime:=false', timeout=60.0)
+    code, err = here(['-p', 'duration:=0.05', '-p', 'duration:=abc', '-p', 'realtime:=false'],
+                     monkeypatch, capfd)
     assert code == 2
     assert one_line(err) == "roller: -p duration:=abc: duration is a double, got the string 'abc'"
 
@@ -302,8 +315,7 @@ def test_hostile_params_file_is_refused_in_one_line(hostile_runs, name, tmp_path
     else:
         path = tmp_path / f'{name}.yaml'
         path.write_bytes(HOSTILE[name][0])
-        code, err = run_roller_main(['--params-file', path, *BATCH], monkeypatch, capfd,
-                                    domain=os.environ['ROS_DOMAIN_ID'])
+        code, err = here(['--params-file', path, *BATCH], monkeypatch, capfd)
     assert code == 2, (name, err[-3000:])
     assert HOSTILE[name][1] in one_line(err)
 
