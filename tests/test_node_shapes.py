@@ -170,29 +170,40 @@ def assert_consistent(checks, shape_words):
     (['-p', 'shape:=egg', '-p', 'arrangement:=swapped', '-p', 'delta:=0.03', '-p',
       'mode:=kinematic'], 'delta = 0.03 m, swapped'),
 ], ids=['superellipse', 'superellipse-custom', 'egg-solid', 'egg-swapped-kinematic'])
-def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words, capsys):
-    made = roller('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
-                  *params, cwd=tmp_path)
-    assert made.returncode == 0, made.stderr
+def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words, monkeypatch,
+                                                       capfd):
+    """The first body's node and inspector run as real processes; the other bodies' through
+    the same entry functions in this process (no interpreter start each)."""
+    first = params[1] == 'shape:=superellipse' and params[3] == 'exponent:=4.0'
+    args = ('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap', *params)
+    if first:
+        made = roller(*args, cwd=tmp_path)
+        code, err = made.returncode, made.stderr
+    else:
+        code, err = run_roller_main(args, monkeypatch, capfd, domain=IN_PROCESS_DOMAIN,
+                                    cwd=tmp_path)
+    assert code == 0, err
     assert_consistent(checks_of(tmp_path / 'run.mcap'), words)
-    # the command line, too: as a process for the first body, its entry function for the rest
-    if params[1] == 'shape:=superellipse' and params[3] == 'exponent:=4.0':
+    # the command line, too
+    if first:
         checked = inspect(tmp_path / 'run.mcap', tmp_path)
         code, out, err = checked.returncode, checked.stdout, checked.stderr
     else:
         from twodisk_ros.inspect.cli import main
-        capsys.readouterr()
+        capfd.readouterr()
         code = main([str(tmp_path / 'run.mcap')])
-        out, err = capsys.readouterr()
+        out, err = capfd.readouterr()
     assert code in (0, 1) and 'result: ' in out, err
 
 
 @needs_lamina_body
-def test_a_points_run_is_checked_without_its_shape_file(tmp_path):
+def test_a_points_run_is_checked_without_its_shape_file(tmp_path, monkeypatch, capfd):
+    """The node through its entry function in this process (the shape file relative to it)."""
     np.savetxt(tmp_path / 'egg.csv', egg_points(), delimiter=',', header='x,y', comments='')
-    made = roller('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
-                  '-p', 'shape:=points', '-p', 'shape_file:=egg.csv', '-p', 'delta:=0.04',
-                  '-p', 'method:=direct', cwd=tmp_path)
-    assert made.returncode == 0, made.stderr
+    code, err = run_roller_main(
+        ('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
+         '-p', 'shape:=points', '-p', 'shape_file:=egg.csv', '-p', 'delta:=0.04',
+         '-p', 'method:=direct'), monkeypatch, capfd, domain=IN_PROCESS_DOMAIN, cwd=tmp_path)
+    assert code == 0, err
     (tmp_path / 'egg.csv').unlink()
     assert_consistent(checks_of(tmp_path / 'run.mcap'), 'body outline of')
