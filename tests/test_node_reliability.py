@@ -159,7 +159,9 @@ def test_a_signal_every_few_milliseconds_until_the_process_ends(tmp_path, sig, d
         assert 'no recording written' in err, err
 
 
-def test_existing_record_file_is_refused_unless_overwrite(tmp_path):
+def test_existing_record_file_is_refused_unless_overwrite(tmp_path, monkeypatch, capfd):
+    """The refusal as a real process; the run that overwrites through the entry function in
+    this process."""
     target = tmp_path / 'kept.mcap'
     target.write_bytes(b'precious')
     code, _, err = finish(roller('-p', f'record:={target}', '-p', 'realtime:=false',
@@ -167,8 +169,10 @@ def test_existing_record_file_is_refused_unless_overwrite(tmp_path):
     assert code == 2 and len(err.strip().splitlines()) == 1, err
     assert 'exists' in err and 'overwrite:=true' in err
     assert target.read_bytes() == b'precious'
-    code, _, err = finish(roller('-p', f'record:={target}', '-p', 'realtime:=false',
-                                 '-p', 'duration:=0.1', '-p', 'overwrite:=true'))
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', f'record:={target}',
+                                 '-p', 'realtime:=false', '-p', 'duration:=0.1',
+                                 '-p', 'overwrite:=true'), monkeypatch, capfd, domain=86,
+                                cwd=REPO)
     assert code == 0, err
     assert_complete(target, err)
 
@@ -235,18 +239,26 @@ def test_bad_start_values_exit_2_with_one_line(argument, words, monkeypatch, cap
     assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err
 
 
-def test_unreadable_params_file_and_unknown_names(tmp_path):
+def test_unreadable_params_file_and_unknown_names(tmp_path, monkeypatch, capfd):
+    """The broken file as a real process; the missing one and the run with unknown names
+    through the entry function in this process."""
     broken = tmp_path / 'broken.yaml'
     broken.write_text('/**:\n  ros__parameters: [unclosed\n')
     for path in (broken, tmp_path / 'missing.yaml'):
-        process = subprocess.Popen(
-            [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
-             str(path)], cwd=REPO, env=node_env(), stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE, text=True)
-        code, _, err = finish(process)
+        if path is broken:
+            process = subprocess.Popen(
+                [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '--params-file',
+                 str(path)], cwd=REPO, env=node_env(), stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE, text=True)
+            code, _, err = finish(process)
+        else:
+            code, err = run_roller_main(('--params-file', path), monkeypatch, capfd,
+                                        domain=86, cwd=REPO)
         assert code == 2 and len(err.strip().splitlines()) == 1 and str(path) in err, err
-    code, _, err = finish(roller('-p', 'no_such_param:=1.0', '-p', 'omgea0:=2.0',
-                                 '-p', 'realtime:=false', '-p', 'duration:=0.1'))
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'no_such_param:=1.0',
+                                 '-p', 'omgea0:=2.0', '-p', 'realtime:=false',
+                                 '-p', 'duration:=0.1'), monkeypatch, capfd, domain=86,
+                                cwd=REPO)
     assert code == 0, err
     assert "unknown parameter 'no_such_param'" in err
     assert "unknown parameter 'omgea0' is ignored; did you mean 'omega0'?" in err
@@ -349,13 +361,14 @@ def test_direct_method_in_real_time_runs_past_its_integration_chunks(ros_context
     np.testing.assert_allclose(one_by_one[:, 1], u_dot, rtol=0, atol=1e-5 * abs(u_dot).max())
 
 
-def test_published_orientation_is_continuous_across_blocks(tmp_path):
+def test_published_orientation_is_continuous_across_blocks(tmp_path, monkeypatch, capfd):
     """Batch blocks are 2000 samples (node/roller.py BATCH_SAMPLES): 40 s at 100 Hz crosses
-    two block boundaries."""
+    two block boundaries. The node through its entry function in this process."""
     target = tmp_path / 'q.mcap'
-    code, _, err = finish(roller('-p', 'realtime:=false', '-p', 'rate:=100.0',
-                                 '-p', 'duration:=40.0', '-p', 'omega0:=8.0',
-                                 '-p', f'record:={target}'))
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'realtime:=false',
+                                 '-p', 'rate:=100.0', '-p', 'duration:=40.0',
+                                 '-p', 'omega0:=8.0', '-p', f'record:={target}'),
+                                monkeypatch, capfd, domain=86, cwd=REPO)
     assert code == 0, err
     recording = read_recording(target, decode=lambda topic: topic == '/pose')
     q = np.array([[m.msg.pose.orientation.x, m.msg.pose.orientation.y,
