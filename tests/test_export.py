@@ -22,6 +22,7 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
+from roller_here import record_with_roller_main  # noqa: E402
 from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 
 pytestmark = pytest.mark.ros
@@ -109,13 +110,12 @@ def decoded_table(path):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 100 Hz, with the contact forces."""
+    """A real recording: the node in batch mode, 2 s at 100 Hz, with the contact forces,
+    through its entry function in this process."""
     path = tmp_path_factory.mktemp('export') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'rate:=100.0', '-p', 'duration:=2.0', '-p', f'record:={path}'],
-        cwd=ROOT, capture_output=True, text=True, timeout=120, env=env())
-    assert made.returncode == 0, made.stderr[-2000:]
+    assert record_with_roller_main(('-p', 'realtime:=false', '-p', 'rate:=100.0',
+                                    '-p', 'duration:=2.0', '-p', f'record:={path}'),
+                                   domain=env()['ROS_DOMAIN_ID'], cwd=ROOT) == 0
     return path
 
 

@@ -28,6 +28,7 @@ from mcap.stream_reader import StreamReader  # noqa: E402
 import pytest  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
+from roller_here import record_with_roller_main  # noqa: E402
 from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 
 pytestmark = pytest.mark.ros
@@ -94,13 +95,12 @@ def independent_count(data):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make)."""
+    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make), through
+    its entry function in this process (the signal-stopped run below is a real process)."""
     path = tmp_path_factory.mktemp('verdicts') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', f'rate:={RATE}', '-p', f'duration:={DURATION}', '-p', f'record:={path}'],
-        cwd=ROOT, capture_output=True, text=True, timeout=120, env=env())
-    assert made.returncode == 0, made.stderr[-2000:]
+    assert record_with_roller_main(('-p', 'realtime:=false', '-p', f'rate:={RATE}',
+                                    '-p', f'duration:={DURATION}', '-p', f'record:={path}'),
+                                   domain=env()['ROS_DOMAIN_ID'], cwd=ROOT) == 0
     return path
 
 
