@@ -96,13 +96,28 @@ def _until_recording(process, target, timeout=30.0):
         time.sleep(0.002)
 
 
+def _until_handled(process, timeout=30.0):
+    """Return once the process catches SIGTERM (/proc/PID/status SigCgt): the entry point's
+    handlers are in, so a signal is the node's to handle. Before that the interpreter is
+    still starting (a SIGINT there interrupts Python's own site import, not our code)."""
+    deadline = time.monotonic() + timeout
+    while process.poll() is None:
+        with open(f'/proc/{process.pid}/status', encoding='ascii') as status:
+            caught = next(int(line.split()[1], 16) for line in status
+                          if line.startswith('SigCgt:'))
+        if caught & (1 << (signal.SIGTERM - 1)):
+            return
+        assert time.monotonic() < deadline, 'the node never installed its signal handlers'
+        time.sleep(0.002)
+
+
 @pytest.mark.parametrize('mode, pattern, seed', SIGNAL_CASES,
                          ids=[f'{m}-{p}-{s}' for m, p, s in SIGNAL_CASES])
 def test_signal_at_a_random_moment_leaves_a_complete_recording(tmp_path, mode, pattern, seed):
     """Start-up, mid-chunk, during close: exit 0, no traceback, a recording that passes.
 
-    Seed 0 a moment in the first second from the start (start-up, or for a fast start the
-    first samples); seeds 1 and 2 a moment after the recording got its name (mid-run): in
+    Seed 0 a moment in the first second after the entry point's signal handlers are in
+    (start-up, or for a fast start the first samples); seeds 1 and 2 a moment after the recording got its name (mid-run): in
     real time (200 Hz, running until stopped) within 0.5 s of it, in batch (15 s at 1 kHz,
     about a second of work) within 0.2 s of it, in a chunk, so the batch is signalled while
     it runs instead of mostly after its end. Waiting for the file instead of sleeping a
@@ -116,6 +131,7 @@ def test_signal_at_a_random_moment_leaves_a_complete_recording(tmp_path, mode, p
         _until_recording(process, target)
         delay = rng.uniform(0.0, 0.5 if mode == 'realtime' else 0.2)
     else:
+        _until_handled(process)
         delay = rng.uniform(0.0, 1.0)
     time.sleep(delay)
     try:
