@@ -28,6 +28,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from PIL import Image  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
+
 pytestmark = pytest.mark.ros
 
 REPO = Path(__file__).resolve().parents[1]
@@ -54,38 +56,57 @@ def _record(directory, name, *params):
 
 @pytest.fixture(scope='module')
 def recordings(tmp_path_factory):
-    """{name: path} of recordings made once per module (node runs are the slow part)."""
+    """path of a recording made once per module (node runs are the slow part); with
+    ``run=True`` (path, the finished process)."""
     directory = tmp_path_factory.mktemp('recordings')
     made = {}
 
-    def get(name, *params):
+    def get(name, *params, run=False):
         if name not in made:
-            out, run = _record(directory, name, *params)
-            assert run.returncode == 0, run.stderr
-            made[name] = out
-        return made[name]
+            out, process = _record(directory, name, *params)
+            assert process.returncode == 0, process.stderr
+            made[name] = out, process
+        return made[name] if run else made[name][0]
     return get
-
-
-@pytest.mark.parametrize('config', CONFIGS)
-def test_every_config_records_a_consistent_run(tmp_path, config):
-    from twodisk_ros.inspect import inspect_recording
-    out, made = _record(tmp_path, config, '--params-file', str(REPO / 'config' / f'{config}.yaml'),
-                        '-p', 'duration:=0.3')
-    assert made.returncode == 0, made.stderr
-    checks = {check.name: check for check in inspect_recording(out).checks}
-    failed = {name: check.detail for name, check in checks.items()
-              if not check.passed and name != 'rolling_validity'}
-    assert not failed, failed
-    node_says_invalid = 'outside the rolling model' in made.stdout + made.stderr
-    assert checks['rolling_validity'].passed is not node_says_invalid, \
-        (checks['rolling_validity'].detail, made.stderr[-400:])
 
 
 EGG_SOLID = ('--params-file', str(REPO / 'config' / 'egg.yaml'), '-p', 'mass_model:=solid',
              '-p', 'duration:=1.0')
 SQUARE = ('--params-file', str(REPO / 'config' / 'rounded_square.yaml'), '-p',
           'duration:=1.0')
+#: Configs whose run here is the 1 s module recording the drawing tests use, not its own.
+SHARED = {'rounded_square': SQUARE}
+
+
+#: The config whose run is a real process; the others run the same entry function in this
+#: process (tests/roller_here.py), without an interpreter start each.
+AS_A_PROCESS = 'oloid'
+
+
+@pytest.mark.parametrize('config', CONFIGS)
+def test_every_config_records_a_consistent_run(tmp_path, config, recordings, monkeypatch,
+                                               capfd):
+    from twodisk_ros.inspect import inspect_recording
+    params = ('--params-file', str(REPO / 'config' / f'{config}.yaml'), '-p', 'duration:=0.3')
+    if config in SHARED:
+        out, made = recordings(config, *SHARED[config], run=True)
+    elif config == AS_A_PROCESS:
+        out, made = _record(tmp_path, config, *params)
+    else:
+        out = tmp_path / f'{config}.mcap'
+        code, err = run_roller_main((*params, '-p', 'realtime:=false', '-p', f'record:={out}'),
+                                    monkeypatch, capfd, domain=DOMAIN, cwd=tmp_path)
+        made = subprocess.CompletedProcess([], code, '', err)
+    assert made.returncode == 0, made.stderr
+    checks = {check.name: check for check in inspect_recording(out).checks}
+    failed = {name: check.detail for name, check in checks.items()
+              if not check.passed and name != 'rolling_validity'}
+    assert not failed, failed
+    said = made.stdout + made.stderr
+    assert 'published ' in said, said          # the node's log is read (its end line)
+    node_says_invalid = 'outside the rolling model' in said
+    assert checks['rolling_validity'].passed is not node_says_invalid, \
+        (checks['rolling_validity'].detail, made.stderr[-400:])
 
 
 @pytest.mark.parametrize('name, params', [('rounded_square', SQUARE), ('egg_solid', EGG_SOLID)])

@@ -22,6 +22,7 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
+from roller_here import record_with_roller_main  # noqa: E402
 from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 
 pytestmark = pytest.mark.ros
@@ -51,6 +52,22 @@ def inspect(*args):
                             env=env(), timeout=120)
     assert 'Traceback' not in result.stderr, result.stderr
     return result.returncode, result.stdout, result.stderr
+
+
+@pytest.fixture
+def inspect_here(capsys):
+    """The entry point's function in this process: (exit status, stdout, stderr). A test
+    runs the real entry point (a subprocess) first; its further calls go through the same
+    function here, without another interpreter start."""
+    from twodisk_ros.inspect.cli import main
+
+    def run(*args):
+        capsys.readouterr()
+        status = main([str(arg) for arg in args])
+        out, err = capsys.readouterr()
+        assert 'Traceback' not in err, err
+        return status, out, err
+    return run
 
 
 def decoded_table(path):
@@ -93,13 +110,12 @@ def decoded_table(path):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 100 Hz, with the contact forces."""
+    """A real recording: the node in batch mode, 2 s at 100 Hz, with the contact forces,
+    through its entry function in this process."""
     path = tmp_path_factory.mktemp('export') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'rate:=100.0', '-p', 'duration:=2.0', '-p', f'record:={path}'],
-        cwd=ROOT, capture_output=True, text=True, timeout=120, env=env())
-    assert made.returncode == 0, made.stderr[-2000:]
+    assert record_with_roller_main(('-p', 'realtime:=false', '-p', 'rate:=100.0',
+                                    '-p', 'duration:=2.0', '-p', f'record:={path}'),
+                                   domain=env()['ROS_DOMAIN_ID'], cwd=ROOT) == 0
     return path
 
 
@@ -191,7 +207,7 @@ def test_cut_recording_exports_what_was_recovered(tmp_path, node_recording):
 @pytest.mark.parametrize('option, suffix', [('--csv', '.csv'), ('--npz', '.npz'),
                                             ('--plot', '.png')])
 def test_existing_output_is_refused_without_overwrite(tmp_path, node_recording, option,
-                                                      suffix):
+                                                      suffix, inspect_here):
     target = tmp_path / f'out{suffix}'
     target.write_bytes(b'precious\x00bytes')
     status, out, err = inspect(node_recording, option, target)
@@ -200,9 +216,9 @@ def test_existing_output_is_refused_without_overwrite(tmp_path, node_recording, 
     assert len(lines) == 1 and str(target) in lines[0] and '--overwrite' in lines[0], err
     assert target.read_bytes() == b'precious\x00bytes'
     # refused before the recording is read: the same line for a recording that is not there
-    status, _, err = inspect(tmp_path / 'missing.mcap', option, target)
+    status, _, err = inspect_here(tmp_path / 'missing.mcap', option, target)
     assert status == 2 and '--overwrite' in err and 'cannot read recording' not in err
-    status, out, err = inspect(node_recording, option, target, '--overwrite')
+    status, out, err = inspect_here(node_recording, option, target, '--overwrite')
     assert status == 0 and err == '', err
     assert target.read_bytes() != b'precious\x00bytes' and target.stat().st_size > 1000
     assert sorted(p.name for p in tmp_path.iterdir()) == [target.name]     # no temp files

@@ -28,6 +28,7 @@ from mcap.stream_reader import StreamReader  # noqa: E402
 import pytest  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
+from roller_here import record_with_roller_main  # noqa: E402
 from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 
 pytestmark = pytest.mark.ros
@@ -55,6 +56,22 @@ def inspect(path, *extra):
     return result.returncode, result.stdout, result.stderr
 
 
+@pytest.fixture
+def inspect_here(capsys):
+    """The entry point's function in this process: (exit status, stdout, stderr). Each test
+    runs the real entry point (a subprocess) first; its other readings of the same file go
+    through the same function here, without a second interpreter start."""
+    from twodisk_ros.inspect.cli import main
+
+    def run(path, *extra):
+        capsys.readouterr()
+        status = main([str(path), *extra])
+        out, err = capsys.readouterr()
+        assert 'Traceback' not in err, err
+        return status, out, err
+    return run
+
+
 def independent_count(data):
     """(samples, diagnostics) in MCAP bytes, read with mcap's StreamReader (not the package's
     reader): stamps carried by pose, both contacts and rolling_state, decoded by mcap_ros2;
@@ -78,24 +95,23 @@ def independent_count(data):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make)."""
+    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make), through
+    its entry function in this process (the signal-stopped run below is a real process)."""
     path = tmp_path_factory.mktemp('verdicts') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', f'rate:={RATE}', '-p', f'duration:={DURATION}', '-p', f'record:={path}'],
-        cwd=ROOT, capture_output=True, text=True, timeout=120, env=env())
-    assert made.returncode == 0, made.stderr[-2000:]
+    assert record_with_roller_main(('-p', 'realtime:=false', '-p', f'rate:={RATE}',
+                                    '-p', f'duration:={DURATION}', '-p', f'record:={path}'),
+                                   domain=env()['ROS_DOMAIN_ID'], cwd=ROOT) == 0
     return path
 
 
-def test_complete_recording_passes(node_recording):
+def test_complete_recording_passes(node_recording, inspect_here):
     assert EXPECTED == math.floor(DURATION * RATE) + 1
     status, out, err = inspect(node_recording)
     assert status == 0 and err == '', out
     assert 'result: PASS (all ' in out
     assert 'recovered 2 001 of 2 001 samples of the run (100.0 %), t = 0 … 2 s of 2 s' in out
     assert independent_count(node_recording.read_bytes()) == (EXPECTED, 3)
-    status, out, _ = inspect(node_recording, '--json')
+    status, out, _ = inspect_here(node_recording, '--json')
     document = json.loads(out)
     assert status == 0 and document['verdict'] == 'PASS' and document['exit_status'] == 0
     run = document['summary']['run']
@@ -106,7 +122,7 @@ def test_complete_recording_passes(node_recording):
 
 @pytest.mark.parametrize('fraction', [1 / 3, 2 / 3])
 def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_recording,
-                                                                fraction):
+                                                                fraction, inspect_here):
     data = node_recording.read_bytes()
     cut = tmp_path / 'cut.mcap'
     cut.write_bytes(data[:int(fraction * len(data))])
@@ -126,7 +142,7 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     assert phrase in result[0] and 'the file is cut' in result[0]
     assert 'PASS (' not in out and 'FAIL' not in out
     assert '0 of 3 diagnostics' in ' '.join(out.split())      # (the run: line may wrap)
-    status, out, _ = inspect(cut, '--json')
+    status, out, _ = inspect_here(cut, '--json')
     document = json.loads(out)
     assert status == 4
     assert document['verdict'] == 'INCOMPLETE' and document['exit_status'] == 4
@@ -142,7 +158,7 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     assert document['summary']['recovered']['total_bytes'] == len(cut.read_bytes())
 
 
-def test_signal_stopped_node_recording_passes(tmp_path):
+def test_signal_stopped_node_recording_passes(tmp_path, inspect_here):
     """SIGTERM during a long batch run: the node closes the file; fewer samples, still PASS."""
     path = tmp_path / 'stopped.mcap'
     process = subprocess.Popen(
@@ -171,7 +187,7 @@ def test_signal_stopped_node_recording_passes(tmp_path):
     run = document['summary']['run']
     assert run['stopped_early'] and run['complete'] and run['file_complete']
     assert run['recovered_samples'] == samples and run['expected_samples'] == expected
-    status, out, _ = inspect(path)
+    status, out, _ = inspect_here(path)
     assert status == 0 and 'result: PASS (all ' in out
     assert 'stopped early, the file is complete' in ' '.join(out.split())
 
@@ -198,19 +214,19 @@ def test_recorder_closed_early_is_a_pass(tmp_path, short_run):
     assert run['stopped_early'] and run['last_s'] == pytest.approx(0.59)
 
 
-def test_samples_missing_inside_a_closed_file_are_not_a_pass(tmp_path, short_run):
+def test_samples_missing_inside_a_closed_file_are_not_a_pass(tmp_path, short_run, inspect_here):
     path = write_run(tmp_path / 'gap.mcap', short_run, SHORT, skip={50})
     status, out, _ = inspect(path, '--json')
     document = json.loads(out)
     assert status == 1 and document['verdict'] == 'FAIL'   # the timestamps check sees the gap
     run = document['summary']['run']
     assert not run['complete'] and run['missing_inside'] == 1 and not run['stopped_early']
-    status, out, _ = inspect(path)
+    status, out, _ = inspect_here(path)
     assert 'the run is also INCOMPLETE: 1 samples missing inside the run' in out
 
 
 @pytest.mark.parametrize('cut', [False, True])
-def test_run_until_stopped_has_no_expected_count(tmp_path, short_run, cut):
+def test_run_until_stopped_has_no_expected_count(tmp_path, short_run, cut, inspect_here):
     """duration 0 (realtime until stopped): only the completeness of the file counts."""
     params = dict(SHORT, duration='0.0', realtime='True')
     path = write_run(tmp_path / 'open.mcap', short_run, params, chunk_size=4096)
@@ -223,7 +239,7 @@ def test_run_until_stopped_has_no_expected_count(tmp_path, short_run, cut):
     assert run['expected_samples'] is None and run['share'] is None
     assert (status, document['verdict']) == ((4, 'INCOMPLETE') if cut else (0, 'PASS'))
     assert 0 < run['recovered_samples'] <= 101
-    status, out, _ = inspect(path)
+    status, out, _ = inspect_here(path)
     assert 'no count is expected' in ' '.join(out.split())
 
 

@@ -32,6 +32,7 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 from tf2_msgs.msg import TFMessage  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
 from rounding import ulps  # noqa: E402
 
 # yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
@@ -306,6 +307,11 @@ def test_changes_resend_what_they_alter_and_nothing_else(client):
 
 # -- bad input -------------------------------------------------------------------------------
 
+#: Real processes: body_frame:=12 is refused by the argument check (before rclpy),
+#: use_sim_time:=true by the node (after rclpy.init).
+FRAMES_IN_A_PROCESS = ('body_frame:=12', 'use_sim_time:=true')
+
+
 @pytest.mark.parametrize('arguments, words', [
     (["body_frame:=''"], 'body_frame must be a non-empty frame name'),
     (["body_frame:='two words'"], 'without spaces'),
@@ -318,10 +324,16 @@ def test_changes_resend_what_they_alter_and_nothing_else(client):
     (['frame_id:=/world'], 'frame_id must be a non-empty frame name'),
 ], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time',
         'frame_id-slash'])
-def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words):
+def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words, monkeypatch, capfd):
+    """Two cases as real processes (one refused before rclpy, one by the node); the others
+    through the same entry function in this process (tests/roller_here.py)."""
     params = [arg for argument in arguments for arg in ('-p', argument)]
-    code, err = stop(start_roller('-p', 'realtime:=false', '-p', 'duration:=0.1', *params),
-                     sig=None, timeout=STARTED)
+    args = ('-p', 'realtime:=false', '-p', 'duration:=0.1', *params)
+    if arguments[-1] in FRAMES_IN_A_PROCESS:
+        code, err = stop(start_roller(*args), sig=None, timeout=STARTED)
+    else:
+        code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *args),
+                                    monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
     lines = err.strip().splitlines()
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err

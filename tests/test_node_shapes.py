@@ -20,6 +20,8 @@ import pytest  # noqa: E402
 from twodisk_ros.physics.lamina import Egg, Superellipse  # noqa: E402
 from twodisk_ros.physics import lamina_body  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
+
 pytestmark = pytest.mark.ros
 
 REPO = Path(__file__).resolve().parents[1]
@@ -79,12 +81,24 @@ def egg_points(count=120):
     (['-p', 'arrangement:=crossed'], 'arrangement'),
     (['-p', 'shape:=superellipse', '-p', 'exponent:=6'], 'exponent is a double: write 6.0'),
 ])
-def test_bad_shape_values_at_start_up_exit_2_in_one_line(tmp_path, params, says):
-    result = roller('-p', 'realtime:=false', '-p', 'duration:=0.1', *params, cwd=tmp_path)
-    lines = result.stderr.splitlines()
-    assert result.returncode == 2, result.stderr
-    assert len(lines) == 1 and 'Traceback' not in lines[0], result.stderr
+def test_bad_shape_values_at_start_up_exit_2_in_one_line(tmp_path, params, says, monkeypatch,
+                                                       capfd):
+    args = ('-p', 'realtime:=false', '-p', 'duration:=0.1', *params)
+    if params[-1] in IN_A_PROCESS:
+        result = roller(*args, cwd=tmp_path)
+        code, err = result.returncode, result.stderr
+    else:
+        code, err = run_roller_main(args, monkeypatch, capfd, domain=IN_PROCESS_DOMAIN,
+                                    cwd=tmp_path)
+    lines = err.splitlines()
+    assert code == 2, err
+    assert len(lines) == 1 and 'Traceback' not in lines[0], err
     assert says in lines[0], lines[0]
+
+
+#: Cases run as real processes: one refused by the argument check (before rclpy), one by the
+#: node (after rclpy.init); the others call the same entry function in this process.
+IN_A_PROCESS = ('exponent:=6', 'shape_file:=/dev/zero')
 
 
 def test_a_shape_file_that_cannot_be_fitted_names_the_file(tmp_path):
@@ -156,21 +170,40 @@ def assert_consistent(checks, shape_words):
     (['-p', 'shape:=egg', '-p', 'arrangement:=swapped', '-p', 'delta:=0.03', '-p',
       'mode:=kinematic'], 'delta = 0.03 m, swapped'),
 ], ids=['superellipse', 'superellipse-custom', 'egg-solid', 'egg-swapped-kinematic'])
-def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words):
-    made = roller('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
-                  *params, cwd=tmp_path)
-    assert made.returncode == 0, made.stderr
+def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words, monkeypatch,
+                                                       capfd):
+    """The first body's node and inspector run as real processes; the other bodies' through
+    the same entry functions in this process (no interpreter start each)."""
+    first = params[1] == 'shape:=superellipse' and params[3] == 'exponent:=4.0'
+    args = ('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap', *params)
+    if first:
+        made = roller(*args, cwd=tmp_path)
+        code, err = made.returncode, made.stderr
+    else:
+        code, err = run_roller_main(args, monkeypatch, capfd, domain=IN_PROCESS_DOMAIN,
+                                    cwd=tmp_path)
+    assert code == 0, err
     assert_consistent(checks_of(tmp_path / 'run.mcap'), words)
-    checked = inspect(tmp_path / 'run.mcap', tmp_path)      # the command line, too
-    assert checked.returncode in (0, 1) and 'result: ' in checked.stdout, checked.stderr
+    # the command line, too
+    if first:
+        checked = inspect(tmp_path / 'run.mcap', tmp_path)
+        code, out, err = checked.returncode, checked.stdout, checked.stderr
+    else:
+        from twodisk_ros.inspect.cli import main
+        capfd.readouterr()
+        code = main([str(tmp_path / 'run.mcap')])
+        out, err = capfd.readouterr()
+    assert code in (0, 1) and 'result: ' in out, err
 
 
 @needs_lamina_body
-def test_a_points_run_is_checked_without_its_shape_file(tmp_path):
+def test_a_points_run_is_checked_without_its_shape_file(tmp_path, monkeypatch, capfd):
+    """The node through its entry function in this process (the shape file relative to it)."""
     np.savetxt(tmp_path / 'egg.csv', egg_points(), delimiter=',', header='x,y', comments='')
-    made = roller('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
-                  '-p', 'shape:=points', '-p', 'shape_file:=egg.csv', '-p', 'delta:=0.04',
-                  '-p', 'method:=direct', cwd=tmp_path)
-    assert made.returncode == 0, made.stderr
+    code, err = run_roller_main(
+        ('-p', 'realtime:=false', '-p', 'duration:=0.3', '-p', 'record:=run.mcap',
+         '-p', 'shape:=points', '-p', 'shape_file:=egg.csv', '-p', 'delta:=0.04',
+         '-p', 'method:=direct'), monkeypatch, capfd, domain=IN_PROCESS_DOMAIN, cwd=tmp_path)
+    assert code == 0, err
     (tmp_path / 'egg.csv').unlink()
     assert_consistent(checks_of(tmp_path / 'run.mcap'), 'body outline of')

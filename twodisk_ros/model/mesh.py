@@ -41,7 +41,6 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.mass_models import MODELS
@@ -217,6 +216,7 @@ def _prism(rim, half, frame):
 
 def hull_mesh(body, resolution=DEFAULT_RESOLUTION):
     """The convex hull of the two rims (see the module docstring), body frame (m)."""
+    from scipy.spatial import ConvexHull
     n = _resolution(resolution)
     if not isinstance(body, TwoDiskBody):
         return Mesh(*ruled_hull(body, n))

@@ -12,7 +12,6 @@ from functools import partial
 import math
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .cycle import TWO_PI
 from .contact_forces import QUANTITIES, squeeze_split
@@ -107,6 +106,7 @@ def liftoff_speed(model):
     contact : str
         'A' or 'B' ('' if never).
     """
+    from scipy.optimize import minimize_scalar
     u = model.terms.u                               # the phases of the table's nodes
     cols = model.coefficients(u)
     best = (math.inf, math.nan, '')

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .analytic import COMPLEX_STEP, complex_step_jet, sinc
 from .orientation import contact_quaternion_samples
@@ -481,6 +480,7 @@ def integrate_contact_trace(body, u_end, rtol=1e-13, atol=None, u_eval=None):
     own error reaches 2e-8 of the size for some shapes, hence the tighter defaults.
     Returns scipy's OdeResult with ``y = (α, X_A, Y_A)`` and dense output ``sol``.
     """
+    from scipy.integrate import solve_ivp
     if atol is None:
         atol = 1e-16 * body.size
     def rates(u, y):

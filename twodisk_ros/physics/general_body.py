@@ -41,7 +41,6 @@ turning points: there the tilt chart is the regular one.
 from dataclasses import dataclass
 import math
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .lamina import Lamina, check_length
 
@@ -311,6 +310,7 @@ class GeneralTwoDiskBody:
     @property
     def steepest(self):
         """(s, |τ|) where |τ| is largest on the family (the tilt chart's far end)."""
+        from scipy.optimize import minimize_scalar
         cached = self.__dict__.get('_steepest')
         if cached is None:
             def elevation(s):
@@ -407,6 +407,7 @@ class GeneralTwoDiskBody:
 
     def size_about(self, g):
         """Largest distance (m) of a disk point from the point g e2 (g in m, from O)."""
+        from scipy.optimize import minimize_scalar
         best = 0.0
         # disk 1: |(x, y − Δ − g)|; disk 2: |(x, σy + Δ − g)| = |(x, y + σ(Δ − g))|
         for offset in (-self.delta - g, self.sigma * (self.delta - g)):

@@ -30,7 +30,6 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 __all__ = ['AreaMoments', 'Egg', 'Ellipse', 'Lamina', 'LENGTH_RANGE', 'SUPERELLIPSE_EXPONENT',
            'Superellipse', 'Support', 'SupportLamina', 'VERTEX_AXES', 'Vertex', 'check_length']
@@ -193,6 +192,7 @@ class Lamina(abc.ABC):
     @property
     def size(self):
         """Largest distance of a boundary point from the origin (m) = max of h over n."""
+        from scipy.optimize import minimize_scalar
         cached = self.__dict__.get('_size')
         if cached is None:
             grid = np.linspace(0.0, np.pi, 2049)
@@ -462,6 +462,7 @@ class Egg(SupportLamina):
     @staticmethod
     def epsilon_max(a, b):
         """Largest |ε| (m) keeping h + h″ > 0: min over cos 3φ > 0 of (a²b²/h_E³)/(8 cos 3φ)."""
+        from scipy.optimize import minimize_scalar
         def ratio(phi):
             he = math.hypot(a * math.cos(phi), b * math.sin(phi))
             return a * a * b * b / he**3 / (8 * math.cos(3 * phi))

@@ -31,7 +31,6 @@ import math
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from .lamina import SupportLamina, normal_of_angle
 
@@ -212,6 +211,7 @@ def _hull_distance(hull, q):
 
 
 def _check_shape(p, tol):
+    from scipy.spatial import ConvexHull, QhullError
     try:
         hull = ConvexHull(p)
     except QhullError:

@@ -32,7 +32,6 @@ turning points where ψ(θ) ~ √(θ_max − θ) is not).
 import math
 
 import numpy as np
-from scipy.optimize import elementwise
 
 from .phase_map import phase_map
 
@@ -107,6 +106,7 @@ class PhaseSolver:
 
     def solve(self, u):
         """(s_A, |τ|) at phases u ∈ [0, π/2] (rad, 1-D array), to the last bits."""
+        from scipy.optimize import elementwise
         u = np.asarray(u, dtype=float)
         s_a = np.empty_like(u)
         tau = np.empty_like(u)

@@ -28,7 +28,6 @@ from functools import partial
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .cycle import TWO_PI
 from .dynamics import RollingDynamics
@@ -506,6 +505,7 @@ def _flat_closed_form(dynamics, u0, u_dot0, method):
 
 def _solve(rhs, t_end, y0, tolerance, scale, rate=None, centre=None):
     """DOP853 over [0, t_end] (s): (OdeSolution, right-hand-side evaluations)."""
+    from scipy.integrate import solve_ivp
     t_end = float(t_end)
     if t_end == 0.0:
         return OdeSolution(None, y0, t_end, rate, centre), 0

@@ -19,7 +19,6 @@ and (docs/physics.md#bodies-that-stop-turning-in-u):
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .solvers import QuadratureSolution, RestSolution, SundmanSolution
 
@@ -82,6 +81,7 @@ def general_closed_form(dynamics, mode, method, u0, w0, regular_forms):
 
 def sundman(dynamics, mode, method, t_end, u0, w0, tolerance):
     """DOP853 in the regularised time τ over t ∈ [0, t_end] (s): (SundmanSolution, nfev)."""
+    from scipy.integrate import solve_ivp
     if method == 'table':
         def terms(u):
             f = dynamics.tabulated(u)

@@ -16,7 +16,6 @@ too, and q(0) = q_c(0) has w > 0.
 """
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .analytic import complex_step_jet
 from .spectral import spectral_derivative
@@ -70,6 +69,7 @@ def contact_quaternion_samples(t1, normal):
     q′ = ½ (W, 0) ⊗ q and q″ = ½ ((W′, 0) ⊗ q + (W, 0) ⊗ q′); W is periodic, so W′ is its
     spectral derivative.
     """
+    from scipy.spatial.transform import Rotation
     (t1, dt1), (n, dn) = complex_step_jet((t1, normal))
     m = np.cross(n, t1)
     dm = np.cross(dn, t1) + np.cross(n, dt1)

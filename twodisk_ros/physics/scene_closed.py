@@ -28,7 +28,6 @@ DOP853 (:class:`~twodisk_ros.physics.scene_motion.SceneStream`).
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .cycle import TWO_PI
 from .scene_terms import STOPPED
@@ -257,6 +256,7 @@ class OscillationSolution(PhaseSolution):
 def _turning_point(terms, energy, u, side):
     """The first u′ beyond u on ``side`` with V(u′) = E, bracketed between the extremum
     before the first maximum above E and that maximum; None within ``SEARCH`` cycles."""
+    from scipy.optimize import brentq
     maxima, minima = _extrema(terms)
     if not maxima:
         return None

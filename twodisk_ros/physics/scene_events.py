@@ -8,7 +8,6 @@ instant by Brent's method (docs/physics.md#scenes). Re-exported by scene_motion.
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .contact_validity import ValidityReport, check_validity
 
@@ -26,6 +25,7 @@ def settle(terms, u0, u_dot0, *, t_max=600.0, rest_energy=1e-9, step=1.0, tolera
     s and located by Brent's method on the dense output (to 1e-9 s).
     (nan, nan, None) if not at rest by ``t_max`` s (e.g. it rolls down the slope).
     """
+    from scipy.optimize import brentq
     stable = [eq for eq in terms.equilibria() if eq.stable]
     from .scene_motion import SceneStream
     stream = SceneStream(terms, u0, u_dot0, tolerance=tolerance, chunk=10 * step)
@@ -84,6 +84,7 @@ def first_failure(terms, samples, stream=None, *, resolution=0.01):
     first sign change of N_A, N_B or μ − μ_required is located by Brent's method (to
     1e-12 s); ``index`` is then the first sample after it.
     """
+    from scipy.optimize import brentq
     friction = terms.scene.friction
     forces = _forces(terms, samples)
     report = check_validity(samples.t, forces, friction)

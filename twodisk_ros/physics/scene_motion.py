@@ -46,7 +46,6 @@ conservative scene on a slope has the closed forms of
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .motion import MotionStream
 from .scene_closed import DriftQuadrature, conservative_solution
@@ -213,6 +212,7 @@ class SceneStream:
 
     def _advance(self, t0, t1, y0):
         """Pieces covering [t0, t1] from state y0 (stops split them)."""
+        from scipy.integrate import solve_ivp
         pieces = []
         y0 = list(y0) + [t0]
         while t0 < t1:

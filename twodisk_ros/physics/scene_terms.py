@@ -26,7 +26,6 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .contact_forces import ContactForceModel, squeeze_split
 from .contact_terms import ForceTerms
@@ -345,6 +344,7 @@ class SceneTerms:
     def _find_equilibria(self):
         # roots of dV/dγ, not of V′ = |ω_u| dV/dγ: where the body stops turning in u V′ = 0
         # but, on a slope, the body is not at rest there
+        from scipy.optimize import brentq
         n = self._table.last_index + 1
         u = TWO_PI * np.arange(n + 1) / n
         slope = self.potential_turn_slope(u)

@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .equilibria import NEUTRAL, STABLE, UNSTABLE
 from .general_body import GeneralTwoDiskBody
@@ -87,6 +86,7 @@ def _tangent_from_axis(lamina, y):
 
     Its outward normal n(φ) = (sin φ, −cos φ) solves h(n) = n·(0, y): one root on each side.
     """
+    from scipy.optimize import brentq
     def gap(phi):
         n = normal_of_angle(phi)
         return float(lamina.support(n).height) - float(n[1]) * y
