@@ -63,10 +63,17 @@ SMOOTH_IDS = [f'{lam!r}-{d}-{arr}' for lam, d, arr in SMOOTH]
 
 # -- the numerical references ----------------------------------------------------------------
 def _chart(body, eq):
-    """Pose function of a chart coordinate x, x at the equilibrium, and the chart's range."""
+    """Pose function of a chart coordinate x, x at the equilibrium, and the chart's range.
+
+    Away from the turning points the coordinate is A's lamina parameter s (the poses of
+    geometry(θ) at θ(s), without its bisection of θ back to s); x* = s(θ*)."""
     if eq.name == 'turning point':
         return body.geometry_at_tilt, math.pi / 2, body.tilt_range
-    return body.geometry, eq.theta, (-body.theta_max, body.theta_max)
+
+    def pose(s):
+        s = np.asarray(s, dtype=float)
+        return body.geometry_at_parameter(s, body.elevation_of_parameter(s))
+    return pose, float(body.parameter_of_theta(eq.theta)), (-body.s_max, body.s_max)
 
 
 def _rolling_samples(chart, centre, h, span):
