@@ -128,13 +128,17 @@ def _flat_heights(body, eq, levels=(1e-3, 1e-4)):
     k, sides = (0, (1,)) if eq.name == 'theta=0' else (1, (1, -1))
     z0 = float(body.geometry(eq.theta).height)
     c0 = float(body.geometry(eq.theta).ground_normal[k])
+
+    def pose(s):        # the pose of geometry(θ(s)) in A's lamina parameter s (no θ bisection)
+        return body.geometry_at_parameter(s, body.elevation_of_parameter(s))
+    s_star = float(body.parameter_of_theta(eq.theta))
     out = []
     for p in levels:
         for side in sides:
-            end = side * body.theta_max * (1 - 1e-12)
-            t = brentq(lambda x: abs(float(body.geometry(x).ground_normal[k]) - c0) - p,
-                       *sorted((eq.theta, end)), xtol=1e-300, rtol=EPS, maxiter=500)
-            g = body.geometry(t)
+            end = side * body.s_max * (1 - 1e-12)
+            s = brentq(lambda x: abs(float(pose(x).ground_normal[k]) - c0) - p,
+                       *sorted((s_star, end)), xtol=1e-300, rtol=EPS, maxiter=500)
+            g = pose(s)
             out.append((float(g.ground_normal[k]) - c0, float(g.height) - z0))
     return out
 
