@@ -122,18 +122,18 @@ def ruling_ends(lamina, delta, arrangement, n):
     dual = GeneralTwoDiskBody(mirrored, delta, arrangement)
     side = float(lamina.support(np.array([1.0, 0.0])).parameter)
     cut = 0.5 * (side + body.s_max)
-    p = lamina.point(np.linspace(-cut, cut, n + 1))
-    theta = np.arctan2(p[:, 0], -p[:, 1])
+    s = np.linspace(-cut, cut, n + 1)
+    tau = body.elevation_of_parameter(s)      # from the parameters: no θ -> s bisection
     points = []
     for branch in (1, -1):
-        pose = body.geometry(theta, branch)
+        pose = body.geometry_at_parameter(s, tau, branch)
         points += [pose.contact_a + body.centroid, pose.contact_b + body.centroid]
-    end = lamina.point(cut)
     for sign in (1, -1):
-        b = body.geometry(sign * math.atan2(end[0], -end[1]), 1).contact_b + body.centroid
+        b = body.geometry_at_parameter(sign * cut, body.elevation_of_parameter(sign * cut),
+                                       1).contact_b + body.centroid
         limit = float(dual.parameter_of_theta(abs(math.atan2(b[2], b[1] - delta))))
-        p = dual.lamina.point(np.linspace(-limit, limit, n // 2 + 1))
-        pose = dual.geometry(np.arctan2(p[:, 0], -p[:, 1]), -sign)
+        s = np.linspace(-limit, limit, n // 2 + 1)
+        pose = dual.geometry_at_parameter(s, dual.elevation_of_parameter(s), -sign)
         points += [(pose.contact_a + dual.centroid) @ SWAP,
                    (pose.contact_b + dual.centroid) @ SWAP]
     return np.vstack(points)

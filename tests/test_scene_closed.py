@@ -113,8 +113,11 @@ def test_a_body_climbing_the_slope_falls_back_by_dop853():
     assert conservative_solution(terms, u0, u_dot0) is None
     stream = scene_stream(dynamics, terms.scene, u0, u_dot0, terms=terms)
     assert isinstance(stream, SceneStream)
-    u_dot = stream.samples(np.linspace(0.0, 20.0, 401)).phase_rate
-    assert u_dot[0] > 0 and u_dot[-1] < 0                 # it turned back downhill
+    # it turns back at 1.45 s (measured); 4 s show it, and that it keeps rolling downhill
+    # (20 s cost 37 000 right-hand sides for the same claim)
+    u_dot = stream.samples(np.linspace(0.0, 4.0, 81)).phase_rate
+    turn = int(np.argmax(u_dot < 0))
+    assert u_dot[0] > 0 and turn > 0 and np.all(u_dot[turn:] < 0)   # it turned back downhill
 
 
 # ---------------------------------------------------------------------- failure, rest
@@ -134,7 +137,8 @@ def test_first_failure_instant_does_not_depend_on_sampling_or_method(scene):
                 stream = scene_stream(dynamics, scene, u0, u_dot0, terms=terms)
                 if not isinstance(stream, ClosedSceneStream):
                     continue
-            samples = stream.samples(np.arange(0.0, 3.0, step))
+            # the failures come at 0.36 s to 0.92 s (measured): 1.5 s of samples hold them
+            samples = stream.samples(np.arange(0.0, 1.5, step))
             report = first_failure(terms, samples, stream)
             assert not report.valid
             found.append((report.time, report.kind))

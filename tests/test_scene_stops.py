@@ -59,13 +59,20 @@ def dynamics_of(name):
     return _DYNAMICS[name]
 
 
+#: the grid (s) on which stop_times looks for the stops: each instant found is the first grid
+#: time past the stop, so the stop lies within STOP_STEP before it (run() widens its gap by
+#: this much; each time on the grid costs a Newton inversion of the stream's t(τ))
+STOP_STEP = 1e-3
+
+
 def stop_times(terms, stream, t_start, t_end):
-    """Instants (s) at which u crosses a phase where |ω_u| = 0 (from a 0.1 ms grid)."""
+    """Instants (s) at which u crosses a phase where |ω_u| = 0: the first time past each
+    crossing on a grid of STOP_STEP."""
     n = terms.table_nodes
     nodes = 2 * math.pi * np.arange(n) / n
     stops = nodes[terms.rows(nodes)[:, W] < 1e-6 * terms.turn_scale]
-    grid = np.linspace(t_start, t_end, int((t_end - t_start) * 1e4) + 1)
-    u = stream.samples_at(grid).phase
+    grid = np.linspace(t_start, t_end, int(math.ceil((t_end - t_start) / STOP_STEP)) + 1)
+    u = stream.state(grid)[0]
     found = [grid[1:][np.diff(np.floor((u - s) / (2 * math.pi))) != 0] for s in stops]
     return np.sort(np.concatenate(found)) if found else np.zeros(0)
 
@@ -80,7 +87,10 @@ def run(name, scene, duration, w0=3.0, u0=0.3, count=40):
     stream.samples(times)                        # integrate, then read the window
     stops = stop_times(terms, stream, times[0], times[-1])
     if stops.size:
-        centres = centres[np.min(np.abs(centres[:, None] - stops), axis=1) >= STOP_GAP]
+        gap = centres[:, None] - stops                 # the stop is within STOP_STEP before
+        far = np.minimum(np.abs(gap), np.abs(gap + STOP_STEP))
+        centres = centres[(np.min(far, axis=1) >= STOP_GAP) & np.all(
+            (gap >= 0) | (gap <= -STOP_STEP), axis=1)]
     samples = stream.samples_at(stencil(centres))
     return terms, samples, kinematics(terms, samples.phase)
 

@@ -63,47 +63,60 @@ SMOOTH_IDS = [f'{lam!r}-{d}-{arr}' for lam, d, arr in SMOOTH]
 
 # -- the numerical references ----------------------------------------------------------------
 def _chart(body, eq):
-    """Pose function of a chart coordinate x, x at the equilibrium, and the chart's range."""
+    """Pose function of a chart coordinate x, x at the equilibrium, and the chart's range.
+
+    Away from the turning points the coordinate is A's lamina parameter s (the poses of
+    geometry(θ) at θ(s), without its bisection of θ back to s); x* = s(θ*)."""
     if eq.name == 'turning point':
         return body.geometry_at_tilt, math.pi / 2, body.tilt_range
-    return body.geometry, eq.theta, (-body.theta_max, body.theta_max)
+
+    def pose(s):
+        s = np.asarray(s, dtype=float)
+        return body.geometry_at_parameter(s, body.elevation_of_parameter(s))
+    return pose, float(body.parameter_of_theta(eq.theta)), (-body.s_max, body.s_max)
 
 
-def _rolling_samples(body, eq, h):
-    """(γ, z_G − z_G*) at six poses with γ ≈ ±h, ±h/2, ±h/4, and the pose at the equilibrium."""
-    pose, x_star, (low, high) = _chart(body, eq)
-    centre = pose(np.array(x_star))
+def _rolling_samples(chart, centre, h, span):
+    """(γ, z_G − z_G*) at six poses with γ ≈ ±h, ±h/2, ±h/4, and the chart half-width used.
+
+    The poses are found on a grid of 81 chart coordinates around the equilibrium whose half-
+    width starts at span and grows (linear extrapolation of the reach, at least doubling)
+    until γ covers ±h; only the targets come from the grid, γ is that of the poses found.
+    """
+    pose, x_star, (low, high) = chart
     n_star = centre.ground_normal
 
     def gamma(geo, x):
         n = geo.ground_normal
         angle = np.arctan2(np.linalg.norm(np.cross(n, n_star), axis=-1), n @ n_star)
         return np.sign(x - x_star) * angle
-    span = 1e-3
     for _ in range(60):
         x = np.clip(x_star + span * np.linspace(-1.0, 1.0, 81), low, high)
         g = gamma(pose(x), x)
-        if g.min() <= -h and g.max() >= h:
+        reach = min(-g.min(), g.max())
+        if reach >= h:
             break
-        span *= 2
+        span = max(2 * span, 1.1 * span * h / reach) if reach > 0 else 2 * span
     targets = h * np.array([-1.0, -0.5, -0.25, 0.25, 0.5, 1.0])
     x = np.interp(targets, g, x)
     poses = pose(x)
-    return gamma(poses, x), poses.height - centre.height, centre
+    return gamma(poses, x), poses.height - centre.height, span
 
 
 def _height_jet(body, eq):
     """(dz_G/dγ, d²z_G/dγ², truncation estimate of the latter, pose at the equilibrium)."""
-    h = H
+    chart = _chart(body, eq)
+    centre = chart[0](np.array(chart[1]))
+    h, span = H, 1e-3
     while True:
-        gam, dz, centre = _rolling_samples(body, eq, h)
+        gam, dz, span = _rolling_samples(chart, centre, h, span)
         full = np.linalg.solve(np.vander(gam, 7, increasing=True)[:, 1:], dz)
         inner = np.abs(gam) < 0.75 * np.max(np.abs(gam))
         part = np.linalg.solve(np.vander(gam[inner], 5, increasing=True)[:, 1:], dz[inner])
         estimate = abs(2 * full[1] - 2 * part[1])
         if estimate <= FD_CAP * body.size or h < H / 64:
             return full[0], 2 * full[1], estimate, centre
-        h /= 2
+        h, span = h / 2, span / 2
 
 
 def _flat_heights(body, eq, levels=(1e-3, 1e-4)):
@@ -115,13 +128,17 @@ def _flat_heights(body, eq, levels=(1e-3, 1e-4)):
     k, sides = (0, (1,)) if eq.name == 'theta=0' else (1, (1, -1))
     z0 = float(body.geometry(eq.theta).height)
     c0 = float(body.geometry(eq.theta).ground_normal[k])
+
+    def pose(s):        # the pose of geometry(θ(s)) in A's lamina parameter s (no θ bisection)
+        return body.geometry_at_parameter(s, body.elevation_of_parameter(s))
+    s_star = float(body.parameter_of_theta(eq.theta))
     out = []
     for p in levels:
         for side in sides:
-            end = side * body.theta_max * (1 - 1e-12)
-            t = brentq(lambda x: abs(float(body.geometry(x).ground_normal[k]) - c0) - p,
-                       *sorted((eq.theta, end)), xtol=1e-300, rtol=EPS, maxiter=500)
-            g = body.geometry(t)
+            end = side * body.s_max * (1 - 1e-12)
+            s = brentq(lambda x: abs(float(pose(x).ground_normal[k]) - c0) - p,
+                       *sorted((s_star, end)), xtol=1e-300, rtol=EPS, maxiter=500)
+            g = pose(s)
             out.append((float(g.ground_normal[k]) - c0, float(g.height) - z0))
     return out
 
