@@ -61,9 +61,11 @@ def original(tmp_path_factory):
     return path.read_bytes()
 
 
-def rewrite(data, compression=CompressionType.NONE, crcs=False, edit=None, chunk_size=16384):
+def rewrite(data, compression=CompressionType.NONE, crcs=False, edit=None, chunk_size=16384,
+            metadata=None):
     """The same records written again, e.g. uncompressed without CRCs (so that flips reach the
-    CDR decoder); ``edit(topic, index, payload) -> payload`` may change a message."""
+    CDR decoder); ``edit(topic, index, payload) -> payload`` may change a message,
+    ``metadata`` {key: text} replaces entries of the metadata records."""
     out = io.BytesIO()
     writer = Writer(out, chunk_size=chunk_size, compression=compression, enable_crcs=crcs)
     writer.start('ros2', 'test rewrite')
@@ -83,7 +85,7 @@ def rewrite(data, compression=CompressionType.NONE, crcs=False, edit=None, chunk
             writer.add_message(channel_id, record.log_time, payload, record.publish_time,
                                record.sequence)
         elif isinstance(record, Metadata):
-            writer.add_metadata(record.name, record.metadata)
+            writer.add_metadata(record.name, {**record.metadata, **(metadata or {})})
     writer.finish()
     return out.getvalue()
 
@@ -257,6 +259,28 @@ def test_inspector_survives_every_mutation(tmp_path, variants):
     # the mutations reach every outcome: reports of what was recovered, and refusals
     assert outcomes['flip'][1] and outcomes['truncate'][4] and outcomes['tiny'][2]
     assert not outcomes['truncate'][0]      # a cut file is never a PASS
+
+
+def test_cached_models_give_the_results_of_fresh_ones(tmp_path, original):
+    """Inspecting two bodies alternately (the models cached by their parameters) reports
+    exactly what inspecting each with nothing cached reports: the shared models are not
+    changed by an inspection; and the second inspection of a body reuses its model."""
+    from twodisk_ros.inspect import model as model_module
+    other = rewrite(original, metadata={'b': '0.08', 'mass': '2.0'})
+    paths = []
+    for name, data in (('a.mcap', original), ('b.mcap', other)):
+        paths.append(tmp_path / name)
+        paths[-1].write_bytes(data)
+    fresh = []
+    for path in paths:
+        model_module.clear_model_cache()
+        fresh.append(run_in_process(path, '--json'))
+    assert fresh[0] != fresh[1]           # the two bodies are told apart
+    model_module.clear_model_cache()
+    for path, expected in zip(paths * 2, fresh * 2):
+        assert run_in_process(path, '--json') == expected, path.name
+    info = model_module._cached.cache_info()
+    assert (info.misses, info.hits) == (2, 2), info
 
 
 def test_damaged_files_through_a_subprocess(tmp_path, variants):

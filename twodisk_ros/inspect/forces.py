@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..physics.contact_forces import ContactForceModel, squeeze_split
+from ..physics.contact_forces import squeeze_split
 
 __all__ = ['ForceComponents', 'Stretch', 'exact_components', 'invalid_stretches',
            'newton_euler', 'recorded_components']
@@ -133,7 +133,7 @@ def exact_components(model, phase, phase_rate, phase_acceleration=None):
     ground that this ü needs (in the frame of the model's poses: for the FD error).
     ``model`` is a :class:`~twodisk_ros.inspect.model.RecordedModel`.
     """
-    forces_model = ContactForceModel(model.dynamics)
+    forces_model = model.forces
     if phase_acceleration is not None:
         forces = forces_model.forces(phase, phase_rate, phase_acceleration)
     elif model.mode == 'kinematic':

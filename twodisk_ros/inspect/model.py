@@ -5,9 +5,14 @@ The recorded parameters are read with the node's own contract, through the run d
 exactly what the node accepts and builds the body the node built: a recording without the
 shape parameters (made before them) is an ellipse run, and one of shape points is rebuilt from
 the fitted outline it holds, not from its shape file.
+
+Models are cached by the recorded parameters (a few at a time): inspecting many recordings of
+one body (or damaged copies of one recording) builds its dynamics tables and contact-force
+tables once. A model is frozen and its tables are only read, never written, by the checks.
 """
 
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -16,12 +21,15 @@ from ..physics.rolling_body import RollingBody
 from ..node.scene_simulation import flat_free, ground_normal
 from ..run.description import RunDescription
 
-__all__ = ['RecordedModel', 'build_model']
+__all__ = ['RecordedModel', 'build_model', 'clear_model_cache']
 
 
-@dataclass
+@dataclass(frozen=True)
 class RecordedModel:
-    """What the recorded parameters define: body, dynamics, mode, rates and tolerance."""
+    """What the recorded parameters define: body, dynamics, mode, rates and tolerance.
+
+    Shared between inspections of recordings with the same parameters: read only.
+    """
 
     body: RollingBody
     dynamics: RollingDynamics
@@ -35,12 +43,42 @@ class RecordedModel:
     #: True if the recorded scene is not today's flat, free, conservative one
     scene: bool = False
 
+    @cached_property
+    def forces(self):
+        """The :class:`~twodisk_ros.physics.contact_forces.ContactForceModel` of the dynamics
+        (its tables built when first read)."""
+        from ..physics.contact_forces import ContactForceModel
+        return ContactForceModel(self.dynamics)
+
 
 def build_model(parameters, problems):
     """The body, mass model and mode the recorded parameters describe, or None.
 
-    Problems found (one line each) are appended to ``problems``.
+    Problems found (one line each) are appended to ``problems``. The same parameters give
+    the same (cached, frozen) model.
     """
+    try:
+        key = tuple(sorted(parameters.items()))
+        hash(key)
+    except TypeError:           # not a mapping of hashable values: build without the cache
+        return _build(parameters, problems)
+    model, found = _cached(key)
+    problems.extend(found)
+    return model
+
+
+def clear_model_cache():
+    """Forget the cached models."""
+    _cached.cache_clear()
+
+
+@lru_cache(maxsize=4)
+def _cached(key):
+    found = []
+    return _build(dict(key), found), tuple(found)
+
+
+def _build(parameters, problems):
     run, found = RunDescription.from_recorded(parameters)
     problems.extend(found)
     if run is None:
