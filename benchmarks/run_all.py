@@ -23,6 +23,24 @@ sys.path.insert(0, HERE)
 if ROOT not in sys.path:
     sys.path.insert(1, ROOT)
 
+
+def _parser():
+    """The command line (built before the heavy imports, so that ``--help`` answers at once)."""
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument('--quick', action='store_true', help='short spans, short hour runs')
+    parser.add_argument('--out', default=os.path.join(ROOT, 'docs', 'benchmarks.md'))
+    parser.add_argument('--figure',
+                        default=os.path.join(ROOT, 'docs', 'figures', 'work_precision.png'))
+    parser.add_argument('--json', default=os.path.join(HERE, 'results.json'))
+    parser.add_argument('--overwrite', action='store_true',
+                        help='replace the report, the figure and the JSON if they exist '
+                        '(make bench passes it)')
+    return parser
+
+
+if __name__ == '__main__':
+    _parser().parse_args()      # --help (or a wrong option) before the heavy imports
+
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402
 import matplotlib  # noqa: E402
@@ -177,15 +195,7 @@ def findings(results, hours, builds, fd_errors, ratios, throughput):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument('--quick', action='store_true', help='short spans, short hour runs')
-    parser.add_argument('--out', default=os.path.join(ROOT, 'docs', 'benchmarks.md'))
-    parser.add_argument('--figure',
-                        default=os.path.join(ROOT, 'docs', 'figures', 'work_precision.png'))
-    parser.add_argument('--json', default=os.path.join(HERE, 'results.json'))
-    parser.add_argument('--overwrite', action='store_true',
-                        help='replace the report, the figure and the JSON if they exist '
-                        '(make bench passes it)')
+    parser = _parser()
     args = parser.parse_args(argv)
     try:
         for path, suffixes in ((args.out, ('.md',)), (args.figure, ('.png',)),

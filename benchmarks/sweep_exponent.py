@@ -19,12 +19,24 @@ Run: ``python benchmarks/sweep_exponent.py [--quick]`` (PYTHONPATH = the reposit
 
 import time
 
-import numpy as np
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.sweep.quantities import STAGES, chunk_quantities
-from twodisk_ros.sweep.request import (CORE_SECONDS_PER_BODY, DEFAULT_CHUNK_SIZE,
+def _arguments():
+    """The command line's options (``--help`` answers here, before the heavy imports)."""
+    import argparse
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--quick', action='store_true', help='fewer bodies (a smoke run)')
+    return parser.parse_args()
+
+
+if __name__ == '__main__':
+    _arguments()
+
+import numpy as np  # noqa: E402
+
+from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.sweep.quantities import STAGES, chunk_quantities  # noqa: E402
+from twodisk_ros.sweep.request import (CORE_SECONDS_PER_BODY, DEFAULT_CHUNK_SIZE,  # noqa: E402
                                        GENERAL_CHUNK_SIZE, GENERAL_CORE_SECONDS_PER_BODY)
 
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
@@ -119,10 +131,7 @@ def report_lines(m):
 
 
 def main():
-    import argparse
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--quick', action='store_true', help='fewer bodies (a smoke run)')
-    args = parser.parse_args()
+    args = _arguments()
     print('\n'.join(report_lines(measure(args.quick))))
 
 

@@ -34,13 +34,17 @@ import sys
 import tempfile
 import time
 
-import numpy as np
+if __name__ == '__main__':   # --help answers before the heavy imports below
+    import argparse
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
 
-from twodisk_ros.sweep.batch import BATCH_STAGES
-from twodisk_ros.sweep.parts import PartsCache
-from twodisk_ros.sweep.quantities import STAGES, chunk_quantities, timed_chunk
-from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client
-from twodisk_ros.sweep.worker import SweepWorkerSetup
+import numpy as np  # noqa: E402
+
+from twodisk_ros.sweep.batch import BATCH_STAGES  # noqa: E402
+from twodisk_ros.sweep.parts import PartsCache  # noqa: E402
+from twodisk_ros.sweep.quantities import STAGES, chunk_quantities, timed_chunk  # noqa: E402
+from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client  # noqa: E402
+from twodisk_ros.sweep.worker import SweepWorkerSetup  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
@@ -280,6 +284,4 @@ def main():
 
 
 if __name__ == '__main__':
-    import argparse
-    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
     main()

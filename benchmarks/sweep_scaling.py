@@ -36,11 +36,23 @@ import sys
 import tempfile
 import time
 
-import numpy as np
 
-from twodisk_ros.sweep.quantities import chunk_quantities
-from twodisk_ros.sweep.request import BYTES_PER_TASK, DEFAULT_STORE_CHUNK_SIZE
-from twodisk_ros.sweep.spec import SweepSpec
+def _arguments():
+    """The command line's options (``--help`` answers here, before the heavy imports)."""
+    import argparse
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--quick', action='store_true', help='fewer tasks (a smoke run)')
+    return parser.parse_args()
+
+
+if __name__ == '__main__':
+    _arguments()
+
+import numpy as np  # noqa: E402
+
+from twodisk_ros.sweep.quantities import chunk_quantities  # noqa: E402
+from twodisk_ros.sweep.request import BYTES_PER_TASK, DEFAULT_STORE_CHUNK_SIZE  # noqa: E402
+from twodisk_ros.sweep.spec import SweepSpec  # noqa: E402
 
 B_RANGE, D_RANGE = (0.2, 3.0), (0.05, 0.95)
 TASK_SECONDS = 1.0         # the shortest task the sweep should have (docs/sweeps.md)
@@ -371,10 +383,7 @@ def report_lines(m):
 
 
 def main():
-    import argparse
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--quick', action='store_true', help='fewer tasks (a smoke run)')
-    args = parser.parse_args()
+    args = _arguments()
     print('\n'.join(report_lines(measure(args.quick))))
 
 

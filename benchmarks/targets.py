@@ -6,15 +6,31 @@ import re
 import time
 import warnings
 
-import numpy as np
 
-from reference import ReferenceTrace
-from scenarios import GRAVITY, MASS
-from work_precision import (REFERENCE_CHECK_RTOL, REFERENCE_RTOL, position_error,
+def _parser():
+    """The command line (built before the heavy imports, so that ``--help`` answers at once;
+    the bodies are checked against scenarios.BODIES once that is imported)."""
+    import argparse
+    parser = argparse.ArgumentParser(description='Poses per second of the table method, and '
+                                     'their errors, for the benchmark bodies.')
+    parser.add_argument('bodies', nargs='*', metavar='BODY',
+                        help='bodies to measure (default: all of scenarios.BODIES: oloid, '
+                        'two_circle_roller, ...)')
+    return parser
+
+
+if __name__ == '__main__':
+    _parser().parse_args()
+
+import numpy as np  # noqa: E402
+
+from reference import ReferenceTrace  # noqa: E402
+from scenarios import GRAVITY, MASS  # noqa: E402
+from work_precision import (REFERENCE_CHECK_RTOL, REFERENCE_RTOL, position_error,  # noqa: E402
                             _timed)
 
-from twodisk_ros import simulate
-from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS
+from twodisk_ros import simulate  # noqa: E402
+from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
 
 TWO_PI = 2 * math.pi
 
@@ -392,13 +408,9 @@ def speed_ratios(results):
 
 
 if __name__ == '__main__':       # PYTHONPATH=. python benchmarks/targets.py [body ...]
-    import argparse
     from scenarios import BODIES
     from work_precision import build
-    parser = argparse.ArgumentParser(description='Poses per second of the table method, and '
-                                     'their errors, for the benchmark bodies.')
-    parser.add_argument('bodies', nargs='*', metavar='BODY',
-                        help=f'bodies to measure (default: all of {", ".join(BODIES)})')
+    parser = _parser()
     chosen = parser.parse_args().bodies
     for unknown in set(chosen) - set(BODIES):
         parser.error(f'unknown body {unknown!r} (known: {", ".join(BODIES)})')
