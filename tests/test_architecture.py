@@ -42,13 +42,10 @@ sys.meta_path.insert(0, _Refuse())
 
 
 def test_inspector_runs_where_rclpy_cannot_be_imported(tmp_path):
-    # record a short run with the node (rclpy available), then inspect it without rclpy
-    out = tmp_path / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'duration:=0.5', '-p', f'record:={out}'],
-        cwd=REPO, capture_output=True, text=True, timeout=120, env=ENV)
-    assert made.returncode == 0, made.stderr
+    # record a short run with the node (rclpy available: the roller's entry function in this
+    # process, tests/batch_recording.py), then inspect it in an interpreter without rclpy
+    from batch_recording import record
+    out = record(tmp_path / 'run.mcap', domain=int(ENV['ROS_DOMAIN_ID']), duration=0.5)
     code = BLOCK_RCLPY + (
         'from twodisk_ros.inspect.cli import main\n'
         f'status = main([{str(out)!r}])\n'

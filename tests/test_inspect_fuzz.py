@@ -52,12 +52,9 @@ def node_env():
 @pytest.fixture(scope='module')
 def original(tmp_path_factory):
     """The bytes of a real recording: the node, 2 s of simulated time at 25 Hz, batch."""
+    from batch_recording import record     # the roller's entry function, in this process
     path = tmp_path_factory.mktemp('fuzz') / 'run.mcap'
-    made = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'rate:=25.0', '-p', 'duration:=2.0', '-p', f'record:={path}'],
-        cwd=ROOT, capture_output=True, text=True, timeout=120, env=node_env())
-    assert made.returncode == 0, made.stderr[-2000:]
+    record(path, rate=25.0, duration=2.0)
     return path.read_bytes()
 
 
