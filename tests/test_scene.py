@@ -239,8 +239,10 @@ def test_equilibria_on_a_slope_are_stationary_heights_and_vanish_past_tipping():
 
 
 def test_lift_off_on_a_slope_is_reported():
+    # the run ends at 1.5 s, the claim's upper bound: a lift-off after it leaves the report
+    # valid and fails the test as before (same 0.01 s grid as the former 3 s run)
     terms, samples, _ = run(OLOID, Scene(gravity=GRAVITY, slope=0.1),
-                            np.linspace(0.01, 3.0, 300))
+                            np.linspace(0.01, 1.5, 150))
     mid = slice(2, None, 5)
     report = first_failure(terms, type(samples)(**{
         k: v[mid] for k, v in vars(samples).items()}))
