@@ -57,7 +57,8 @@ def wait_for_workers(address, count, timeout=60):
 @contextlib.contextmanager
 def cluster(folder, workers=2):
     """(address, [scheduler, worker...] Popen) of a scheduler and ``workers`` single-thread
-    worker processes (each under a nanny, each its own ``dask worker`` command), logs in
+    worker processes (each its own ``dask worker --no-nanny`` command: one process per
+    worker, no nanny process to start, and nothing restarts a killed worker), logs in
     ``folder``; everything stopped on exit."""
     port = free_port()
     address = f'tcp://127.0.0.1:{port}'
@@ -73,7 +74,7 @@ def cluster(folder, workers=2):
             logs.append(log)
             procs.append(subprocess.Popen(
                 [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
-                 '--nthreads', '1', *NO_DASHBOARD],
+                 '--nthreads', '1', '--no-nanny', *NO_DASHBOARD],
                 stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder,
                 start_new_session=True))
         wait_for_workers(address, workers)

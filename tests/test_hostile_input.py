@@ -86,11 +86,26 @@ def test_sweep_reference_speed_out_of_range_is_refused(speed, tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize('address', ['!!!', 'tcp://host', 'foo://127.0.0.1:5'])
-def test_sweep_malformed_scheduler_address_is_one_line(address, tmp_path):
+def test_sweep_malformed_scheduler_address_is_one_line(tmp_path):
     # was the refusal, then 10 s later "Exception ignored in Client.__del__" and a traceback
-    refused('twodisk_ros.sweep', *SWEEP, '--out', tmp_path / 'm.nc', '--scheduler', address,
+    # (at the process's exit: the real command, once)
+    refused('twodisk_ros.sweep', *SWEEP, '--out', tmp_path / 'm.nc', '--scheduler', '!!!',
             cwd=tmp_path, says='is not valid')
+    assert not (tmp_path / 'm.nc').exists()
+
+
+@pytest.mark.parametrize('address', ['!!!', 'tcp://host', 'foo://127.0.0.1:5'])
+def test_every_malformed_scheduler_address_is_one_line(address, tmp_path, capsys):
+    # the command line in this process (the real command refuses in the test above); a
+    # collection afterwards finds no half-made Client to complain about on stderr
+    import gc
+    from twodisk_ros.sweep.cli import main
+    status = main([*SWEEP, '--out', str(tmp_path / 'm.nc'), '--scheduler', address])
+    gc.collect()
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert status == 2, lines
+    assert len(lines) == 1 and 'Traceback' not in lines[0], lines
+    assert 'is not valid' in lines[0], lines
     assert not (tmp_path / 'm.nc').exists()
 
 
