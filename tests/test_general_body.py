@@ -36,18 +36,6 @@ AWAY_FROM_ZERO = np.concatenate([np.linspace(-0.98, -0.2, 12), np.linspace(0.2, 
 OTHER_IDS = [f'{lam!r}-d{d}' for lam, d in OTHER_SHAPES]
 
 
-_BODIES = {}
-
-
-def _body(lamina, delta, arrangement='parallel'):
-    """GeneralTwoDiskBody built once per module: the tests below read the same bodies
-    (read only), so their root tables and lazily computed ranges are computed once."""
-    key = (repr(lamina), delta, arrangement)
-    if key not in _BODIES:
-        _BODIES[key] = GeneralTwoDiskBody(lamina, delta, arrangement)
-    return _BODIES[key]
-
-
 def _phase_grid():
     u = np.linspace(-np.pi / 2, 3 * np.pi / 2, 801)
     near = np.pi / 2 + np.concatenate([-np.logspace(-12, -1, 12), np.logspace(-12, -1, 12)])
@@ -58,7 +46,7 @@ def _phase_grid():
 @pytest.mark.parametrize('a, b, delta', ELLIPSE_BODIES)
 def test_ellipse_agrees_with_closed_forms(a, b, delta, arrangement):
     ref = TwoDiskBody(a, b, delta)
-    body = _body(Ellipse(a, b), delta, arrangement)
+    body = GeneralTwoDiskBody(Ellipse(a, b), delta, arrangement)
     size = ref.size
     assert body.theta_max == pytest.approx(ref.theta_max, abs=ELLIPSE_TOL)
     assert body.psi_max == pytest.approx(ref.psi_max, abs=ELLIPSE_TOL)
@@ -98,7 +86,7 @@ def test_ellipse_agrees_with_closed_forms(a, b, delta, arrangement):
 @pytest.mark.parametrize('radius', [1.0, 2.5])
 def test_oloid_height_range_literature(radius):
     """Circles, Δ = r/2: z_G runs over [r/√2, 3r/4] (the oloid's literature values)."""
-    body = _body(Ellipse(radius, radius), radius / 2)
+    body = GeneralTwoDiskBody(Ellipse(radius, radius), radius / 2)
     # claim: the extremes are attained at θ = π/2 and θ = 0, to rounding of the size
     assert float(body.height(np.pi / 2)) == pytest.approx(radius / math.sqrt(2),
                                                           abs=1e-14 * radius)
@@ -137,7 +125,7 @@ def _parameter_of(lamina, point):
 @pytest.mark.parametrize('arrangement', ['parallel', 'swapped'])
 @pytest.mark.parametrize('lamina, delta', OTHER_SHAPES, ids=OTHER_IDS)
 def test_ground_supports_and_touches_both_laminae(lamina, delta, arrangement):
-    body = _body(lamina, delta, arrangement)
+    body = GeneralTwoDiskBody(lamina, delta, arrangement)
     size = body.size
     theta = body.theta_max * np.concatenate([np.linspace(-1, 1, 13), [0.999999]])
     _, rim1, rim2 = _rim_points(body)
@@ -183,7 +171,7 @@ def test_ground_supports_and_touches_both_laminae(lamina, delta, arrangement):
 def test_theta_max_is_the_tangent_from_the_far_tip(lamina, delta, arrangement):
     """At θ_max disk 1 stands vertical and the ground passes through disk 2's far tip: the
     tangent from that tip T to disk 1 in its plane (root of (r − T) × r′ by brentq, 1e-12)."""
-    body = _body(lamina, delta, arrangement)
+    body = GeneralTwoDiskBody(lamina, delta, arrangement)
     _, y_min, y_max = lamina.extents
     tip = 2 * delta + (y_max if arrangement == 'parallel' else -y_min)
 
@@ -211,7 +199,7 @@ def test_symmetries(lamina, delta):
     is invariant under the disk swap (x1, x2, x3) ↦ (x3, −x2, x1): (θ, ψ) ↦ (−ψ, −θ)."""
     theta = np.linspace(-0.98, 0.98, 25)
     for arrangement in ('parallel', 'swapped'):
-        body = _body(lamina, delta, arrangement)
+        body = GeneralTwoDiskBody(lamina, delta, arrangement)
         th = theta * body.theta_max
         up, down, left = body.geometry(th, 1), body.geometry(th, -1), body.geometry(-th, 1)
         flip1, flip3 = np.array([-1.0, 1, 1]), np.array([1.0, 1, -1])
