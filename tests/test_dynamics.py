@@ -113,6 +113,15 @@ def stencil_times(t_end, n, h=FD_STEP_T):
     return centres, (centres[:, None] + h * STENCIL).ravel()
 
 
+@functools.lru_cache(maxsize=None)
+def stencil_run(abd, t_end, n, method, mode='dynamic', **init):
+    """simulate() of the laminae body abd on stencil_times(t_end, n), run once per module
+    and shared (read only) by the tests that check the same run against different
+    references (energy, kinematic speed, and the other method)."""
+    _, t = stencil_times(t_end, n)
+    return simulate(model(abd)[3], t, mode=mode, method=method, tolerance=SOLVER_TOL, **init)
+
+
 def rates_in_time(motion, h=FD_STEP_T):
     """From a motion (or RollingState) sampled on stencil_times: R, G, A, B, ω (world) and Ġ
     at the centres."""
@@ -211,8 +220,7 @@ def test_energy_is_conserved(abd, kind, method):
     body, cycle, mass, dyn = model(abd)
     init = STATES[abd][kind]
     t_end = SPANS[method, kind]
-    _, t = stencil_times(t_end, 30)
-    motion = simulate(dyn, t, method=method, tolerance=SOLVER_TOL, **init)
+    motion = stencil_run(abd, t_end, 30, method, **init)
     scale = MASS * GRAVITY * body.size
 
     # the state is what it claims to be: rolling over or oscillating, and it really moves
@@ -271,14 +279,17 @@ def test_solid_oloid_direct_matches_table():
 
 # ----------------------------------------------------------------------------- kinematic
 
+#: (t_end, n) of stencil_times for the kinematic runs (4 s: u̇ varies along the cycle)
+KINEMATIC_SPAN = (4.0, 60)
+
+
 @pytest.mark.parametrize('method', ['table', 'direct'])
 @pytest.mark.parametrize('omega0', [2.5, -1.7])
 @pytest.mark.parametrize('abd', [OLOID, FIGURE3], ids=['oloid', 'figure3'])
 def test_kinematic_mode_holds_angular_speed(abd, omega0, method):
     _, _, _, dyn = model(abd)
-    _, t = stencil_times(4.0, 60)
-    motion = simulate(dyn, t, mode='kinematic', theta0=0.4, omega0=omega0, method=method,
-                      tolerance=SOLVER_TOL)
+    motion = stencil_run(abd, *KINEMATIC_SPAN, method, mode='kinematic', theta0=0.4,
+                         omega0=omega0)
     _, _, a, b, omega, _ = rates_in_time(motion)
     # |ω| from the rotation matrices alone
     assert_allclose(np.linalg.norm(omega, axis=-1), abs(omega0), rtol=SPEED_RTOL[method])
@@ -510,11 +521,15 @@ def test_small_oscillation_period_scaling():
                                         ('kinematic', 'roll')])
 @pytest.mark.parametrize('abd', [OLOID, FIGURE3], ids=['oloid', 'figure3'])
 def test_methods_agree(abd, mode, kind):
-    body, _, _, dyn = model(abd)
-    t = np.linspace(0.0, 2.0, 41)
-    init = STATES[abd][kind]
-    table = simulate(dyn, t, mode=mode, method='table', tolerance=SOLVER_TOL, **init)
-    direct = simulate(dyn, t, mode=mode, method='direct', tolerance=SOLVER_TOL, **init)
+    # the runs (and spans) of test_energy_is_conserved (dynamic: 1 s of rolling over, 2.5 s
+    # of oscillation) and test_kinematic_mode_holds_angular_speed (4 s), computed once
+    body = model(abd)[0]
+    if mode == 'kinematic':
+        span, init = KINEMATIC_SPAN, dict(theta0=0.4, omega0=2.5)
+    else:
+        span, init = (SPANS['direct', kind], 30), STATES[abd][kind]
+    table = stencil_run(abd, *span, 'table', mode=mode, **init)
+    direct = stencil_run(abd, *span, 'direct', mode=mode, **init)
     assert np.ptp(table.phase) > 0.3
     for x_table, x_direct in zip(table.positions(), direct.positions()):
         assert_allclose(x_direct, x_table, rtol=0, atol=AGREEMENT_MAX * body.size)

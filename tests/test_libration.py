@@ -122,11 +122,17 @@ def _closed_rhs(name):
     assert np.max(np.abs(slope[-20:])) < 1e-14 * np.max(np.abs(slope))
     assert np.max(np.abs(mass[-20:])) < 1e-14 * np.max(np.abs(mass))
     dmass = chebyshev.chebder(mass) * 2 / (hi - lo)
+    # the three series as the columns of one array, evaluated as T_k(ξ) = cos(k arccos ξ)
+    # (one vector operation instead of three 160-step recurrences per right-hand side): the
+    # argument's rounding, ≤ k · 4e-16 rad, moves the sums by ≤ 4e-16 Σ k |c_k| ~ 4e-16 of
+    # max |dV′/dξ| — 1e-15 V″, below the 1e-12 V″ A budget above by 300× at A = 1e-3
+    series = np.stack([mass, np.append(dmass, 0.0), slope], axis=1)
+    order = np.arange(161.0)
 
     def rhs(t, y):
         xi = (2 * y[0] - (hi + lo)) / (hi - lo)
-        m, dm = chebyshev.chebval(xi, mass), chebyshev.chebval(xi, dmass)
-        return [y[1], -(chebyshev.chebval(xi, slope) + 0.5 * dm * y[1] ** 2) / m]
+        m, dm, dv = np.cos(order * math.acos(min(1.0, max(-1.0, xi)))) @ series
+        return [y[1], -(dv + 0.5 * dm * y[1] ** 2) / m]
     return rhs
 
 
@@ -290,7 +296,8 @@ def test_issue_9_nudged_oloid(method, start):
 def test_two_circle_roller_rolls_on_at_any_speed(method, omega0):
     abd = (0.1, 0.1, 0.1 / math.sqrt(2.0))
     dyn = RollingDynamics(TwoDiskBody(*abd), laminae(*abd, MASS), GRAVITY)
-    t = np.linspace(0.0, 5.0, 51)
+    # 4 s: at 2 rad/s the phase advances 6.5 rad, one whole turn of m(u) (a cycle of the body)
+    t = np.linspace(0.0, 4.0, 41)
     motion = simulate(dyn, t, omega0=omega0, method=method)
     assert np.all(np.diff(motion.phase) > 0)
     kinetic = 0.5 * dyn.effective_mass(motion.phase) * motion.phase_rate**2
