@@ -31,6 +31,23 @@ def test_physics_imports_without_rclpy_or_matplotlib():
     assert result.stdout.strip() == '[]'
 
 
+def test_a_default_node_run_does_not_import_scipy_spatial(tmp_path):
+    """scipy.spatial costs half a second of CPU at import (k-d trees, sparse matrices, qhull),
+    and the node needs only rotation matrices to quaternions of it (Markley's method in
+    physics/orientation.py, checked against scipy in tests/test_poses.py)."""
+    record = tmp_path / 'run.mcap'
+    code = ('import sys\n'
+            'from twodisk_ros.node.main import main\n'
+            'status = main(["roller", "--ros-args", "--params-file", "config/oloid.yaml",'
+            ' "-p", "realtime:=false", "-p", "duration:=0.2",'
+            f' "-p", "record:={record}"])\n'
+            'print(sorted(m for m in sys.modules if m.startswith("scipy.spatial")))\n'
+            'sys.exit(status)\n')
+    result = _run(code)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip().splitlines()[-1] == '[]'
+
+
 BLOCK_RCLPY = '''
 import sys
 class _Refuse:

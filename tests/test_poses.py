@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from rounding import ulps
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.cycle import RollingCycle
+from twodisk_ros.physics.orientation import quaternion_from_matrix
 from twodisk_ros.physics.tables import HermiteTable
 
 TWO_PI = 2 * math.pi
@@ -128,6 +129,29 @@ def test_quaternion_across_shapes(drawn, start):
     _check_against_closed_forms(cycle, u)
     _check_continuous(cycle, np.linspace(start, start + 3 * TWO_PI, 6000))
     assert_array_equal(cycle.poses(u).position_g, cycle.positions(u)[0])
+
+
+# -- matrix to quaternion against scipy's Rotation ---------------------------------------------
+@pytest.mark.parametrize('seed', [0, 1])
+def test_quaternion_from_matrix_is_scipys_rotation(seed):
+    """Every pivot of Markley's method: random rotations, half-turns about each axis (w = 0,
+    the x, y or z pivot), the identity and tiny turns (the w pivot). Compared as rotations (up
+    to the global sign) with ``Rotation.from_matrix``; the bound is 16 ulps of the unit
+    components, a few rounded products and sums apiece."""
+    rotations = Rotation.concatenate([
+        Rotation.random(2000, random_state=seed),
+        Rotation.from_rotvec(math.pi * np.eye(3)),
+        Rotation.from_rotvec((math.pi - 1e-9) * np.eye(3)),
+        Rotation.from_rotvec(1e-12 * np.eye(3)),
+        Rotation.identity()])
+    matrices = rotations.as_matrix()
+    expected = rotations.as_quat()
+    got = quaternion_from_matrix(matrices)
+    sign = np.sign(np.sum(got * expected, axis=-1))[:, None]
+    assert np.all(sign != 0)
+    assert_allclose(got * sign, expected, rtol=0, atol=ulps(16))
+    # one matrix gives one quaternion, the same as in a batch
+    assert_array_equal(quaternion_from_matrix(matrices[7]), got[7])
 
 
 # -- continuity -----------------------------------------------------------------------------------

@@ -20,7 +20,8 @@ import numpy as np
 from .analytic import complex_step_jet
 from .spectral import spectral_derivative
 
-__all__ = ['contact_quaternion_samples', 'pure_product', 'CONTINUITY_MIN_DOT']
+__all__ = ['contact_quaternion_samples', 'pure_product', 'quaternion_from_matrix',
+           'CONTINUITY_MIN_DOT']
 
 #: Neighbouring nodes of the tabulated quaternion must agree at least this well (q_j·q_{j+1});
 #: the nodes turn by ≪ 1 rad, so the dot product is ≈ 1 and its sign unambiguous.
@@ -42,6 +43,48 @@ def pure_product(vector, quaternion):
     xyz, w = quaternion[..., :3], quaternion[..., 3:]
     return np.concatenate([w * vector + np.cross(vector, xyz),
                            -np.sum(vector * xyz, axis=-1, keepdims=True)], axis=-1)
+
+
+def quaternion_from_matrix(matrix):
+    """Unit quaternions (x, y, z, w) of rotation matrices, one of the two signs each.
+
+    Markley's method (J. Guid. Control Dyn. 31(2), 2008, 440–442), as in scipy's
+    ``Rotation.from_matrix``: of the four equivalent formulas, the one whose pivot
+    (1 + trace, or 1 − trace + 2 R_ii) is largest, so no component comes from a
+    difference of nearly equal numbers. Written in numpy because the node needs only this
+    of ``scipy.spatial``, whose import costs half a second of every node start.
+
+    Parameters
+    ----------
+    matrix : ndarray, shape (..., 3, 3)
+        Rotation matrices (orthonormal, det +1, up to rounding).
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        q with R = R(q), normalised; its sign is not fixed (q and −q are one rotation).
+    """
+    r = np.asarray(matrix, dtype=float)
+    diagonal = np.diagonal(r, axis1=-2, axis2=-1)
+    trace = np.sum(diagonal, axis=-1)
+    pivots = np.concatenate([diagonal, trace[..., None]], axis=-1)
+    choice = np.argmax(pivots, axis=-1)
+    q = np.empty(r.shape[:-2] + (4,))
+    for i in range(3):                           # pivot on x, y or z: 1 − tr + 2 R_ii
+        j, k = (i + 1) % 3, (i + 2) % 3
+        at = choice == i
+        ra = r[at]
+        q[at, i] = 1.0 - trace[at] + 2.0 * ra[:, i, i]
+        q[at, j] = ra[:, j, i] + ra[:, i, j]
+        q[at, k] = ra[:, k, i] + ra[:, i, k]
+        q[at, 3] = ra[:, k, j] - ra[:, j, k]
+    at = choice == 3                             # pivot on w: 1 + tr
+    ra = r[at]
+    q[at, 0] = ra[:, 2, 1] - ra[:, 1, 2]
+    q[at, 1] = ra[:, 0, 2] - ra[:, 2, 0]
+    q[at, 2] = ra[:, 1, 0] - ra[:, 0, 1]
+    q[at, 3] = 1.0 + trace[at]
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def contact_quaternion_samples(t1, normal):
@@ -69,13 +112,12 @@ def contact_quaternion_samples(t1, normal):
     q′ = ½ (W, 0) ⊗ q and q″ = ½ ((W′, 0) ⊗ q + (W, 0) ⊗ q′); W is periodic, so W′ is its
     spectral derivative.
     """
-    from scipy.spatial.transform import Rotation
     (t1, dt1), (n, dn) = complex_step_jet((t1, normal))
     m = np.cross(n, t1)
     dm = np.cross(dn, t1) + np.cross(n, dt1)
     c = np.stack([t1, m, n], axis=-2)
     dc = np.stack([dt1, dm, dn], axis=-2)
-    q = Rotation.from_matrix(c).as_quat()
+    q = quaternion_from_matrix(c)
     dots = np.sum(q[1:] * q[:-1], axis=-1)
     if np.min(np.abs(dots)) < CONTINUITY_MIN_DOT:
         raise ValueError('contact frame turns too far between nodes to follow its sign')
