@@ -258,7 +258,7 @@ def main(argv=None):
     # checked: from here on xarray (run, dataset) and, in dask_client, Dask
     from .parts import PartsCache, PartsMismatch, parts_folder
     from .progress import summary_line
-    from .run import dask_client, run_sweep
+    from .run import dask_client, quiet_dask_loggers, run_sweep
     progress = None if args.quiet else sys.stderr
     cache = None
     kept = f'{args.out}.parts/' if fmt == 'netcdf' else args.out
@@ -282,6 +282,8 @@ def main(argv=None):
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted; finished chunks are kept in {kept} - run the same '
               f'command again to resume', file=sys.stderr)
+        # futures the stopped client left behind may report at the interpreter's exit
+        quiet_dask_loggers()
         return 130
     except Exception as error:  # noqa: BLE001 (a task died: keep the state, one line)
         return _fail(f'a task failed ({type(error).__name__}: {error}); finished chunks are '

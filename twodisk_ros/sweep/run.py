@@ -143,11 +143,46 @@ def dask_client(scheduler=None, workers=None, timeout=CONNECT_TIMEOUT):
             client = Client(cluster, set_as_default=False)
         try:
             yield client
-        finally:
-            client.close()
+        except BaseException:
+            # stopped (Ctrl-C, a failed task): the caller reports it in one line, so
+            # Dask's own noise while the client closes early is not shown on top of it
+            with quiet_dask_shutdown():
+                client.close()
+            raise
+        client.close()
     finally:
         if cluster is not None:
             cluster.close()
+
+
+#: Loggers through which Dask and asyncio report what goes wrong while a client closes
+#: early (e.g. "Future exception was never retrieved ... TimeoutError" on a loaded machine).
+SHUTDOWN_LOGGERS = ('asyncio', 'distributed', 'tornado')
+
+
+def quiet_dask_loggers():
+    """Let the :data:`SHUTDOWN_LOGGERS` and their children show only CRITICAL records; returns their previous
+    levels ({name: level}). For a program whose sweep was stopped and said so in one line:
+    futures its client left behind may still report when the interpreter exits."""
+    names = set(SHUTDOWN_LOGGERS) | {
+        name for name in logging.root.manager.loggerDict
+        if name.startswith(tuple(f'{prefix}.' for prefix in SHUTDOWN_LOGGERS))}
+    previous = {name: logging.getLogger(name).level for name in sorted(names)}
+    for name in previous:          # their own levels too: Dask sets some (distributed.client)
+        logging.getLogger(name).setLevel(logging.CRITICAL)
+    return previous
+
+
+@contextmanager
+def quiet_dask_shutdown():
+    """:func:`quiet_dask_loggers` within, their levels restored at exit: for the early close
+    of a client whose sweep was stopped (the caller reports the stop)."""
+    previous = quiet_dask_loggers()
+    try:
+        yield
+    finally:
+        for name, level in previous.items():
+            logging.getLogger(name).setLevel(level)
 
 
 def _collect(client, futures, bar, on_chunk, handle):
