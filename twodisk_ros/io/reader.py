@@ -9,12 +9,14 @@ offline on any machine.
 
 import contextlib
 import errno
+from functools import lru_cache
 import io
 import os
 import stat
 from dataclasses import dataclass, field
 from typing import Any
 
+from mcap.records import Schema
 from mcap_ros2.decoder import DecoderFactory
 
 from ..limits import describe_bytes, memory_limit
@@ -197,24 +199,35 @@ def _read_regular_file(path):
         return stream.read()
 
 
+@lru_cache(maxsize=32)
+def _decoder(message_encoding, schema_name, schema_encoding, schema_data):
+    """(decoder, None) or (None, reason) for a channel's encoding and schema record (name,
+    encoding, bytes; None without a schema). Cached by those exact values: reading many
+    recordings of the node in one process parses each schema text once (~1 ms apiece, a
+    sixth of inspecting a short recording), and a damaged schema is another key."""
+    schema = (None if schema_name is None else
+              Schema(id=1, name=schema_name, encoding=schema_encoding, data=schema_data))
+    printed = io.StringIO()   # the vendored msg parser prints its complaints
+    try:
+        with contextlib.redirect_stderr(printed), contextlib.redirect_stdout(printed):
+            return DecoderFactory().decoder_for(message_encoding, schema), None
+    except Exception as error:  # noqa: BLE001 - a damaged schema text
+        return None, f'schema: {reason_of(error)}'
+
+
 def _decode(scan, recording, decode):
     """Decode the scanned messages into ``recording``; failures are counted, not raised."""
     schemas = {**scan.summary_schemas, **scan.schemas}
     channels = {**scan.summary_channels, **scan.channels}
-    factory = DecoderFactory()
     decoders = {}
     counts = {channel.topic: 0 for channel in channels.values()}
 
     def decoder_of(channel):
         if channel.id not in decoders:
-            printed = io.StringIO()   # the vendored msg parser prints its complaints
-            try:
-                with contextlib.redirect_stderr(printed), contextlib.redirect_stdout(printed):
-                    decoder = factory.decoder_for(channel.message_encoding,
-                                                  schemas.get(channel.schema_id))
-                decoders[channel.id] = (decoder, None)
-            except Exception as error:  # noqa: BLE001 - a damaged schema text
-                decoders[channel.id] = (None, f'schema: {reason_of(error)}')
+            schema = schemas.get(channel.schema_id)
+            decoders[channel.id] = _decoder(
+                channel.message_encoding, *((None, None, None) if schema is None else
+                                            (schema.name, schema.encoding, bytes(schema.data))))
         return decoders[channel.id]
 
     for raw in scan.messages:
