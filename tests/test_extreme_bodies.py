@@ -98,8 +98,8 @@ def test_thin_body_libration_stops_at_the_noise_floor():
 
 def _node_start(**values):
     """The node's physics for these parameters, and the CPU time (s) of its first 0.5 s."""
-    from twodisk_ros.node.parameters import DEFAULTS      # the node's contract, no rclpy
-    from twodisk_ros.node.simulation import Simulation
+    from twodisk_ros.run.parameters import DEFAULTS      # the node's contract, no rclpy
+    from twodisk_ros.run.simulation import Simulation
     begin = time.process_time()
     simulation = Simulation(DEFAULTS.with_values(**values))
     t = np.arange(1, 51) / 100.0                          # the first 0.5 s at 100 Hz

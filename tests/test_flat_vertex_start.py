@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 
 from twodisk_ros.node import diagnostics, run_summary
-from twodisk_ros.node.parameters import DEFAULTS
-from twodisk_ros.node.simulation import Simulation
+from twodisk_ros.run.parameters import DEFAULTS
+from twodisk_ros.run.simulation import Simulation
 
 pytestmark = pytest.mark.ros
 

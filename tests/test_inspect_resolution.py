@@ -31,8 +31,8 @@ from test_inspect import OLOID, simulate_run as simulate_oloid, write_run as wri
 from test_inspect_forces import write_run
 from twodisk_ros.inspect import inspect_recording
 from twodisk_ros.inspect.resolution import CAP, UNRESOLVED
-from twodisk_ros.node.parameters import RollerSettings
-from twodisk_ros.node.simulation import Simulation
+from twodisk_ros.run.parameters import RollerSettings
+from twodisk_ros.run.simulation import Simulation
 
 pytestmark = pytest.mark.ros
 

@@ -15,7 +15,7 @@ import pytest
 from batch_recording import record
 from twodisk_ros.inspect import inspect_recording
 from twodisk_ros.io.reader import read_recording
-from twodisk_ros.node.parameters import parse_recorded
+from twodisk_ros.run.parameters import parse_recorded
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.dynamics import RollingDynamics
 from twodisk_ros.plotting import palette

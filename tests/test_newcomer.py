@@ -63,7 +63,7 @@ def test_readme_blocks_do_not_write_one_output_twice():
 
 
 def test_parameter_table_into_a_closed_pipe_has_no_traceback():
-    """``python -m twodisk_ros.node.parameters | head -3`` printed a BrokenPipeError
+    """``python -m twodisk_ros.run.parameters | head -3`` printed a BrokenPipeError
     traceback (the reader closes the pipe before the table is written)."""
     import os
     import subprocess
@@ -71,7 +71,7 @@ def test_parameter_table_into_a_closed_pipe_has_no_traceback():
     read, write = os.pipe()
     os.close(read)                # the reader is gone before the table is written
     try:
-        result = subprocess.run([sys.executable, '-m', 'twodisk_ros.node.parameters'],
+        result = subprocess.run([sys.executable, '-m', 'twodisk_ros.run.parameters'],
                                 stdout=write, stderr=subprocess.PIPE, text=True, timeout=60,
                                 env=dict(os.environ, PYTHONPATH=str(REPO)))
     finally:

@@ -27,7 +27,7 @@ import twodisk_ros  # noqa: E402
 from twodisk_ros.node.arguments import (ArgumentError, check_arguments, node_fqn,  # noqa: E402
                                         params_file_values, rclpy_type_hint)
 from roller_here import run_roller_main  # noqa: E402
-from twodisk_ros.node.params_yaml import (MAX_ENTRIES, load_params_file,  # noqa: E402
+from twodisk_ros.run.params_yaml import (MAX_ENTRIES, load_params_file,  # noqa: E402
                                           node_matches, parse_value)
 
 REPO = Path(__file__).resolve().parents[1]
@@ -92,7 +92,7 @@ def test_help_prints_usage_and_exits_0_writing_nothing(flag, tmp_path):
     assert code == 0 and err == '', err
     assert out.startswith('usage: roller')
     for words in ('--ros-args', '-p NAME:=VALUE', '--params-file', 'rate:=50.0',
-                  'python -m twodisk_ros.node.parameters', 'README', 'examples:'):
+                  'python -m twodisk_ros.run.parameters', 'README', 'examples:'):
         assert words in out, words
     assert list(tmp_path.iterdir()) == []
 

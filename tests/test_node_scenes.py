@@ -178,7 +178,7 @@ def test_the_time_to_rest_is_in_the_diagnostics(context, tmp_path, losses):
 
     Losses of 0.03 bring the default oloid to rest after 5.8 s (damping) and 3.4 s (rolling
     resistance) instead of 18 s and 9.3 s at 0.01: the same claim on a shorter run."""
-    from twodisk_ros.node.parameters import DEFAULTS
+    from twodisk_ros.run.parameters import DEFAULTS
     from twodisk_ros.physics.scene import Scene
     from twodisk_ros.physics.scene_events import settle
     from twodisk_ros.physics.scene_terms import SceneTerms

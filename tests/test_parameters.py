@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from twodisk_ros.node.parameters import (DEFAULTS, PARAMETERS, RollerSettings, markdown_table,
+from twodisk_ros.run.parameters import (DEFAULTS, PARAMETERS, RollerSettings, markdown_table,
                                          parse_recorded)
 
 README = Path(__file__).resolve().parents[1] / 'README.md'

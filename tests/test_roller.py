@@ -250,8 +250,8 @@ def test_markers(oloid_run):
 
 def test_hull_marker_is_the_ruled_surface():
     from twodisk_ros.node import messages
-    from twodisk_ros.node.parameters import DEFAULTS
-    from twodisk_ros.node.simulation import Simulation
+    from twodisk_ros.run.parameters import DEFAULTS
+    from twodisk_ros.run.simulation import Simulation
     from visualization_msgs.msg import Marker
     simulation = Simulation(DEFAULTS.with_values(a=0.2, b=0.1, delta=0.1,
                                                  mass_model='solid'))

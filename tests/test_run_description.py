@@ -14,8 +14,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings as hsettings, strategies as st
 
 from twodisk_ros.node import arguments
-from twodisk_ros.node.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
-from twodisk_ros.node.simulation import Simulation
+from twodisk_ros.run.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
+from twodisk_ros.run.simulation import Simulation
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.dynamics import RollingDynamics
 from twodisk_ros.physics.lamina import Egg

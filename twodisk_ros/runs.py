@@ -19,9 +19,9 @@ from .io.errors import one_line
 from .io.reader import read_recording
 from .model.outline import DEFAULT_TOLERANCE, disk_rims
 from .node.arguments import ArgumentError, params_file_values
-from .node.parameters import BY_NAME, DEFAULTS
-from .node.scene_simulation import flat_free
-from .node.simulation import Simulation
+from .run.parameters import BY_NAME, DEFAULTS
+from .run.scene_simulation import flat_free
+from .run.simulation import Simulation
 from .physics.contact_forces import ContactForceModel
 from .physics.motion import simulate
 from .run.description import RunDescription
@@ -223,7 +223,7 @@ def library_run(settings=None, *, stop=6.0, rate=LIBRARY_RATE, forces=False, **v
 
 def _scene_run(description, t, forces):
     """A run of a scene (slope, drive, dissipation) as the node's batch run makes it: the
-    node's :class:`~twodisk_ros.node.simulation.Simulation`, with no command and no service
+    node's :class:`~twodisk_ros.run.simulation.Simulation`, with no command and no service
     call (a speed drive holds its starting speed, a torque drive gives 0 N m)."""
     s = description.settings
     try:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..physics.dynamics import RollingDynamics
 from ..physics.rolling_body import RollingBody
-from ..node.scene_simulation import flat_free, ground_normal
+from ..run.scene_simulation import flat_free, ground_normal
 from ..run.description import RunDescription
 
 __all__ = ['RecordedModel', 'build_model', 'clear_model_cache']

@@ -4,7 +4,7 @@ rclpy answers a malformed ``--ros-args`` section (``-p a:=``, a missing or broke
 ``--params-file``) with a multi-line ``RCLError`` traceback, silently ignores a parameter name
 the node does not declare, and refuses a value of the wrong type (``rate:=50``, an integer)
 only after rcl has parsed everything. :func:`check_arguments` reads the same arguments first,
-with the one loader of :mod:`~twodisk_ros.node.params_yaml` (rcl's typing, bounded), and
+with the one loader of :mod:`~twodisk_ros.run.params_yaml` (rcl's typing, bounded), and
 returns one-line errors and warnings instead.
 
 Every value given for a declared parameter must have its declared type, wherever it appears
@@ -18,9 +18,9 @@ given counts, as in rcl.
 import difflib
 import re
 
-from .parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
+from ..run.parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
 from .usage import split_ros_args
-from .params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
+from ..run.params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
 
 __all__ = ['ArgumentError', 'check_arguments', 'node_fqn', 'params_file_values',
            'rclpy_type_hint', 'type_problem']

@@ -127,7 +127,7 @@ def body_marker_specs(disk1, disk2, contact_a, contact_b, size, *, filled=True, 
     ``alpha``); 5 (if ``hull`` is given): the convex hull as a TRIANGLE_LIST strip between
     ``hull = (rim_1, rim_2)``, matching points of the two rims (arrays (n + 1, 3), closed),
     e.g. the end points A and B of the rulings over one cycle
-    (:meth:`~twodisk_ros.node.simulation.Simulation.hull_rims`). ``disk1``, ``disk2``: closed
+    (:meth:`~twodisk_ros.run.simulation.Simulation.hull_rims`). ``disk1``, ``disk2``: closed
     outlines, arrays (n + 1, 3) with the last point the first.
     """
     width = 0.01 * size

@@ -33,18 +33,19 @@ from std_msgs.msg import String
 
 from .. import __version__
 from ..io import McapRecorder, cdr
-from ..outputs import check_output
 from ..io.cdr_markers import encode_markers
-from . import diagnostics, encoding, messages, run_summary, schedule, sim_clock
-from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
+from ..outputs import check_output
+from ..physics.startup import startup_estimate
+from ..run import schedule
+from ..run.description import RunDescription
+from ..run.parameters import BY_NAME, DEFAULTS, PARAMETERS
+from ..run.scene_simulation import frame_metadata
+from ..run.simulation import Simulation
+from . import diagnostics, encoding, messages, run_summary, sim_clock
 from .descriptors import descriptor, ros_value
-from .parameters import BY_NAME, DEFAULTS, PARAMETERS
+from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
 from .path_history import PathHistory
 from .scene_control import EVENTS_QOS, SceneControl
-from .scene_simulation import frame_metadata
-from .simulation import Simulation
-from ..physics.startup import startup_estimate
-from ..run.description import RunDescription
 
 __all__ = ['Roller']
 

@@ -33,7 +33,7 @@ from std_msgs.msg import Float64, String
 from std_srvs.srv import Empty, SetBool
 
 from ..io import cdr
-from .scene_simulation import SPEED_LIMIT, TORQUE_LIMIT
+from ..run.scene_simulation import SPEED_LIMIT, TORQUE_LIMIT
 from ..physics.scene import command_error
 
 __all__ = ['EVENTS_TOPIC', 'EVENTS_QOS', 'SceneControl']

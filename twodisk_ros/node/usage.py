@@ -4,7 +4,7 @@ No rclpy, no numpy, so that the help is instant and writes nothing, and a refusa
 before any heavy import. rcl ignores every argument outside a ``--ros-args ... [--]``
 section; a node that took ``roller -p duration:=1.0`` would run the defaults for ever, so
 such an argument is refused. Each ``--params-file`` is read once here, within the limits of
-:mod:`~twodisk_ros.node.params_yaml` (PyYAML only), so that a hostile file is refused in a
+:mod:`~twodisk_ros.run.params_yaml` (PyYAML only), so that a hostile file is refused in a
 fraction of a second and never reaches rcl.
 """
 
@@ -43,7 +43,7 @@ Parameters are ROS 2 parameters and go after --ros-args:
   --params-file FILE    a YAML file: /**: {{ros__parameters: {{NAME: VALUE, ...}}}}
                         (UTF-8, at most 1 MiB, 32 levels, 10 000 entries, no aliases)
 Every parameter with its type, default, unit and allowed values:
-  python -m twodisk_ros.node.parameters    (the table of README.md, "Parameters")
+  python -m twodisk_ros.run.parameters    (the table of README.md, "Parameters")
 
 examples:
   ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml -p rate:=50.0
@@ -125,7 +125,7 @@ def early_exit(argv, out=None, err=None):
     files = _inside(list(argv)[1:])
     files = [value for flag, value in zip(files, files[1:]) if flag == '--params-file']
     if files:
-        from .params_yaml import ArgumentError, load_params_file
+        from ..run.params_yaml import ArgumentError, load_params_file
         try:
             for path in files:
                 load_params_file(path)

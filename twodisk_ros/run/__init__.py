@@ -1,16 +1,22 @@
-"""The description of a run: settings → lamina, body, mass model, dynamics and motion.
+"""The run: its parameters, the body they describe, and its simulation, below the node.
 
-One place that the node (:mod:`~twodisk_ros.node.simulation`), the inspector
-(:mod:`~twodisk_ros.inspect.model`), the sweeps and the animation read, so that they all build
-the same body from the same settings. ROS-free.
+ROS-free (no rclpy): the node (:mod:`twodisk_ros.node`), the inspector
+(:mod:`~twodisk_ros.inspect.model`), the viewer, the sweeps and the animation read it, so
+that they all build the same body from the same settings.
 
+- :mod:`~twodisk_ros.run.parameters`: the parameter contract (names, types, units, ranges);
+- :mod:`~twodisk_ros.run.params_yaml`: the one bounded loader of parameter files and ``-p``
+  values, typed as rcl types them;
 - :mod:`~twodisk_ros.run.shape`: the lamina the settings name (``shape``, ``exponent``,
   ``egg_asymmetry``, ``shape_file``), read and checked; a fitted outline in a recording's
   metadata;
 - :mod:`~twodisk_ros.run.description`: :class:`~twodisk_ros.run.description.RunDescription`,
   the body (TwoDiskBody for ellipses, LaminaBody otherwise), its mass model, dynamics and
-  motion stream, and the recording's metadata.
+  motion stream, and the recording's metadata;
+- :mod:`~twodisk_ros.run.simulation`, :mod:`~twodisk_ros.run.scene_simulation`: the
+  settings' physics objects and the samples they give;
+- :mod:`~twodisk_ros.run.schedule`: the sample schedule, tick → time and stamp.
 
-Nothing is imported here: :mod:`twodisk_ros.node.parameters` imports
+Nothing is imported here: :mod:`~twodisk_ros.run.parameters` imports
 :mod:`~twodisk_ros.run.shape`, and the description imports the parameters.
 """

@@ -1,6 +1,6 @@
 """The description of a run: checked settings → lamina, body, mass model, dynamics, motion.
 
-Read by the node (:class:`~twodisk_ros.node.simulation.Simulation`, the start-up estimate),
+Read by the node (:class:`~twodisk_ros.run.simulation.Simulation`, the start-up estimate),
 the inspector (:func:`~twodisk_ros.inspect.model.build_model`) and the tools that rebuild a
 run from its parameters, so that every reader builds the same body:
 
@@ -20,7 +20,7 @@ checking settings, describing the URDF and building the simulation pay for a bod
 
 from functools import cached_property, lru_cache
 
-from ..node.parameters import parse_recorded
+from .parameters import parse_recorded
 from ..physics.body import TwoDiskBody
 from ..physics.dynamics import RollingDynamics
 from ..physics.motion import MotionStream
@@ -89,7 +89,7 @@ class RunDescription:
         """(RunDescription or None, problems) of a recording's ``twodisk_ros`` metadata.
 
         The parameters are read with the node's contract
-        (:func:`~twodisk_ros.node.parameters.parse_recorded`): a recording without the shape
+        (:func:`~twodisk_ros.run.parameters.parse_recorded`): a recording without the shape
         parameters is an ellipse run; one of shape points is rebuilt from the outline it
         holds, without its shape file. Problems are one line each.
         """

@@ -1,6 +1,6 @@
 """The lamina a run's settings name: ``shape``, ``exponent``, ``egg_asymmetry``, ``shape_file``.
 
-ROS-free and lazy-free: :mod:`twodisk_ros.node.parameters` checks settings with it, the run
+ROS-free and lazy-free: :mod:`twodisk_ros.run.parameters` checks settings with it, the run
 description (:mod:`~twodisk_ros.run.description`) builds the body on it. Settings are read by
 attribute (any object with the parameter names: ``RollerSettings`` in practice).
 

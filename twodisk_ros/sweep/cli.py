@@ -173,7 +173,7 @@ def _checked(args):
         if workers > most:
             raise _Usage(f'--workers {workers}: at most {most} worker processes '
                          f'({MAX_WORKERS_PER_CORE} per core of this machine)')
-    from ..node.parameters import B_OVER_A     # (numpy: not needed for --help)
+    from ..run.parameters import B_OVER_A     # (numpy: not needed for --help)
     b = _grid_range('--b-over-a', args.b_over_a)
     if not B_OVER_A[0] <= b[0] <= b[1] <= B_OVER_A[1]:
         # the node's range: beyond it the tables of one body grow past 65 536 nodes a cycle

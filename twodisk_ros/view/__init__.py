@@ -5,7 +5,7 @@ served over the Foxglove WebSocket protocol by ``foxglove-sdk`` (subprotocol
 ``foxglove.sdk.v1``). Nothing here imports rclpy or matplotlib.
 
 - :mod:`~twodisk_ros.view.sources`: the samples: :class:`LiveSource` (the node's
-  :class:`~twodisk_ros.node.simulation.Simulation`, block by block) and
+  :class:`~twodisk_ros.run.simulation.Simulation`, block by block) and
   :class:`ReplaySource` (a recording, as recorded);
 - :mod:`~twodisk_ros.view.scene`: samples → Foxglove messages (frame transforms, the body's
   mesh and rims, the contact segment, the force arrows, the traces);

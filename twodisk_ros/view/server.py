@@ -18,7 +18,7 @@ from foxglove import Capability, Parameter, ParameterType
 from foxglove.channels import FrameTransformsChannel, SceneUpdateChannel
 from foxglove.websocket import ServerListener
 
-from ..node.parameters import PARAMETERS
+from ..run.parameters import PARAMETERS
 
 __all__ = ['SUBPROTOCOL', 'TOPICS', 'ServeError', 'ViewServer', 'parameter_values']
 

@@ -3,7 +3,7 @@
 Both sources give :class:`Block` s of samples with their stamps (ns) and the wall-clock
 times (s after the show started) at which each is due. No rclpy here.
 
-- :class:`LiveSource`: the node's physics (:class:`twodisk_ros.node.simulation.Simulation`,
+- :class:`LiveSource`: the node's physics (:class:`twodisk_ros.run.simulation.Simulation`,
   the same settings as ``roller``) sampled at ``rate`` from t = 0, in blocks of
   :data:`BLOCK_SECONDS` of simulated time, for ``duration`` (0: until stopped). Sample k is
   at t = k / rate and stamped ``start_ns + round(k × 1e9 / rate)``, as the node stamps it
@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..node import schedule
-from ..node.simulation import Simulation
+from ..run import schedule
+from ..run.simulation import Simulation
 from ..runs import recorded_run
 
 __all__ = ['BLOCK_SECONDS', 'Block', 'LiveSource', 'ReplaySource']

@@ -20,7 +20,7 @@ from ..physics.lamina import SUPERELLIPSE_EXPONENT
 from ..physics.mass_models import MODELS, custom, mass_properties
 from ..physics.motion import METHODS, MODES
 from ..physics.scene import DRIVES
-from ..run import shape as shapes
+from . import shape as shapes
 
 __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
            'markdown_table', 'parse_recorded']
@@ -306,7 +306,7 @@ class _SettingsMethods:
         if self.shape == 'ellipse':
             return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
                                    principal_moments=moments)
-        from ..run.description import RunDescription
+        from .description import RunDescription
         return RunDescription(self, outline).mass
 
     def as_strings(self):
@@ -433,7 +433,7 @@ def field_names():
 if __name__ == '__main__':
     import argparse
     argparse.ArgumentParser(
-        prog='python -m twodisk_ros.node.parameters',
+        prog='python -m twodisk_ros.run.parameters',
         description="Print the roller node's parameter table (Markdown, as in the README)."
     ).parse_args()
     import os

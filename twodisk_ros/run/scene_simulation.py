@@ -1,6 +1,6 @@
 """The node's motion in a scene other than the flat free one (no rclpy here).
 
-:class:`~twodisk_ros.node.simulation.Simulation` keeps today's path (its MotionStream, poses
+:class:`~twodisk_ros.run.simulation.Simulation` keeps today's path (its MotionStream, poses
 and contact forces, bit for bit) where the settings describe the flat, free, conservative
 scene and the motion starts at ``theta0``; everything else is a :class:`SceneMotion`: the
 scene's stream (:func:`~twodisk_ros.physics.scene_motion.scene_stream`, or the integrator of

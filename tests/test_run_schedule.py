@@ -10,8 +10,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from twodisk_ros.node import schedule
-from twodisk_ros.node.parameters import DEFAULTS
+from twodisk_ros.run import schedule
+from twodisk_ros.run.parameters import DEFAULTS
 from twodisk_ros.view.sources import LiveSource
 
 T0 = 1_795_669_634_697_440_220

@@ -2,7 +2,7 @@
 
 :class:`Simulation` takes the body, mass model, dynamics and motion stream that
 :class:`~twodisk_ros.run.description.RunDescription` builds from
-:class:`~twodisk_ros.node.parameters.RollerSettings`, adds the equilibria and the contact
+:class:`~twodisk_ros.run.parameters.RollerSettings`, adds the equilibria and the contact
 forces, and samples everything the node publishes at a block of simulated times.
 """
 
@@ -14,7 +14,7 @@ from ..model.outline import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
 from ..physics.dynamics import PhaseState
-from ..run.description import RunDescription
+from .description import RunDescription
 from .scene_simulation import SceneMotion, flat_free
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
@@ -86,7 +86,7 @@ class Simulation:
     run : RunDescription, optional
         The description of these settings if already built (else built here).
     drive, command, start, carry, terms
-        A scene's motion (:class:`~twodisk_ros.node.scene_simulation.SceneMotion`): the drive
+        A scene's motion (:class:`~twodisk_ros.run.scene_simulation.SceneMotion`): the drive
         in force and its command, the state at t = 0 (a
         :class:`~twodisk_ros.physics.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
         ``omega0``), the work
