@@ -81,7 +81,10 @@ def _bisect(func, lo, hi, even=False):
     returned (the measured differences are a few ulps).
     """
     lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
-    f_lo, f_hi = np.asarray(func(lo), dtype=float), np.asarray(func(hi), dtype=float)
+    # the ends may be degenerate (the elevation equation at t = 0 and c = 0 asks a
+    # superellipse for h(0, 0) = 0, whose support point 0·∞ is not used): no warnings there
+    with np.errstate(divide='ignore', invalid='ignore'):
+        f_lo, f_hi = np.asarray(func(lo), dtype=float), np.asarray(func(hi), dtype=float)
     # an end where func already has the root's sign (0 included) is the answer: bisection
     # would creep towards it, down to the subnormals near 0 (~1075 steps)
     at_lo = f_lo >= 0
