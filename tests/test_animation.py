@@ -149,7 +149,7 @@ def test_legend_readable_at_the_demo_size(view):
     5 entries and lies inside the picture, below the view; its colours are the palette's."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from twodisk_ros.plotting import palette
+    from twodisk_ros.model import palette
     run = library_run(settings_from(REPO / 'config' / 'oloid.yaml'), stop=0.2, forces=True)
     figure = Figure(figsize=(4.8, 3.6), dpi=animation.DPI)
     FigureCanvasAgg(figure)

@@ -113,3 +113,24 @@ def test_no_module_reads_private_names_of_another(path):
 def test_modules_stay_small(path):
     lines = len(path.read_text(encoding='utf-8').splitlines())
     assert lines <= 520, f'{path.name} has {lines} lines: split it by concept'
+
+
+def test_import_linter_contracts_hold_and_place_every_module():
+    """The layers of .importlinter (import-linter: every import, deferred ones too), the
+    ROS-free and matplotlib-free rules; and every subpackage and top-level module of the
+    package has its place in the layers (a new one must be placed)."""
+    import configparser
+    config = configparser.ConfigParser()
+    config.read(REPO / '.importlinter', encoding='utf-8')
+    layers = config['importlinter:contract:layers']['layers'].split()
+    placed = {name.split('.', 1)[1] for name in layers if name != '|'}
+    present = {p.stem if p.is_file() else p.name for p in PACKAGE.iterdir()
+               if (p.suffix == '.py' and p.stem != '__init__')
+               or (p.is_dir() and (p / '__init__.py').is_file())}
+    assert placed == present, (sorted(present - placed), sorted(placed - present))
+    lint = Path(sys.executable).parent / 'lint-imports'
+    result = subprocess.run([str(lint), '--config', str(REPO / '.importlinter'),
+                             '--no-cache'], cwd=REPO, capture_output=True, text=True,
+                            timeout=120, env=ENV)
+    assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
+    assert 'Contracts: 3 kept, 0 broken.' in result.stdout, result.stdout[-2000:]

@@ -1,4 +1,4 @@
-"""The figure of ``twodisk-inspect --plot`` (plotting/inspection.py) shows what it says.
+"""The figure of ``twodisk-inspect --plot`` (inspect/figure.py) shows what it says.
 
 Recordings are made by the real node in batch mode (1 s, 100 Hz; in this process, domain
 14): the Two-Circle-Roller (constant height of G), the oloid driven at constant |ω|
@@ -18,8 +18,8 @@ from twodisk_ros.io.reader import read_recording
 from twodisk_ros.run.parameters import parse_recorded
 from twodisk_ros.physics.body import TwoDiskBody
 from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.plotting import palette
-from twodisk_ros.plotting.inspection import align_zeros, inspection_figure, plot_inspection
+from twodisk_ros.model import palette
+from twodisk_ros.inspect.figure import align_zeros, inspection_figure, plot_inspection
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RUNS = {

@@ -26,7 +26,7 @@ from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.stl import stl_bytes
 from twodisk_ros.model.urdf import body_description, robot_description
 from twodisk_ros.physics import TwoDiskBody, mass_properties
-from twodisk_ros.plotting import palette
+from twodisk_ros.model import palette
 
 # yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
 pytestmark = pytest.mark.filterwarnings('ignore:.*Scene.dump.*:DeprecationWarning')

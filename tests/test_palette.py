@@ -1,4 +1,4 @@
-"""One palette for every picture: plotting/palette.py, used by the figures, the inspection
+"""One palette for every picture: model/palette.py, used by the figures, the inspection
 plot, the animation and the RViz/Foxglove markers (which must not import matplotlib)."""
 
 import ast
@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from twodisk_ros.plotting import palette
+from twodisk_ros.model import palette
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / 'twodisk_ros'
@@ -20,7 +20,7 @@ NAMES = ('A', 'B', 'AB', 'G', 'FORCE', 'FORCE_PULLING', 'HULL', 'MU', 'INVALID',
 
 
 def test_palette_is_plain_hex_without_imports():
-    tree = ast.parse((PACKAGE / 'plotting' / 'palette.py').read_text(encoding='utf-8'))
+    tree = ast.parse((PACKAGE / 'model' / 'palette.py').read_text(encoding='utf-8'))
     assert not [node for node in ast.walk(tree) if isinstance(node, (ast.Import,
                                                                      ast.ImportFrom))]
     for name in NAMES:

@@ -37,7 +37,7 @@ from twodisk_ros.physics.contact_forces import ContactForceModel
 from twodisk_ros.physics.dynamics import RollingDynamics
 from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.motion import simulate
-from twodisk_ros.plotting import palette
+from twodisk_ros.model import palette
 
 REPO = Path(__file__).resolve().parents[1]
 OLOID = REPO / 'config' / 'oloid.yaml'

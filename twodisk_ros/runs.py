@@ -18,8 +18,8 @@ import numpy as np
 from .io.errors import one_line
 from .io.reader import read_recording
 from .model.outline import DEFAULT_TOLERANCE, disk_rims
-from .node.arguments import ArgumentError, params_file_values
 from .run.parameters import BY_NAME, DEFAULTS
+from .run.params_yaml import ArgumentError, params_file_values
 from .run.scene_simulation import flat_free
 from .run.simulation import Simulation
 from .physics.contact_forces import ContactForceModel

@@ -8,7 +8,10 @@
   from the poses (Newton–Euler) against the recorded wrenches, and the model's validity;
 - :mod:`~twodisk_ros.inspect.tf_check`: the body frame on /tf against the poses, bit for bit;
 - :mod:`~twodisk_ros.inspect.inspection`: :func:`inspect_recording`;
-- :mod:`~twodisk_ros.inspect.report`, :mod:`~twodisk_ros.inspect.cli`: output, command line.
+- :mod:`~twodisk_ros.inspect.status`: the verdicts and the exit status of each;
+- :mod:`~twodisk_ros.inspect.report`, :mod:`~twodisk_ros.inspect.figure`,
+  :mod:`~twodisk_ros.inspect.export`, :mod:`~twodisk_ros.inspect.cli`: the report, the figure
+  (``--plot``, matplotlib), the exported states, the command line.
 """
 
 import importlib

@@ -2,7 +2,7 @@
 
 Summary and checks of a recording, and its states as a table.
 
-Exit status (:mod:`twodisk_ros.inspect.results`): 0 PASS (every check passes and the run is
+Exit status (:mod:`twodisk_ros.inspect.status`): 0 PASS (every check passes and the run is
 all there), 1 FAIL (a check fails), 4 INCOMPLETE (every check passes on the recovered part,
 but the file is cut or damaged), 2 the file cannot be read, an output is refused (an existing
 file without ``--overwrite``, a wrong suffix, a missing directory) or cannot be written (one
@@ -17,12 +17,10 @@ import warnings
 
 from ..io.errors import RecordingError, one_line
 from ..outputs import OutputError, check_output, replacing
+from .status import EXIT_UNUSABLE, PROG
 
 # Light imports only up to here: ``--help`` and bad arguments answer without numpy, the
 # reader or the physics, which ``main`` imports once the arguments are parsed.
-PROG = 'twodisk-inspect'
-#: exit status of an unreadable file or a refused output (inspect.results.EXIT_STATUS)
-EXIT_UNUSABLE = 2
 
 __all__ = ['main']
 
@@ -157,7 +155,7 @@ def _run(args):
 def _write(option, inspection, path):
     """Write one output through a temporary file renamed over ``path`` when complete."""
     if option == 'plot':
-        from ..plotting.inspection import plot_inspection
+        from .figure import plot_inspection
         with replacing(path) as temporary:
             plot_inspection(inspection, temporary)
     else:

@@ -2,8 +2,7 @@
 
 import textwrap
 
-from .cli import PROG
-from .results import FAIL, INCOMPLETE
+from .status import FAIL, INCOMPLETE, PROG
 from .series import METADATA_NAME
 
 __all__ = ['PROG', 'format_report', 'run_phrase']

@@ -1,18 +1,5 @@
-"""The results of an inspection: checks with values and tolerances, the verdict, the report.
-
-The verdict of a recording and the exit status of ``twodisk-inspect``:
-
-``PASS`` (0)
-    every check passes and the run is all there (a run stopped early by a signal, whose file
-    the node closed, is all there: :mod:`~twodisk_ros.inspect.completeness`);
-``FAIL`` (1)
-    a check fails (whatever else: it takes precedence);
-``INCOMPLETE`` (4)
-    every check passes on what was recovered, but the run is not all there: the file is cut
-    (no footer) or damaged, or samples are missing inside it;
-
-and exit status 2 for a file that cannot be read or an output that cannot be written
-(:data:`EXIT_UNUSABLE`).
+"""The results of an inspection: checks with values and tolerances, the verdict
+(:mod:`~twodisk_ros.inspect.status`), the report.
 """
 
 from dataclasses import dataclass, field
@@ -20,15 +7,10 @@ import math
 
 import numpy as np
 
+from .status import EXIT_STATUS, EXIT_UNUSABLE, FAIL, INCOMPLETE, PASS
+
 __all__ = ['Check', 'EXIT_STATUS', 'EXIT_UNUSABLE', 'FAIL', 'INCOMPLETE', 'Inspection', 'PASS',
            'json_ready']
-
-PASS, FAIL, INCOMPLETE = 'PASS', 'FAIL', 'INCOMPLETE'
-#: Exit status of ``twodisk-inspect`` for each verdict.
-EXIT_STATUS = {PASS: 0, FAIL: 1, INCOMPLETE: 4}
-#: Exit status for a file that cannot be read, bad arguments or an output refused (defined
-#: with the command line, which answers bad arguments before importing this module).
-from .cli import EXIT_UNUSABLE  # noqa: E402
 
 
 @dataclass
@@ -83,7 +65,7 @@ class Inspection:
         recovered).
     checks : list of Check
     series : dict of str to numpy.ndarray
-        Time series for :func:`twodisk_ros.plotting.inspection.plot_inspection` (times in s
+        Time series for :func:`twodisk_ros.inspect.figure.plot_inspection` (times in s
         from the first stamp).
     samples : Samples or None
         The joined samples (:func:`~twodisk_ros.inspect.series.join_samples`).

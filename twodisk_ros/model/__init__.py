@@ -1,4 +1,4 @@
-"""The body as a robot description: disk frames, meshes and a URDF (no ROS, no plots).
+"""The body as a robot description: disk frames, meshes and a URDF (no ROS, no matplotlib).
 
 Any body: a TwoDiskBody (ellipses), a LaminaBody or a GeneralTwoDiskBody (any lamina).
 
@@ -8,5 +8,7 @@ Any body: a TwoDiskBody (ellipses), a LaminaBody or a GeneralTwoDiskBody (any la
 - :mod:`~twodisk_ros.model.frames`: the two disk frames relative to the body frame;
 - :mod:`~twodisk_ros.model.mesh`: triangle meshes of the laminae and of the solid hull;
 - :mod:`~twodisk_ros.model.stl`: binary STL, and the content-addressed mesh cache;
-- :mod:`~twodisk_ros.model.urdf`: the URDF published on ``robot_description``.
+- :mod:`~twodisk_ros.model.urdf`: the URDF published on ``robot_description``;
+- :mod:`~twodisk_ros.model.palette`: the colours of the body, its contacts and forces in
+  every picture and marker (plain hex strings).
 """

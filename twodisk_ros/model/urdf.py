@@ -28,7 +28,7 @@ import math
 from pathlib import Path
 from xml.etree import ElementTree
 
-from twodisk_ros.plotting import palette
+from . import palette
 
 from .frames import check_frame_id, disk_frames
 from .mesh import DEFAULT_RESOLUTION, mesh_parts

@@ -20,12 +20,12 @@ import re
 
 from ..run.parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
 from .usage import split_ros_args
-from ..run.params_yaml import ArgumentError, MAX_ENTRIES, at, flat, load_params_file, parse_value
+from ..run.params_yaml import (ArgumentError, MAX_ENTRIES, NODE_NAME, at, flat, load_params_file,
+                               params_file_values, parse_value)
 
 __all__ = ['ArgumentError', 'check_arguments', 'node_fqn', 'params_file_values',
            'rclpy_type_hint', 'type_problem']
 
-NODE_NAME = 'roller'
 UNKNOWN_SHOWN = 5            #: unknown names warned about one by one; the rest are counted
 _PARAM_FLAGS = ('-p', '--param')
 _FILE_FLAGS = ('--params-file',)
@@ -72,16 +72,6 @@ def _parse_override(text):
                             f"empty string is {name}:='')")
     parsed = parse_value(value, name, where)
     return (name if node in ('', NODE_NAME) else None), parsed
-
-
-def params_file_values(path, fqn='/' + NODE_NAME):
-    """{name: value} that a params file (rclpy's format) sets for this node, or ArgumentError.
-
-    Nested mappings are flattened to dotted names, as rclpy does; values are typed as rcl
-    types them (a list stays a list). The file is bounded (``params_yaml``'s limits).
-    """
-    loaded = load_params_file(path, fqn)
-    return {name: value.value for name, value in loaded.values.items()}
 
 
 def type_problem(parameter, value):

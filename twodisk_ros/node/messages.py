@@ -16,7 +16,7 @@ from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
 from ..io.cdr_markers import MarkerSpec
-from ..plotting import palette
+from ..model import palette
 
 JOINT_NAMES = ['theta', 'psi', 'phase']
 
@@ -80,7 +80,7 @@ def marker(frame_id, time_ns, spec):
 #: Marker ids of :func:`body_markers` (namespace ``twodisk``).
 MARKER_IDS = {'outline_1': 0, 'outline_2': 1, 'contact_line': 2, 'disk_1': 3, 'disk_2': 4,
               'hull': 5, 'ground': 6}
-#: disk 1 and disk 2 (r, g, b): the package's one palette (plotting/palette.py)
+#: disk 1 and disk 2 (r, g, b): the package's one palette (model/palette.py)
 DISK_COLORS = (palette.rgb(palette.A), palette.rgb(palette.B))
 
 

@@ -19,7 +19,7 @@ import textwrap
 
 import numpy as np
 
-from . import palette
+from ..model import palette
 from .frames import gif_frame as _gif_frame, render as _render
 from ..runs import Run, RunError, library_run
 

@@ -26,7 +26,7 @@ from ..physics.body import TwoDiskBody  # noqa: E402
 from ..physics.lamina import Egg, Superellipse  # noqa: E402
 from ..physics.lamina_body import LaminaBody  # noqa: E402
 from ..outputs import OutputError, check_output_dir, replacing  # noqa: E402
-from . import palette  # noqa: E402
+from ..model import palette  # noqa: E402
 from ..physics.cycle import RollingCycle  # noqa: E402
 from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 

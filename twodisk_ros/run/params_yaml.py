@@ -29,8 +29,12 @@ import stat
 
 import yaml
 
-__all__ = ['ArgumentError', 'MAX_BYTES', 'MAX_DEPTH', 'MAX_ENTRIES', 'ParamsFile', 'Value', 'at',
-           'flat', 'load_params_file', 'node_matches', 'parse_value', 'typed']
+__all__ = ['ArgumentError', 'MAX_BYTES', 'MAX_DEPTH', 'MAX_ENTRIES', 'NODE_NAME', 'ParamsFile',
+           'Value', 'at', 'flat', 'load_params_file', 'node_matches', 'params_file_values',
+           'parse_value', 'typed']
+
+#: The node's name: a parameter file's entries for ``/roller`` (or ``/**``) are the run's.
+NODE_NAME = 'roller'
 
 MAX_BYTES = 1 << 20          #: largest params file read (bytes)
 MAX_DEPTH = 32               #: deepest nesting of mappings and lists
@@ -337,7 +341,7 @@ def _read_text(path, where):
                             f'0x{data[error.start]:02x}); a params file is YAML text') from None
 
 
-def load_params_file(path, fqn='/roller'):
+def load_params_file(path, fqn='/' + NODE_NAME):
     """The :class:`ParamsFile` of ``path`` for the node named ``fqn``, or ArgumentError.
 
     Bounded: at most :data:`MAX_BYTES` read, :data:`MAX_ENTRIES` entries and :data:`MAX_DEPTH`
@@ -377,3 +381,13 @@ def parse_value(text, name, where):
         # an empty plain scalar (``---``): rcl finds no value there; '' is the empty string
         raise ArgumentError(f"{where}: no value (write '' for an empty string)")
     return Value(value.value, flat(text.strip()), 0)
+
+
+def params_file_values(path, fqn='/' + NODE_NAME):
+    """{name: value} that a params file (rclpy's format) sets for this node, or ArgumentError.
+
+    Nested mappings are flattened to dotted names, as rclpy does; values are typed as rcl
+    types them (a list stays a list). The file is bounded (this module's limits).
+    """
+    loaded = load_params_file(path, fqn)
+    return {name: value.value for name, value in loaded.values.items()}

@@ -7,7 +7,7 @@ parameters: the world frame ``frame_id`` (Z up, the ground z = 0), the body fram
 (centre of the disk, z normal to its plane, x along the common axis towards its far tip).
 Quaternions are (x, y, z, w), rotating child-frame components into parent-frame ones, as in
 ROS and in ``foxglove.FrameTransform``. Colours come from
-:mod:`twodisk_ros.plotting.palette` (plain hex strings, no matplotlib): disk 1 and A blue,
+:mod:`twodisk_ros.model.palette` (plain hex strings, no matplotlib): disk 1 and A blue,
 disk 2 and B orange, AB green.
 """
 
@@ -20,7 +20,7 @@ from foxglove.messages import (ArrowPrimitive, Color, FrameTransform, FrameTrans
                                Vector3)
 
 from ..model.outline import DEFAULT_TOLERANCE, frame_rims
-from ..plotting import palette
+from ..model import palette
 
 __all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows',
            'force_update', 'frame_transforms', 'timestamp', 'trace_update']

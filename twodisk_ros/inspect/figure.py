@@ -10,7 +10,7 @@ import os
 
 import numpy as np
 
-from . import palette
+from ..model import palette
 
 __all__ = ['plot_inspection', 'inspection_figure', 'invariant_drift', 'align_zeros']
 
@@ -258,7 +258,7 @@ def _recorded_state(inspection):
     The inspector's plot series do not carry the phase, so ``rolling_state`` is read again
     from the file (only that topic is decoded); any failure gives None (no drift drawn).
     """
-    from ..inspect.series import select_topics, extract_series, topic_role
+    from .series import select_topics, extract_series, topic_role
     from ..io.reader import read_recording
     try:
         recording = read_recording(inspection.summary['file'],
@@ -351,7 +351,7 @@ def _invalid_stretches(data):
     """The stretches outside the rolling model (lift-off, slip) from the recorded forces."""
     if 't_forces' not in data:
         return []
-    from ..inspect.forces import invalid_stretches
+    from .forces import invalid_stretches
     stretches = invalid_stretches(data['t_forces'], data['normal_a'], data['normal_b'],
                                   data['mu_required'], float(data['friction']))
     return stretches
