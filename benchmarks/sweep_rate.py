@@ -42,7 +42,8 @@ import numpy as np  # noqa: E402
 
 from twodisk_ros.sweep.batch import BATCH_STAGES  # noqa: E402
 from twodisk_ros.sweep.parts import PartsCache  # noqa: E402
-from twodisk_ros.sweep.quantities import STAGES, chunk_quantities, timed_chunk  # noqa: E402
+from twodisk_ros.sweep.chunks import chunk_quantities, timed_chunk  # noqa: E402
+from twodisk_ros.sweep.quantities import STAGES  # noqa: E402
 from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client  # noqa: E402
 from twodisk_ros.sweep.worker import SweepWorkerSetup  # noqa: E402
 

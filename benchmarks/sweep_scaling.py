@@ -50,7 +50,7 @@ if __name__ == '__main__':
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.sweep.quantities import chunk_quantities  # noqa: E402
+from twodisk_ros.sweep.chunks import chunk_quantities  # noqa: E402
 from twodisk_ros.sweep.request import BYTES_PER_TASK, DEFAULT_STORE_CHUNK_SIZE  # noqa: E402
 from twodisk_ros.sweep.spec import SweepSpec  # noqa: E402
 

@@ -14,7 +14,8 @@ from PIL import Image
 from rounding import ulps
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
-from twodisk_ros.model.outline import DEFAULT_TOLERANCE, disk_rims
+from twodisk_ros.model.frames import disk_rims
+from twodisk_ros.model.outline import DEFAULT_TOLERANCE
 from twodisk_ros.physics.general_body import GeneralTwoDiskBody
 from twodisk_ros.physics.lamina import Egg, Superellipse
 from twodisk_ros.plotting.animation import still

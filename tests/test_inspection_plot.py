@@ -73,7 +73,7 @@ def test_drift_panel_shows_the_recorded_energy_drift_not_the_fd_error(recordings
     inspection, figure = figures['tcr']
     settings, phase, rate = recorded_state(recordings['tcr'])
     dynamics = RollingDynamics(TwoDiskBody(settings.a, settings.b, settings.delta),
-                               settings.mass_properties(), settings.gravity)
+                               settings.ellipse_mass_properties(), settings.gravity)
     energy = dynamics.energy(phase, rate)
     reference = np.max(np.abs(energy - energy[0])) / dynamics.energy_scale
     drift = axes_named(figure, 'drift')

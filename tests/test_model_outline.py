@@ -21,9 +21,9 @@ import trimesh
 from scipy.spatial import ConvexHull
 
 from rounding import ulps
-from twodisk_ros.model.frames import disk_frames
+from twodisk_ros.model.frames import disk_frames, disk_rims
 from twodisk_ros.model.mesh import body_mesh, mesh_parts
-from twodisk_ros.model.outline import disk_rims, frame_rims, lamina_outline
+from twodisk_ros.model.outline import frame_rims, lamina_outline
 from twodisk_ros.model.stl import cached_stl
 from twodisk_ros.physics import TwoDiskBody
 from twodisk_ros.physics.general_body import GeneralTwoDiskBody

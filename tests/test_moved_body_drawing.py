@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from twodisk_ros.model.frames import disk_frames
-from twodisk_ros.model.outline import DEFAULT_TOLERANCE, disk_rims
+from twodisk_ros.model.frames import disk_rims
+from twodisk_ros.model.outline import DEFAULT_TOLERANCE
 from twodisk_ros.model.rulings import hull_rulings
 from twodisk_ros.physics.lamina import Egg
 from twodisk_ros.physics.lamina_body import LaminaBody

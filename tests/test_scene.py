@@ -24,8 +24,8 @@ from scipy.spatial.transform import Rotation
 from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
 from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.scene import Scene, quaternion_product
-from twodisk_ros.physics.scene_motion import (SceneStream, first_failure, scene_stream,
-                                              settle)
+from twodisk_ros.physics.scene_events import first_failure, settle
+from twodisk_ros.physics.scene_motion import SceneStream, scene_stream
 from twodisk_ros.physics.scene_terms import SceneTerms
 
 MASS, GRAVITY = 1.3, 9.81

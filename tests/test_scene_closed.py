@@ -26,8 +26,8 @@ from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.scene import Scene, command_error
 from twodisk_ros.physics.scene_closed import (DriftQuadrature, OscillationSolution,
                                               conservative_solution)
-from twodisk_ros.physics.scene_motion import (ClosedSceneStream, SceneStream, first_failure,
-                                              scene_stream, settle)
+from twodisk_ros.physics.scene_events import first_failure, settle
+from twodisk_ros.physics.scene_motion import ClosedSceneStream, SceneStream, scene_stream
 from twodisk_ros.physics.scene_terms import SceneTerms
 from twodisk_ros.physics.solvers import LibrationSolution
 

@@ -29,7 +29,8 @@ from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.physics.motion import simulate_phase
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_netcdf
-from twodisk_ros.sweep.quantities import VARIABLES, chunk_quantities
+from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.quantities import VARIABLES
 from twodisk_ros.sweep.run import SweepSpec, dask_client, parts_folder, run_sweep
 
 REPO = Path(__file__).resolve().parents[1]

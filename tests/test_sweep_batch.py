@@ -22,7 +22,8 @@ from twodisk_ros.physics.dynamics import RollingDynamics
 from twodisk_ros.physics.mass_models import mass_properties
 from twodisk_ros.sweep import batch
 from twodisk_ros.sweep.batch import batch_quantities
-from twodisk_ros.sweep.quantities import VARIABLES, body_quantities, chunk_quantities
+from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.quantities import VARIABLES, body_quantities
 
 #: Every quantity against the scalar path, relative (the issue's bound). Measured ≤ 5e-12
 #: over the seeded sample (liftoff_speed and mu_required, whose tables hold spectral

@@ -27,7 +27,8 @@ from twodisk_ros.sweep import general
 from twodisk_ros.sweep.batch import batch_quantities
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
-from twodisk_ros.sweep.quantities import VARIABLES, chunk_quantities
+from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.quantities import VARIABLES
 from twodisk_ros.sweep.request import EXPONENT_RANGE, SweepError, exponent_values
 from twodisk_ros.sweep.run import SweepSpec, run_sweep
 

@@ -17,7 +17,8 @@ import numpy as np
 
 from .io.errors import one_line
 from .io.reader import read_recording
-from .model.outline import DEFAULT_TOLERANCE, disk_rims
+from .model.frames import disk_rims
+from .model.outline import DEFAULT_TOLERANCE
 from .run.parameters import BY_NAME, DEFAULTS
 from .run.params_yaml import ArgumentError, params_file_values
 from .run.scene_simulation import flat_free
@@ -90,7 +91,7 @@ class Run:
         """World points (m) of both disk rims at sample ``index``: two closed arrays (N + 1, 3)
         (the last point the first), each starting at its disk's far tip and reaching the near
         tip at index N/2; the real outline of ``body.lamina`` to a polygon error of
-        ``tolerance`` × its size (:func:`~twodisk_ros.model.outline.disk_rims`)."""
+        ``tolerance`` × its size (:func:`~twodisk_ros.model.frames.disk_rims`)."""
         rims = self.__dict__.setdefault('_rims', {})
         if tolerance not in rims:
             rims[tolerance] = disk_rims(self.body, tolerance)

@@ -35,9 +35,9 @@ import math
 
 import numpy as np
 
-from .outline import body_shape
+from .outline import DEFAULT_TOLERANCE, body_shape, frame_rims
 
-__all__ = ['DiskFrame', 'disk_frames', 'check_frame_id', 'DISK_SUFFIXES']
+__all__ = ['DiskFrame', 'disk_frames', 'disk_rims', 'check_frame_id', 'DISK_SUFFIXES']
 
 #: The suffixes of the disk frames' names, after the body frame's: disk 1 (A), disk 2 (B).
 DISK_SUFFIXES = ('_disk_a', '_disk_b')
@@ -123,3 +123,19 @@ def disk_frames(body, body_frame='twodisk_body'):
         frames.append(DiskFrame(body_frame + suffix, arrays[0], arrays[1], body_frame,
                                 arrays[2]))
     return tuple(frames)
+
+
+def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
+    """Both rims in the body frame (m, from the body's origin G or P): (rim of disk 1, rim of disk 2), arrays
+    (N + 1, 3) with the last point the first (``closed``) or (N, 3).
+
+    Disk 1 lies in x3 = 0, disk 2 in x1 = 0; each starts at its far tip along e2 (−e2 for
+    disk 1, +e2 for disk 2) and reaches the near tip at index N/2.
+    """
+    rims = []
+    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance, outline)):
+        local = np.zeros((len(rim), 3))
+        local[:, :2] = rim
+        points = local @ frame.axes.T + frame.translation
+        rims.append(np.vstack([points, points[:1]]) if closed else points)
+    return tuple(rims)

@@ -170,20 +170,3 @@ def frame_rims(body, tolerance=DEFAULT_TOLERANCE, outline=None):
     if shape.sigma < 0:
         rim_2 = np.roll(rim_2, 1, axis=0)       # the tip s = 0 first again
     return rim_1, rim_2
-
-
-def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
-    """Both rims in the body frame (m, from the body's origin G or P): (rim of disk 1, rim of disk 2), arrays
-    (N + 1, 3) with the last point the first (``closed``) or (N, 3).
-
-    Disk 1 lies in x3 = 0, disk 2 in x1 = 0; each starts at its far tip along e2 (−e2 for
-    disk 1, +e2 for disk 2) and reaches the near tip at index N/2.
-    """
-    from .frames import disk_frames
-    rims = []
-    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance, outline)):
-        local = np.zeros((len(rim), 3))
-        local[:, :2] = rim
-        points = local @ frame.axes.T + frame.translation
-        rims.append(np.vstack([points, points[:1]]) if closed else points)
-    return tuple(rims)

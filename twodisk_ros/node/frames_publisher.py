@@ -63,8 +63,9 @@ class Description:
     problem: str | None = None
 
 
-def describe(settings, body):
-    """The :class:`Description` of checked ``settings`` and their ``TwoDiskBody``.
+def describe(settings, body, mass):
+    """The :class:`Description` of checked ``settings``, their body and its
+    :class:`~twodisk_ros.physics.mass_models.MassProperties` (the simulation's).
 
     The URDF's meshes are written to the mesh cache if missing
     (:func:`~twodisk_ros.model.urdf.body_description`). If the cache cannot be written
@@ -74,7 +75,6 @@ def describe(settings, body):
     frames = tuple((f.parent_frame_id, f.child_frame_id, tuple(map(float, f.translation)),
                     tuple(map(float, f.quaternion)))
                    for f in disk_frames(body, settings.body_frame))
-    mass = settings.mass_properties()
     try:
         return Description(frames, body_description(body, mass, settings.body_frame))
     except OutputError as error:

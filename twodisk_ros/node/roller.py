@@ -109,7 +109,8 @@ class Roller(Node):
                       for topic, kind in TOPIC_TYPES.items()}
         self._pubs[sim_clock.CLOCK_TOPIC] = self.create_publisher(
             Clock, sim_clock.CLOCK_TOPIC, sim_clock.CLOCK_QOS)     # published, not recorded
-        description = describe(self.settings, self.simulation.body)
+        description = describe(self.settings, self.simulation.body,
+                               self.simulation.dynamics.mass)
         if description.problem:
             self.get_logger().warn(description.problem)
         self._latched = LatchedTopics(self, description)
@@ -204,7 +205,8 @@ class Roller(Node):
             candidate = base.with_values(**changes).checked()
             simulation = (Simulation(candidate) if candidate.physics_differs(self.settings)
                           else None)
-            description = describe(candidate, (simulation or self.simulation).body)
+            built = simulation or self.simulation
+            description = describe(candidate, built.body, built.dynamics.mass)
         except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:
             return SetParametersResult(successful=False, reason=' '.join(str(error).split()))
         self._pending = (candidate, simulation, description)

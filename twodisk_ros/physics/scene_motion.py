@@ -57,8 +57,7 @@ from .scene_terms import DJ, DW, J, PW, QA, RHO, SceneTerms, W
 #: closed form over its first 1e-3 rad of u (SceneStream._leave_stop): t(τ) barely advances
 LEAVE_STOP = 1e-6
 
-__all__ = ['ClosedSceneStream', 'SceneStream', 'SceneSamples', 'scene_stream',
-           'simulate_scene', 'settle', 'first_failure']
+__all__ = ['ClosedSceneStream', 'SceneStream', 'SceneSamples', 'scene_stream']
 
 
 class SceneStream:
@@ -85,7 +84,7 @@ class SceneStream:
 
     The dense output of every segment reaching back to the earliest time of the latest
     call is kept, so :meth:`evaluate` gives the state at any time of that window (the root
-    finding of :func:`first_failure` and :func:`settle`).
+    finding of :func:`~.scene_events.first_failure` and :func:`~.scene_events.settle`).
     """
 
     def __init__(self, terms, u0, u_dot0, *, tolerance=1e-10, chunk=10.0, lookahead=0.5,
@@ -439,15 +438,3 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
             return ClosedSceneStream(terms, solution)
     return SceneStream(terms, u0, None, tolerance=tolerance, chunk=chunk,
                        lookahead=lookahead, angular_speed=omega0)
-
-
-def simulate_scene(terms, t_eval, u0, u_dot0, *, tolerance=1e-10):
-    """:class:`SceneSamples` of the general integrator at times ``t_eval`` (s, increasing, ≥ 0)."""
-    t_eval = np.asarray(t_eval, dtype=float)
-    stream = SceneStream(terms, u0, u_dot0, tolerance=tolerance,
-                         chunk=max(float(t_eval[-1]), 1e-3))
-    return stream.samples(t_eval)
-
-
-# the refined event times live in scene_events (they read SceneStream's dense output)
-from .scene_events import first_failure, settle  # noqa: E402  (re-exported, public API)

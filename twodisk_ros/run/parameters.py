@@ -243,7 +243,7 @@ def _check_together(s, outline=None):
             raise ValueError('principal_moments must be 3 numbers > 0 kg m^2 for '
                              f'mass_model custom, got {list(moments)!r}')
     if s.shape == 'ellipse':
-        s.mass_properties()   # the triangle inequalities of custom moments, the solid's quadrature
+        s.ellipse_mass_properties()   # custom moments: triangle inequalities; solid: quadrature
     elif s.mass_model == 'custom':
         custom(s.mass, s.principal_moments)   # the triangle inequalities (any shape)
     if s.drive != 'none' and s.mode != 'dynamic':
@@ -296,18 +296,16 @@ class _SettingsMethods:
             raise ValueError(f'unknown parameter {unknown[0]!r}')
         return replace(self, **{k: _check_one(BY_NAME[k], v) for k, v in values.items()})
 
-    def mass_properties(self, outline=None):
-        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of these settings.
-
-        Ellipses: the closed forms of a, b, delta. Other shapes: those of the run's body
-        (:meth:`twodisk_ros.run.description.RunDescription.mass`).
-        """
+    def ellipse_mass_properties(self):
+        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of ellipse settings:
+        the closed forms of a, b, delta. Other shapes: the run's body's
+        (:attr:`twodisk_ros.run.description.RunDescription.mass`)."""
+        if self.shape != 'ellipse':
+            raise ValueError(f'ellipse_mass_properties is for shape ellipse, not {self.shape}: '
+                             'the mass of another shape is RunDescription(settings).mass')
         moments = self.principal_moments if self.mass_model == 'custom' else None
-        if self.shape == 'ellipse':
-            return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
-                                   principal_moments=moments)
-        from .description import RunDescription
-        return RunDescription(self, outline).mass
+        return mass_properties(self.mass_model, self.a, self.b, self.delta, self.mass,
+                               principal_moments=moments)
 
     def as_strings(self):
         """Every parameter as text (the recording's metadata; read by :func:`parse_recorded`)."""

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.outline import disk_rims
+from ..model.frames import disk_rims
 from ..physics.contact_forces import ContactForceModel
 from ..physics.contact_validity import check_validity
 from ..physics.dynamics import PhaseState
@@ -314,7 +314,7 @@ class Simulation:
     def disk_outlines(self, rotation, position_g):
         """World points (m) of both disk outlines for one pose: two closed arrays (N + 1, 3),
         the real outline of the body's lamina to a polygon error of 2e-3 of its size
-        (:func:`~twodisk_ros.model.outline.disk_rims`, sampled once per body)."""
+        (:func:`~twodisk_ros.model.frames.disk_rims`, sampled once per body)."""
         rims = self.__dict__.get('_outline_rims')
         if rims is None:
             rims = self.__dict__['_outline_rims'] = disk_rims(self.body)

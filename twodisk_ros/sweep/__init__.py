@@ -1,6 +1,9 @@
 """Parameter sweeps over the family of bodies, on Dask: ``twodisk-sweep`` and its library.
 
-- :mod:`~twodisk_ros.sweep.quantities`: what is computed for the bodies of a task (no Dask);
+- :mod:`~twodisk_ros.sweep.quantities`: what is computed for one body (no Dask);
+- :mod:`~twodisk_ros.sweep.chunks`: one task, a chunk of bodies on the path that fits it (the
+  batched ellipse, :mod:`~twodisk_ros.sweep.batch`, or the per-body general path,
+  :mod:`~twodisk_ros.sweep.general`);
 - :mod:`~twodisk_ros.sweep.spec`: the grid, the options and the blocks (one task each);
 - :mod:`~twodisk_ros.sweep.run`: the Dask tasks, results, progress and resume;
 - :mod:`~twodisk_ros.sweep.store`: the Zarr store, written by the workers, its own resume state;
@@ -15,5 +18,5 @@ Units: a = 1, g = 1, M = 1, so lengths are in a, times in √(a/g) and angular s
 (docs/sweeps.md). Dask and xarray are imported only by the modules that need them.
 """
 
-__all__ = ['quantities', 'spec', 'run', 'store', 'worker', 'parts', 'dataset', 'progress',
+__all__ = ['quantities', 'chunks', 'spec', 'run', 'store', 'worker', 'parts', 'dataset', 'progress',
            'request', 'cli']

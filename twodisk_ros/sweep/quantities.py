@@ -5,8 +5,9 @@ of a, times in units of √(a/g), angular speeds in units of √(g/a) (a = 1 m, 
 M = 1 kg in the library calls). In :func:`body_quantities` each quantity is one call of the
 physics library (:mod:`twodisk_ros.physics`): the scalar reference path, which agrees bitwise
 with the same call made directly (docs/sweeps.md lists the variables and their definitions).
-A sweep's tasks (:func:`chunk_quantities`) compute the same quantities for a whole chunk at
-once as arrays (:mod:`~twodisk_ros.sweep.batch`), to ≤ 1e-10 relative of the scalar path.
+A sweep's tasks (:func:`~twodisk_ros.sweep.chunks.chunk_quantities`) compute the same
+quantities for a whole chunk at once as arrays (:mod:`~twodisk_ros.sweep.batch`), to ≤ 1e-10
+relative of the scalar path.
 
 A body that cannot be built or whose computation fails is not an error of the sweep: its
 quantities from the failing stage on are NaN and ``failure`` says why, in one line.
@@ -31,8 +32,7 @@ from ..physics.mass_models import mass_properties
 from .request import ELLIPSE_EXPONENT
 
 __all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities', 'run_stages',
-           'shape_failure', 'chunk_quantities', 'timed_chunk', 'contact_length_range',
-           'cycle_time', 'one_line']
+           'shape_failure', 'contact_length_range', 'cycle_time', 'one_line']
 
 #: name → (units, description), in the order of the output; units with a = g = M = 1.
 VARIABLES = {
@@ -241,81 +241,3 @@ def _equilibria_stage(state, values, mass_model, b, d):
     omega_u = float(dynamics.angular_speed_per_phase(u_star))
     # ½ m(u*) u̇² = M g ΔH with M = g = 1, then |ω| = |ω_u(u*)| u̇
     values['rollover_speed'] = omega_u * math.sqrt(2.0 * barrier / m_star)
-
-
-def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
-                     timings=None, method='batch', exponent=ELLIPSE_EXPONENT,
-                     body_factory=None, mass_factory=None):
-    """:func:`body_quantities` over paired 1-D arrays of b/a and Δ/a (one task of a sweep).
-
-    Parameters
-    ----------
-    method : str
-        'batch' (default): all bodies at once as arrays (:mod:`~twodisk_ros.sweep.batch`,
-        ≤ 1e-10 relative from the scalar path, docs/sweeps.md); 'scalar':
-        :func:`body_quantities` body by body (the reference). ``timings`` gets the stages of
-        the chosen path (:data:`~twodisk_ros.sweep.batch.BATCH_STAGES` or :data:`STAGES`).
-        Ignored for an exponent other than 2 or with a ``body_factory``.
-    exponent : float
-        Superellipse exponent n of every body of the chunk: 2 (the ellipse, default) takes
-        ``method``; any other n, or a ``body_factory``, the per-body general path
-        (:func:`~twodisk_ros.sweep.general.general_body_quantities`, its stages in
-        ``timings``).
-    body_factory, mass_factory : callable, optional
-        ``body_factory(b, delta, n)`` → RollingBody and ``mass_factory(model, body)`` →
-        MassProperties (M = 1) of the general path (default: superellipse laminae,
-        ``LaminaBody``; tests pass their own).
-
-    Returns
-    -------
-    dict
-        name → float64 array for every name of :data:`VARIABLES`, and ``failure`` → list of
-        str, all of the length of the inputs.
-    """
-    if exponent != ELLIPSE_EXPONENT or body_factory is not None:
-        return _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed,
-                              timings, body_factory, mass_factory)
-    if method == 'batch':
-        from .batch import batch_quantities     # batch builds on this module (its fallback)
-        return batch_quantities(b_values, delta_values, mass_model, reference_speed, timings)
-    if method != 'scalar':
-        raise ValueError(f"method must be 'batch' or 'scalar', got {method!r}")
-    b_values = np.asarray(b_values, dtype=float).ravel()
-    delta_values = np.asarray(delta_values, dtype=float).ravel()
-    out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
-    failures = []
-    for k, (b, d) in enumerate(zip(b_values, delta_values)):
-        values, failure = body_quantities(b, d, mass_model, reference_speed, timings)
-        for name, value in values.items():
-            out[name][k] = value
-        failures.append(failure)
-    out['failure'] = failures
-    return out
-
-
-def _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed, timings,
-                   body_factory, mass_factory):
-    """:func:`chunk_quantities` on the per-body general path (one body after the other)."""
-    from .general import general_body_quantities
-    b_values = np.asarray(b_values, dtype=float).ravel()
-    delta_values = np.asarray(delta_values, dtype=float).ravel()
-    out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
-    failures = []
-    for k, (b, d) in enumerate(zip(b_values, delta_values)):
-        values, failure = general_body_quantities(b, d, exponent, mass_model, reference_speed,
-                                                  timings, body_factory, mass_factory)
-        for name, value in values.items():
-            out[name][k] = value
-        failures.append(failure)
-    out['failure'] = failures
-    return out
-
-
-def timed_chunk(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
-                exponent=ELLIPSE_EXPONENT):
-    """(:func:`chunk_quantities` (...), wall time, CPU time of the process in s): one task
-    (one exponent n)."""
-    start, cpu = time.perf_counter(), time.process_time()
-    result = chunk_quantities(b_values, delta_values, mass_model, reference_speed,
-                              exponent=exponent)
-    return result, time.perf_counter() - start, time.process_time() - cpu

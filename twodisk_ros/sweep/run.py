@@ -2,10 +2,10 @@
 
 The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`), each of one
 exponent n; each block is one Dask task on a worker (the batched path for n = 2, the per-body
-general path otherwise: :func:`~twodisk_ros.sweep.quantities.chunk_quantities`). Where the
+general path otherwise: :func:`~twodisk_ros.sweep.chunks.chunk_quantities`). Where the
 results go depends on the output's suffix:
 
-- ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.quantities.timed_chunk`) sends
+- ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.chunks.timed_chunk`) sends
   its block's values back to the client, which saves each finished block in the resume cache
   (:class:`~twodisk_ros.sweep.parts.PartsCache`, ``FILE.nc.parts/``) and writes the NetCDF
   file at the end. Workers need no shared file system; the client holds the whole map.
@@ -43,7 +43,8 @@ from ..outputs import OutputError, check_output
 from .dataset import build_dataset, write_netcdf
 from .parts import PartsCache, parts_folder
 from .progress import SweepProgress
-from .quantities import VARIABLES, timed_chunk
+from .chunks import timed_chunk
+from .quantities import VARIABLES
 from .request import DEFAULT_CHUNK_SIZE, SweepError, linspace_grid, output_format, store_plan
 from .spec import SweepSpec
 

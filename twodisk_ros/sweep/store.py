@@ -34,7 +34,8 @@ import warnings
 import numpy as np
 
 from .dataset import COMPUTED, template_dataset
-from .quantities import VARIABLES, timed_chunk
+from .chunks import timed_chunk
+from .quantities import VARIABLES
 from .request import STORE_MANIFEST, STORE_STATE
 
 __all__ = ['create_store', 'remove_store', 'complete_blocks', 'write_block', 'finish_store',
@@ -116,7 +117,7 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     b_values, delta_values : 1-D arrays
         The grid values of those rows and columns.
     mass_model, reference_speed, exponent
-        As :func:`~twodisk_ros.sweep.quantities.chunk_quantities` (``exponent``: the block's
+        As :func:`~twodisk_ros.sweep.chunks.chunk_quantities` (``exponent``: the block's
         n).
 
     Returns
