@@ -43,6 +43,7 @@ import numpy as np
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 from .lamina import Ellipse
 from .rolling_body import RollingBody
+from .vectors import cross, vector
 
 __all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
 
@@ -120,15 +121,17 @@ class TwoDiskForms:
         f2 = a * d + b * cos_t * (2 * delta - a)
         return big_l * f2
 
-    def _geometry(self, theta, cos_t, sin_t, sq):
+    def _geometry(self, theta, cos_t, sin_t, sq, d=None):
         """Closed forms from θ and σ√Q (works for complex arguments)."""
-        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq)
-        return tuple(np.stack(v, axis=-1) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
+        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq, d)
+        return tuple(vector(*v) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
 
-    def _geometry_components(self, cos_t, sin_t, sq):
-        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components."""
+    def _geometry_components(self, cos_t, sin_t, sq, d=None):
+        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components
+        (``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
         a, b, delta = self.a, self.b, self.delta
-        d = self._ellipse_terms(cos_t, sin_t)
+        if d is None:
+            d = self._ellipse_terms(cos_t, sin_t)
         rho = a * b / d
         zero = np.zeros_like(rho)
         r1 = [rho * sin_t, -(delta + rho * cos_t), zero]
@@ -144,9 +147,10 @@ class TwoDiskForms:
         a, b = self.a, self.b
         planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
         norm_n = np.sqrt(planar2 + sq * sq)
-        n = [-a * a * sin_t / norm_n, b * b * cos_t / norm_n, sq / norm_n]
+        b2_cos = b * b * cos_t
+        n = [-a * a * sin_t / norm_n, b2_cos / norm_n, sq / norm_n]
         planar = np.sqrt(planar2)
-        return n, [b * b * cos_t / planar, a * a * sin_t / planar], planar, norm_n
+        return n, [b2_cos / planar, a * a * sin_t / planar], planar, norm_n
 
     def _theta_array(self, theta):
         theta = np.asarray(theta, dtype=float)
@@ -180,24 +184,24 @@ class TwoDiskForms:
         a, b = self.a, self.b
         eta_m, tm = self._eta_max, self.theta_max
         w = np.sin(u)
-        sign_w = np.where(np.real(w) < 0, -1.0, 1.0)
+        sign_w = np.where(w.real < 0, -1.0, 1.0)
         abs_w = w * sign_w
         abs_eta = eta_m * abs_w
-        e = np.sqrt(a * a * np.cos(abs_eta) ** 2 + b * b * np.sin(abs_eta) ** 2)
+        cos_eta, sin_eta = np.cos(abs_eta), np.sin(abs_eta)
+        e = np.sqrt(a * a * cos_eta ** 2 + b * b * sin_eta ** 2)
         e_m = self._e_max
-        cos_t = a * np.cos(abs_eta) / e
-        sin_abs = b * np.sin(abs_eta) / e
+        cos_t = a * cos_eta / e
+        sin_abs = b * sin_eta / e
         # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
         v_over_c2 = eta_m / (1 + abs_w)
         v = v_over_c2 * np.cos(u) ** 2
-        x = (a * a * np.cos(abs_eta) * self._cos_eta_max
-             + b * b * np.sin(abs_eta) * self._sin_eta_max)
+        x = a * a * cos_eta * self._cos_eta_max + b * b * sin_eta * self._sin_eta_max
         # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
         denom = e * e_m + x
         t = a * b * np.sin(v) / denom
         # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
         # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
-        near_axis = np.real(abs_eta) < 1.0
+        near_axis = abs_eta.real < 1.0
         tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
         abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
         j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
@@ -216,10 +220,12 @@ class TwoDiskForms:
         _, cos_t, sin_t, j = self.phase_angles(u)
         return self._phase_sqrt_q(u, cos_t, sin_t, j)
 
-    def _phase_sqrt_q(self, u, cos_t, sin_t, j):
-        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe)."""
-        cofactor = self._q_cofactor(cos_t, self._ellipse_terms(cos_t, sin_t))
-        return np.cos(u) * np.sqrt(j * cofactor)
+    def _phase_sqrt_q(self, u, cos_t, sin_t, j, d=None):
+        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe;
+        ``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
+        if d is None:
+            d = self._ellipse_terms(cos_t, sin_t)
+        return np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
 
     def phase_vectors(self, u):
         """(r1, r2, n, t1, z_G, planar, |N|, θ, σ√Q) at phase u, body frame (complex-safe).
@@ -228,19 +234,21 @@ class TwoDiskForms:
         z_G (m) and the unnormalised lengths of the normal; for complex-step derivatives.
         """
         theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
-        return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
+        return self._geometry(theta, cos_t, sin_t, sq, d) + (theta, sq)
 
     def phase_geometry(self, u):
         """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
         u = np.asarray(u, dtype=float)
         theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
         branch = np.where(np.cos(u) < 0, -1.0, 1.0)
-        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
+        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch, d)
 
-    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch):
-        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq)
+    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch, d=None):
+        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq, d)
         psi = np.arctan2(sq, -self.a**2 * cos_t)
         tilt = np.arctan2(planar, sq)
         return PhaseGeometry(phase=u, theta=theta, psi=psi, branch=branch, signed_sqrt_q=sq,
@@ -296,16 +304,22 @@ class TwoDiskForms:
         ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
         """
         u = np.asarray(u, dtype=float)
-        vec = self.phase_vectors(u + 1j * COMPLEX_STEP)
-        return self._angular_velocity(vec[2], vec[3], self.phase_rates(u)[1])
+        n, t1 = self._phase_frame(u + 1j * COMPLEX_STEP)
+        return self._angular_velocity(n, t1, self.phase_rates(u)[1])
+
+    def _phase_frame(self, u):
+        """(n, t1) of :meth:`phase_vectors` at phase(s) u alone (complex-safe)."""
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        n, t1, planar, _ = self._frame(cos_t, sin_t, self._phase_sqrt_q(u, cos_t, sin_t, j))
+        return vector(*n), vector(*t1, np.zeros_like(planar) / planar)
 
     @staticmethod
     def _angular_velocity(n, t1, dalpha):
         """ω_u from n and t1 at u + ih (complex, :data:`COMPLEX_STEP`) and dα/du at u."""
-        m = np.cross(n, t1)
+        m = cross(n, t1)
         n_re, t1_re, m_re = n.real, t1.real, m.real
         dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))
-        frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
+        frame_rate = 0.5 * (cross(n_re, dn) + cross(t1_re, dt1) + cross(m_re, dm))
         return dalpha[..., None] * n_re - frame_rate
 
 
