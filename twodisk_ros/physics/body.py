@@ -130,16 +130,19 @@ class TwoDiskForms:
         """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components
         (``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
         a, b, delta = self.a, self.b, self.delta
-        if d is None:
-            d = self._ellipse_terms(cos_t, sin_t)
-        rho = a * b / d
-        zero = np.zeros_like(rho)
-        r1 = [rho * sin_t, -(delta + rho * cos_t), zero]
+        d = self._ellipse_terms(cos_t, sin_t) if d is None else d
+        r1 = self._contact_a(cos_t, sin_t, d)
+        zero = r1[2]
         e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
         r2 = [zero, delta - a * a * b * cos_t / e, -b * sq / e]
         n, t1, planar, norm_n = self._frame(cos_t, sin_t, sq)
         height = b * (a * d + delta * b * cos_t) / norm_n
         return r1, r2, n, t1 + [zero / planar], height, planar, norm_n
+
+    def _contact_a(self, cos_t, sin_t, d):
+        """The components of r1 = GA (m) from θ and D = :meth:`_ellipse_terms` (ρ = ab/D)."""
+        rho = self.a * self.b / d
+        return [rho * sin_t, -(self.delta + rho * cos_t), np.zeros_like(rho)]
 
     def _frame(self, cos_t, sin_t, sq):
         """The components of n (three) and of t1 (the first two; the third is 0), the planar
@@ -223,8 +226,7 @@ class TwoDiskForms:
     def _phase_sqrt_q(self, u, cos_t, sin_t, j, d=None):
         """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe;
         ``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
-        if d is None:
-            d = self._ellipse_terms(cos_t, sin_t)
+        d = self._ellipse_terms(cos_t, sin_t) if d is None else d
         return np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
 
     def phase_vectors(self, u):
@@ -304,18 +306,23 @@ class TwoDiskForms:
         ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
         """
         u = np.asarray(u, dtype=float)
-        n, t1 = self._phase_frame(u + 1j * COMPLEX_STEP)
-        return self._angular_velocity(n, t1, self.phase_rates(u)[1])
+        return self._angular_velocity(u, self.phase_rates(u)[1])
 
-    def _phase_frame(self, u):
-        """(n, t1) of :meth:`phase_vectors` at phase(s) u alone (complex-safe)."""
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at real
+        phase(s) u (RollingBody), from one evaluation of the real closed forms."""
+        u = np.asarray(u, dtype=float)
         _, cos_t, sin_t, j = self.phase_angles(u)
-        n, t1, planar, _ = self._frame(cos_t, sin_t, self._phase_sqrt_q(u, cos_t, sin_t, j))
-        return vector(*n), vector(*t1, np.zeros_like(planar) / planar)
+        d = self._ellipse_terms(cos_t, sin_t)
+        dalpha = self._rates(u, cos_t, sin_t, self._phase_sqrt_q(u, cos_t, sin_t, j, d))[1]
+        return self._angular_velocity(u, dalpha), vector(*self._contact_a(cos_t, sin_t, d))
 
-    @staticmethod
-    def _angular_velocity(n, t1, dalpha):
-        """ω_u from n and t1 at u + ih (complex, :data:`COMPLEX_STEP`) and dα/du at u."""
+    def _angular_velocity(self, u, dalpha):
+        """ω_u at real u from n and t1 at u + ih (:data:`COMPLEX_STEP`) and dα/du at u."""
+        uc = u + 1j * COMPLEX_STEP
+        _, cos_t, sin_t, j = self.phase_angles(uc)
+        n, t1, planar, _ = self._frame(cos_t, sin_t, self._phase_sqrt_q(uc, cos_t, sin_t, j))
+        n, t1 = vector(*n), vector(*t1, np.zeros_like(planar) / planar)  # as phase_vectors
         m = cross(n, t1)
         n_re, t1_re, m_re = n.real, t1.real, m.real
         dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))

@@ -89,8 +89,7 @@ class RollingDynamics:
     def effective_mass(self, u):
         """m(u) (kg m²/rad²): T = ½ m(u) u̇²."""
         u = np.asarray(u, dtype=float)
-        omega = self.body.phase_angular_velocity(u)
-        r1 = self.body.phase_geometry(u).contact_a
+        omega, r1 = self.body.phase_angular_velocity_and_contact(u)
         v = cross(omega, r1)
         inertia = self.mass.inertia
         return (np.einsum('...i,ij,...j->...', omega, inertia, omega)

@@ -267,7 +267,18 @@ class LaminaBody(RollingBody):
         """ω_u (rad per rad of u, body frame): α′ n − ½ Σ b_i × b_i′ over the contact frame
         (t1, n × t1, n), derivatives from the table."""
         u = np.asarray(u, dtype=float)
-        f, df = self._values(u), self._table(np.mod(u, TWO_PI), 1)
+        return self._angular_velocity(u, self._values(u))
+
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at real
+        phase(s) u (RollingBody), from one evaluation of the table at u."""
+        u = np.asarray(u, dtype=float)
+        f = self._values(u)
+        return self._angular_velocity(u, f), self._vectors(f)[0]
+
+    def _angular_velocity(self, u, f):
+        """ω_u at real phase(s) u from the table's columns f there."""
+        df = self._table(np.mod(u, TWO_PI), 1)
         _, _, n, t1, _ = self._vectors(f + 1j * COMPLEX_STEP * df)
         m = cross(n, t1)
         frame = 0.5 * sum(cross(x.real, x.imag / COMPLEX_STEP) for x in (n, t1, m))

@@ -80,6 +80,11 @@ class RollingBody(abc.ABC):
     def phase_angular_velocity(self, u):
         """ω_u (rad per rad of u, body frame, u.shape + (3,)): the angular velocity per u̇."""
 
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at
+        real phase(s) u, what the kinetic energy needs (bodies may share the evaluations)."""
+        return self.phase_angular_velocity(u), self.phase_geometry(u).contact_a
+
     @abc.abstractmethod
     def phase_angles_with_rates(self, u):
         """(θ, ψ, dθ/du, dψ/du) at real phase(s) u."""
