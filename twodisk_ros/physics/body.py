@@ -35,14 +35,13 @@ Accuracy (measured by the tests against independent constructions).
   (4096 at Δ/a = 1e-3, resolved automatically); below Δ/a ≈ 1e-6 expect degraded accuracy.
 """
 
-from dataclasses import dataclass
 import math
 
 import numpy as np
 
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 from .lamina import Ellipse
-from .rolling_body import RollingBody
+from .rolling_body import PhaseGeometry, RollingBody
 from .vectors import cross, vector
 
 __all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
@@ -66,25 +65,6 @@ def _check_parameter(name, value, low, high, rule):
         raise ValueError(f'{name} must be finite and {rule}, got {value!r}')
     return value
 
-
-@dataclass(frozen=True)
-class PhaseGeometry:
-    """Body-frame geometry at cycle phases ``u`` (arrays broadcast with ``u``).
-
-    Vectors have shape ``u.shape + (3,)`` and are in the body frame (metres or unit).
-    """
-
-    phase: np.ndarray           #: u (rad)
-    theta: np.ndarray           #: θ (rad), contact angle on disk 1
-    psi: np.ndarray             #: ψ (rad), contact angle on disk 2
-    branch: np.ndarray          #: +1 / −1 (sign of cos u; +1 at the turning points)
-    signed_sqrt_q: np.ndarray   #: σ√Q (m⁴)
-    contact_a: np.ndarray       #: r1 = GA (m)
-    contact_b: np.ndarray       #: r2 = GB (m)
-    ground_normal: np.ndarray   #: n, unit, the world's up direction seen in the body frame
-    tangent_a: np.ndarray       #: unit tangent of disk 1 at A (direction of increasing θ)
-    height: np.ndarray          #: z_G = −r1·n (m), the potential energy per unit M g
-    tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
 class TwoDiskForms:
     """The closed forms of the body in the cycle phase u, for one body or for a batch.
@@ -136,8 +116,15 @@ class TwoDiskForms:
         e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
         r2 = [zero, delta - a * a * b * cos_t / e, -b * sq / e]
         n, t1, planar, norm_n = self._frame(cos_t, sin_t, sq)
-        height = b * (a * d + delta * b * cos_t) / norm_n
-        return r1, r2, n, t1 + [zero / planar], height, planar, norm_n
+        return r1, r2, n, t1 + [zero / planar], self._height(cos_t, d, norm_n), planar, norm_n
+
+    def _height(self, cos_t, d, norm_n):
+        """z_G = b (a D + Δ b cos θ) / |N| (m) from θ, D and |N| (:meth:`_frame`)."""
+        return self.b * (self.a * d + self.delta * self.b * cos_t) / norm_n
+
+    def _planar2(self, cos_t, sin_t):
+        """a⁴ sin²θ + b⁴ cos²θ (m⁸): the squared norm of N's first two components."""
+        return self.a**4 * sin_t * sin_t + self.b**4 * cos_t * cos_t
 
     def _contact_a(self, cos_t, sin_t, d):
         """The components of r1 = GA (m) from θ and D = :meth:`_ellipse_terms` (ρ = ab/D)."""
@@ -148,7 +135,7 @@ class TwoDiskForms:
         """The components of n (three) and of t1 (the first two; the third is 0), the planar
         norm and |N|, from θ and σ√Q (complex-safe)."""
         a, b = self.a, self.b
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        planar2 = self._planar2(cos_t, sin_t)
         norm_n = np.sqrt(planar2 + sq * sq)
         b2_cos = b * b * cos_t
         n = [-a * a * sin_t / norm_n, b2_cos / norm_n, sq / norm_n]
@@ -258,8 +245,11 @@ class TwoDiskForms:
                              height=height, tilt=tilt)
 
     def phase_height(self, u):
-        """z_G(u) (m), analytic in u."""
-        return self.phase_vectors(u)[4]
+        """z_G(u) (m), analytic in u (the height of :meth:`phase_vectors`, alone)."""
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
+        return self._height(cos_t, d, np.sqrt(self._planar2(cos_t, sin_t) + sq * sq))
 
     def _psi_half_angle(self, u):
         """ψ(u) = 2 arctan(sin ψ / (1 + cos ψ)), analytic in u (|ψ| < π over the cycle)."""
@@ -295,8 +285,7 @@ class TwoDiskForms:
         speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
         ds_du = np.sqrt(speed2) * self._eta_max * np.cos(u)
         k = a * b / speed2**1.5
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
-        cos_phi = sq / np.sqrt(planar2 + sq * sq)
+        cos_phi = sq / np.sqrt(self._planar2(cos_t, sin_t) + sq * sq)
         return ds_du, k * cos_phi * ds_du
 
     def phase_angular_velocity(self, u):
