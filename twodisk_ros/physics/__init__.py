@@ -19,7 +19,8 @@ Modules, from geometry to motion (docs/physics.md derives each):
   bodies (:mod:`~twodisk_ros.physics.rolling_body`: the protocol the cycle, dynamics, forces
   and equilibria read, which :class:`TwoDiskBody` implements with its closed forms);
 - :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
-  :mod:`~twodisk_ros.physics.tables`: the numerical tools they share.
+  :mod:`~twodisk_ros.physics.tables`, :mod:`~twodisk_ros.physics.vectors`: the numerical
+  tools they share.
 """
 
 from .body import PhaseGeometry, TwoDiskBody

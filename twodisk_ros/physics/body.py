@@ -35,14 +35,14 @@ Accuracy (measured by the tests against independent constructions).
   (4096 at Δ/a = 1e-3, resolved automatically); below Δ/a ≈ 1e-6 expect degraded accuracy.
 """
 
-from dataclasses import dataclass
 import math
 
 import numpy as np
 
 from .analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
 from .lamina import Ellipse
-from .rolling_body import RollingBody
+from .rolling_body import PhaseGeometry, RollingBody
+from .vectors import cross, vector
 
 __all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
 
@@ -65,25 +65,6 @@ def _check_parameter(name, value, low, high, rule):
         raise ValueError(f'{name} must be finite and {rule}, got {value!r}')
     return value
 
-
-@dataclass(frozen=True)
-class PhaseGeometry:
-    """Body-frame geometry at cycle phases ``u`` (arrays broadcast with ``u``).
-
-    Vectors have shape ``u.shape + (3,)`` and are in the body frame (metres or unit).
-    """
-
-    phase: np.ndarray           #: u (rad)
-    theta: np.ndarray           #: θ (rad), contact angle on disk 1
-    psi: np.ndarray             #: ψ (rad), contact angle on disk 2
-    branch: np.ndarray          #: +1 / −1 (sign of cos u; +1 at the turning points)
-    signed_sqrt_q: np.ndarray   #: σ√Q (m⁴)
-    contact_a: np.ndarray       #: r1 = GA (m)
-    contact_b: np.ndarray       #: r2 = GB (m)
-    ground_normal: np.ndarray   #: n, unit, the world's up direction seen in the body frame
-    tangent_a: np.ndarray       #: unit tangent of disk 1 at A (direction of increasing θ)
-    height: np.ndarray          #: z_G = −r1·n (m), the potential energy per unit M g
-    tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
 class TwoDiskForms:
     """The closed forms of the body in the cycle phase u, for one body or for a batch.
@@ -120,33 +101,46 @@ class TwoDiskForms:
         f2 = a * d + b * cos_t * (2 * delta - a)
         return big_l * f2
 
-    def _geometry(self, theta, cos_t, sin_t, sq):
+    def _geometry(self, theta, cos_t, sin_t, sq, d=None):
         """Closed forms from θ and σ√Q (works for complex arguments)."""
-        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq)
-        return tuple(np.stack(v, axis=-1) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
+        r1, r2, n, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t, sq, d)
+        return tuple(vector(*v) for v in (r1, r2, n, t1)) + (height, planar, norm_n)
 
-    def _geometry_components(self, cos_t, sin_t, sq):
-        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components."""
+    def _geometry_components(self, cos_t, sin_t, sq, d=None):
+        """:meth:`_geometry` with r1, r2, n and t1 as lists of their three components
+        (``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
         a, b, delta = self.a, self.b, self.delta
-        d = self._ellipse_terms(cos_t, sin_t)
-        rho = a * b / d
-        zero = np.zeros_like(rho)
-        r1 = [rho * sin_t, -(delta + rho * cos_t), zero]
+        d = self._ellipse_terms(cos_t, sin_t) if d is None else d
+        r1 = self._contact_a(cos_t, sin_t, d)
+        zero = r1[2]
         e = a * d + 2 * b * delta * cos_t  # > 0 over the whole range
         r2 = [zero, delta - a * a * b * cos_t / e, -b * sq / e]
         n, t1, planar, norm_n = self._frame(cos_t, sin_t, sq)
-        height = b * (a * d + delta * b * cos_t) / norm_n
-        return r1, r2, n, t1 + [zero / planar], height, planar, norm_n
+        return r1, r2, n, t1 + [zero / planar], self._height(cos_t, d, norm_n), planar, norm_n
+
+    def _height(self, cos_t, d, norm_n):
+        """z_G = b (a D + Δ b cos θ) / |N| (m) from θ, D and |N| (:meth:`_frame`)."""
+        return self.b * (self.a * d + self.delta * self.b * cos_t) / norm_n
+
+    def _planar2(self, cos_t, sin_t):
+        """a⁴ sin²θ + b⁴ cos²θ (m⁸): the squared norm of N's first two components."""
+        return self.a**4 * sin_t * sin_t + self.b**4 * cos_t * cos_t
+
+    def _contact_a(self, cos_t, sin_t, d):
+        """The components of r1 = GA (m) from θ and D = :meth:`_ellipse_terms` (ρ = ab/D)."""
+        rho = self.a * self.b / d
+        return [rho * sin_t, -(self.delta + rho * cos_t), np.zeros_like(rho)]
 
     def _frame(self, cos_t, sin_t, sq):
         """The components of n (three) and of t1 (the first two; the third is 0), the planar
         norm and |N|, from θ and σ√Q (complex-safe)."""
         a, b = self.a, self.b
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
+        planar2 = self._planar2(cos_t, sin_t)
         norm_n = np.sqrt(planar2 + sq * sq)
-        n = [-a * a * sin_t / norm_n, b * b * cos_t / norm_n, sq / norm_n]
+        b2_cos = b * b * cos_t
+        n = [-a * a * sin_t / norm_n, b2_cos / norm_n, sq / norm_n]
         planar = np.sqrt(planar2)
-        return n, [b * b * cos_t / planar, a * a * sin_t / planar], planar, norm_n
+        return n, [b2_cos / planar, a * a * sin_t / planar], planar, norm_n
 
     def _theta_array(self, theta):
         theta = np.asarray(theta, dtype=float)
@@ -180,24 +174,24 @@ class TwoDiskForms:
         a, b = self.a, self.b
         eta_m, tm = self._eta_max, self.theta_max
         w = np.sin(u)
-        sign_w = np.where(np.real(w) < 0, -1.0, 1.0)
+        sign_w = np.where(w.real < 0, -1.0, 1.0)
         abs_w = w * sign_w
         abs_eta = eta_m * abs_w
-        e = np.sqrt(a * a * np.cos(abs_eta) ** 2 + b * b * np.sin(abs_eta) ** 2)
+        cos_eta, sin_eta = np.cos(abs_eta), np.sin(abs_eta)
+        e = np.sqrt(a * a * cos_eta ** 2 + b * b * sin_eta ** 2)
         e_m = self._e_max
-        cos_t = a * np.cos(abs_eta) / e
-        sin_abs = b * np.sin(abs_eta) / e
+        cos_t = a * cos_eta / e
+        sin_abs = b * sin_eta / e
         # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
         v_over_c2 = eta_m / (1 + abs_w)
         v = v_over_c2 * np.cos(u) ** 2
-        x = (a * a * np.cos(abs_eta) * self._cos_eta_max
-             + b * b * np.sin(abs_eta) * self._sin_eta_max)
+        x = a * a * cos_eta * self._cos_eta_max + b * b * sin_eta * self._sin_eta_max
         # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
         denom = e * e_m + x
         t = a * b * np.sin(v) / denom
         # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
         # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
-        near_axis = np.real(abs_eta) < 1.0
+        near_axis = abs_eta.real < 1.0
         tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
         abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
         j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
@@ -216,10 +210,11 @@ class TwoDiskForms:
         _, cos_t, sin_t, j = self.phase_angles(u)
         return self._phase_sqrt_q(u, cos_t, sin_t, j)
 
-    def _phase_sqrt_q(self, u, cos_t, sin_t, j):
-        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe)."""
-        cofactor = self._q_cofactor(cos_t, self._ellipse_terms(cos_t, sin_t))
-        return np.cos(u) * np.sqrt(j * cofactor)
+    def _phase_sqrt_q(self, u, cos_t, sin_t, j, d=None):
+        """σ√Q = cos u · √(j L F2) from the angles of :meth:`phase_angles` (complex-safe;
+        ``d``: :meth:`_ellipse_terms` of the angles if already evaluated)."""
+        d = self._ellipse_terms(cos_t, sin_t) if d is None else d
+        return np.cos(u) * np.sqrt(j * self._q_cofactor(cos_t, d))
 
     def phase_vectors(self, u):
         """(r1, r2, n, t1, z_G, planar, |N|, θ, σ√Q) at phase u, body frame (complex-safe).
@@ -228,19 +223,21 @@ class TwoDiskForms:
         z_G (m) and the unnormalised lengths of the normal; for complex-step derivatives.
         """
         theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
-        return self._geometry(theta, cos_t, sin_t, sq) + (theta, sq)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
+        return self._geometry(theta, cos_t, sin_t, sq, d) + (theta, sq)
 
     def phase_geometry(self, u):
         """Body-frame geometry at cycle phase(s) ``u`` (rad), any real value."""
         u = np.asarray(u, dtype=float)
         theta, cos_t, sin_t, j = self.phase_angles(u)
-        sq = self._phase_sqrt_q(u, cos_t, sin_t, j)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
         branch = np.where(np.cos(u) < 0, -1.0, 1.0)
-        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch)
+        return self._phase_geometry_from(u, theta, cos_t, sin_t, sq, branch, d)
 
-    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch):
-        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq)
+    def _phase_geometry_from(self, u, theta, cos_t, sin_t, sq, branch, d=None):
+        r1, r2, n, t1, height, planar, norm_n = self._geometry(theta, cos_t, sin_t, sq, d)
         psi = np.arctan2(sq, -self.a**2 * cos_t)
         tilt = np.arctan2(planar, sq)
         return PhaseGeometry(phase=u, theta=theta, psi=psi, branch=branch, signed_sqrt_q=sq,
@@ -248,8 +245,11 @@ class TwoDiskForms:
                              height=height, tilt=tilt)
 
     def phase_height(self, u):
-        """z_G(u) (m), analytic in u."""
-        return self.phase_vectors(u)[4]
+        """z_G(u) (m), analytic in u (the height of :meth:`phase_vectors`, alone)."""
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        sq = self._phase_sqrt_q(u, cos_t, sin_t, j, d)
+        return self._height(cos_t, d, np.sqrt(self._planar2(cos_t, sin_t) + sq * sq))
 
     def _psi_half_angle(self, u):
         """ψ(u) = 2 arctan(sin ψ / (1 + cos ψ)), analytic in u (|ψ| < π over the cycle)."""
@@ -285,8 +285,7 @@ class TwoDiskForms:
         speed2 = b * b * np.cos(eta) ** 2 + a * a * np.sin(eta) ** 2   # (ds/dη)²
         ds_du = np.sqrt(speed2) * self._eta_max * np.cos(u)
         k = a * b / speed2**1.5
-        planar2 = a**4 * sin_t * sin_t + b**4 * cos_t * cos_t
-        cos_phi = sq / np.sqrt(planar2 + sq * sq)
+        cos_phi = sq / np.sqrt(self._planar2(cos_t, sin_t) + sq * sq)
         return ds_du, k * cos_phi * ds_du
 
     def phase_angular_velocity(self, u):
@@ -296,16 +295,27 @@ class TwoDiskForms:
         ω_u = α′ n − ½ Σ b_i × b_i′ (derivatives in u, by complex step).
         """
         u = np.asarray(u, dtype=float)
-        vec = self.phase_vectors(u + 1j * COMPLEX_STEP)
-        return self._angular_velocity(vec[2], vec[3], self.phase_rates(u)[1])
+        return self._angular_velocity(u, self.phase_rates(u)[1])
 
-    @staticmethod
-    def _angular_velocity(n, t1, dalpha):
-        """ω_u from n and t1 at u + ih (complex, :data:`COMPLEX_STEP`) and dα/du at u."""
-        m = np.cross(n, t1)
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at real
+        phase(s) u (RollingBody), from one evaluation of the real closed forms."""
+        u = np.asarray(u, dtype=float)
+        _, cos_t, sin_t, j = self.phase_angles(u)
+        d = self._ellipse_terms(cos_t, sin_t)
+        dalpha = self._rates(u, cos_t, sin_t, self._phase_sqrt_q(u, cos_t, sin_t, j, d))[1]
+        return self._angular_velocity(u, dalpha), vector(*self._contact_a(cos_t, sin_t, d))
+
+    def _angular_velocity(self, u, dalpha):
+        """ω_u at real u from n and t1 at u + ih (:data:`COMPLEX_STEP`) and dα/du at u."""
+        uc = u + 1j * COMPLEX_STEP
+        _, cos_t, sin_t, j = self.phase_angles(uc)
+        n, t1, planar, _ = self._frame(cos_t, sin_t, self._phase_sqrt_q(uc, cos_t, sin_t, j))
+        n, t1 = vector(*n), vector(*t1, np.zeros_like(planar) / planar)  # as phase_vectors
+        m = cross(n, t1)
         n_re, t1_re, m_re = n.real, t1.real, m.real
         dn, dt1, dm = (x.imag / COMPLEX_STEP for x in (n, t1, m))
-        frame_rate = 0.5 * (np.cross(n_re, dn) + np.cross(t1_re, dt1) + np.cross(m_re, dm))
+        frame_rate = 0.5 * (cross(n_re, dn) + cross(t1_re, dt1) + cross(m_re, dm))
         return dalpha[..., None] * n_re - frame_rate
 
 

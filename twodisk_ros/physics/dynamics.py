@@ -26,6 +26,7 @@ from .mass_models import MassProperties
 from .rolling_body import check_rolling_body
 from .spectral import spectral_derivative
 from .tables import HermiteTable
+from .vectors import cross
 from .wells import LocalWell, TabulatedWell
 
 __all__ = ['PhaseState', 'RollingDynamics']
@@ -88,9 +89,8 @@ class RollingDynamics:
     def effective_mass(self, u):
         """m(u) (kg m²/rad²): T = ½ m(u) u̇²."""
         u = np.asarray(u, dtype=float)
-        omega = self.body.phase_angular_velocity(u)
-        r1 = self.body.phase_geometry(u).contact_a
-        v = np.cross(omega, r1)
+        omega, r1 = self.body.phase_angular_velocity_and_contact(u)
+        v = cross(omega, r1)
         inertia = self.mass.inertia
         return (np.einsum('...i,ij,...j->...', omega, inertia, omega)
                 + self.mass.mass * np.sum(v * v, axis=-1))
@@ -102,7 +102,7 @@ class RollingDynamics:
         geo = self.body.phase_geometry(np.asarray(u, dtype=float))
         d = geo.contact_b - geo.contact_a
         e = d / np.linalg.norm(d, axis=-1)[..., None]
-        v = np.cross(e, geo.contact_a)
+        v = cross(e, geo.contact_a)
         return (np.einsum('...i,ij,...j->...', e, self.mass.inertia, e)
                 + self.mass.mass * np.sum(v * v, axis=-1))
 

@@ -40,6 +40,7 @@ from .lamina_phase import BRANCH_FLIP, COLUMNS, PhaseSolver, THETA_FLIP, unfold
 from .rolling_body import RollingBody
 from .spectral import TAIL_TOLERANCE, real_spectral_derivative, spectral_tails, upsample
 from .tables import HermiteTable
+from .vectors import cross, vector
 
 __all__ = ['LaminaBody', 'MIN_NODES', 'MAX_NODES', 'OVERSAMPLING', 'RESOLVED_TAIL', 'symmetrise']
 
@@ -223,10 +224,10 @@ class LaminaBody(RollingBody):
     def _vectors(self, f):
         zero = np.zeros_like(f[..., 0])
         g = self._offset
-        r1 = np.stack([f[..., 0], f[..., 1] - g, zero], axis=-1)
-        r2 = np.stack([zero, f[..., 2] - g, f[..., 3]], axis=-1)
+        r1 = vector(f[..., 0], f[..., 1] - g, zero)
+        r2 = vector(zero, f[..., 2] - g, f[..., 3])
         n = self._unit(f[..., 4:7])
-        t1 = self._unit(np.stack([f[..., 7], f[..., 8], zero], axis=-1))
+        t1 = self._unit(vector(f[..., 7], f[..., 8], zero))
         return r1, r2, n, t1, self._height(f, n[..., 1])
 
     def _height(self, f, n2=None):
@@ -266,10 +267,21 @@ class LaminaBody(RollingBody):
         """ω_u (rad per rad of u, body frame): α′ n − ½ Σ b_i × b_i′ over the contact frame
         (t1, n × t1, n), derivatives from the table."""
         u = np.asarray(u, dtype=float)
-        f, df = self._values(u), self._table(np.mod(u, TWO_PI), 1)
+        return self._angular_velocity(u, self._values(u))
+
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at real
+        phase(s) u (RollingBody), from one evaluation of the table at u."""
+        u = np.asarray(u, dtype=float)
+        f = self._values(u)
+        return self._angular_velocity(u, f), self._vectors(f)[0]
+
+    def _angular_velocity(self, u, f):
+        """ω_u at real phase(s) u from the table's columns f there."""
+        df = self._table(np.mod(u, TWO_PI), 1)
         _, _, n, t1, _ = self._vectors(f + 1j * COMPLEX_STEP * df)
-        m = np.cross(n, t1)
-        frame = 0.5 * sum(np.cross(x.real, x.imag / COMPLEX_STEP) for x in (n, t1, m))
+        m = cross(n, t1)
+        frame = 0.5 * sum(cross(x.real, x.imag / COMPLEX_STEP) for x in (n, t1, m))
         return f[..., _DALPHA][..., None] * n.real - frame
 
     def phase_angles_with_rates(self, u):

@@ -27,8 +27,31 @@ cross products, norms, arctan) then carries its exact first derivative too.
 """
 
 import abc
+from dataclasses import dataclass
 
-__all__ = ['RollingBody', 'check_rolling_body']
+import numpy as np
+
+__all__ = ['PhaseGeometry', 'RollingBody', 'check_rolling_body']
+
+
+@dataclass(frozen=True)
+class PhaseGeometry:
+    """Body-frame geometry at cycle phases ``u`` (arrays broadcast with ``u``).
+
+    Vectors have shape ``u.shape + (3,)`` and are in the body frame (metres or unit).
+    """
+
+    phase: np.ndarray           #: u (rad)
+    theta: np.ndarray           #: θ (rad), contact angle on disk 1
+    psi: np.ndarray             #: ψ (rad), contact angle on disk 2
+    branch: np.ndarray          #: +1 / −1 (sign of cos u; +1 at the turning points)
+    signed_sqrt_q: np.ndarray   #: σ√Q (m⁴)
+    contact_a: np.ndarray       #: r1 = GA (m)
+    contact_b: np.ndarray       #: r2 = GB (m)
+    ground_normal: np.ndarray   #: n, unit, the world's up direction seen in the body frame
+    tangent_a: np.ndarray       #: unit tangent of disk 1 at A (direction of increasing θ)
+    height: np.ndarray          #: z_G = −r1·n (m), the potential energy per unit M g
+    tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
 
 class RollingBody(abc.ABC):
@@ -56,7 +79,7 @@ class RollingBody(abc.ABC):
     # -- geometry in the phase u -------------------------------------------------------------
     @abc.abstractmethod
     def phase_geometry(self, u):
-        """:class:`~twodisk_ros.physics.body.PhaseGeometry` at real phase(s) u (rad, any real).
+        """:class:`PhaseGeometry` at real phase(s) u (rad, any real).
 
         ``signed_sqrt_q`` is the ellipse's σ√Q (m⁴); NaN for bodies without one.
         """
@@ -79,6 +102,11 @@ class RollingBody(abc.ABC):
     @abc.abstractmethod
     def phase_angular_velocity(self, u):
         """ω_u (rad per rad of u, body frame, u.shape + (3,)): the angular velocity per u̇."""
+
+    def phase_angular_velocity_and_contact(self, u):
+        """(ω_u, r1): :meth:`phase_angular_velocity` and ``phase_geometry(u).contact_a`` at
+        real phase(s) u, what the kinetic energy needs (bodies may share the evaluations)."""
+        return self.phase_angular_velocity(u), self.phase_geometry(u).contact_a
 
     @abc.abstractmethod
     def phase_angles_with_rates(self, u):

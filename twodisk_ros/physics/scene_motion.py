@@ -121,7 +121,8 @@ class SceneStream:
         """J, J′, |ω_u|, |ω_u|′, dV/dγ, ρ, N_g, N per w², N per ẇ at phase(s) u."""
         t = self.terms
         row = t.rows(u)
-        n_g = np.sum(t.quantities_from(u, row, 0.0, 0.0)[..., :2], axis=-1)
+        q = t.quantities_from(u, row, 0.0, 0.0)
+        n_g = q[..., 0] + q[..., 1]             # N_A + N_B (np.sum's arithmetic for two)
         return (row[..., J], row[..., DJ], row[..., W], row[..., DW],
                 t.potential_turn_slope_from(u, row), row[..., RHO], n_g,
                 row[..., PW] + row[..., PW + 1], row[..., QA] + row[..., QA + 1])
