@@ -44,11 +44,6 @@ def _dot(x, y):
     return np.sum(x * y, axis=-1)
 
 
-def _periodic(values):
-    first = real_spectral_derivative(values)
-    return HermiteTable.periodic(values, first, real_spectral_derivative(first))
-
-
 def project(force, moment, r1, r2, normal):
     """(N_A, N_B, T_A, T_B, S, τ) of a total force and moment about G, shape (..., 6).
 

@@ -11,7 +11,7 @@ stated accuracy (docs/physics.md#accuracy-and-its-limits): shapes with b/a in [0
 same contract.
 """
 
-from dataclasses import dataclass, fields, make_dataclass, replace
+from dataclasses import dataclass, make_dataclass, replace
 import math
 import re
 
@@ -421,11 +421,6 @@ def markdown_table():
 def _cell(text):
     """Text for a Markdown table cell (a literal | escaped)."""
     return text.replace('|', '\\|')
-
-
-def field_names():
-    """The parameter names in contract order (the fields of :class:`RollerSettings`)."""
-    return [f.name for f in fields(RollerSettings)]
 
 
 if __name__ == '__main__':
