@@ -1,13 +1,19 @@
-"""twodisk_ros: rolling of a rigid body made of two elliptic disks in perpendicular planes.
+"""twodisk_ros: a rigid body of two congruent symmetric laminae (ellipses, superellipses,
+eggs, any convex outline) in perpendicular planes, rolling without slipping on a plane.
 
-Folders are the architecture:
+Folders are the architecture, in layers (README "Layout"; enforced by import-linter,
+``.importlinter``), each importing only the ones below it:
 
-- :mod:`twodisk_ros.physics`: the body, its cycle, equilibria, mass models and dynamics
-  (numpy/scipy only; imports without rclpy or matplotlib);
-- :mod:`twodisk_ros.io`: MCAP recordings in rosbag2's layout (writer and tolerant reader);
-- :mod:`twodisk_ros.node`: the ``roller`` node, its parameters and its messages;
+- :mod:`twodisk_ros.node` (the ``roller`` node, the only rclpy layer),
+  :mod:`twodisk_ros.view` (``twodisk-view``), :mod:`twodisk_ros.sweep` (``twodisk-sweep``);
+- :mod:`twodisk_ros.plotting`: figures and animations (matplotlib);
 - :mod:`twodisk_ros.inspect`: ``twodisk-inspect``, the offline checks of a recording;
-- :mod:`twodisk_ros.plotting`: every figure (matplotlib).
+  :mod:`twodisk_ros.runs`: runs to show;
+- :mod:`twodisk_ros.run`: the parameters, the body they describe and its simulation;
+- :mod:`twodisk_ros.io`: MCAP recordings in rosbag2's layout (writer and tolerant reader);
+  :mod:`twodisk_ros.model`: the body as a robot description (frames, meshes, URDF);
+- :mod:`twodisk_ros.physics`: the bodies, their cycles, equilibria, mass models and dynamics
+  (numpy/scipy only).
 
 The physics is re-exported here (imported on first use):
 ``from twodisk_ros import TwoDiskBody, simulate``.

@@ -40,7 +40,7 @@ class RecordedModel:
     shape: str = ''          #: one line on the shape, for the report
     #: the ground's unit normal in frame_id: (sin slope, 0, cos slope), z up on flat ground
     ground_normal: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
-    #: True if the recorded scene is not today's flat, free, conservative one
+    #: True if the recorded scene is not the flat, free, conservative one
     scene: bool = False
 
     @cached_property

@@ -77,7 +77,7 @@ class RollingDynamics:
         self.mass = mass_properties
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
-        #: True for any body but the ellipse (whose closed forms keep today's paths)
+        #: True for any body but the ellipse (whose closed forms keep the (u, u̇) path)
         self._general = not isinstance(body, TwoDiskBody)
         self._feature_width = body.feature_width
         self._build_tables(4 * self.cycle.resolution)

@@ -1,7 +1,7 @@
 """The scene the body rolls in: ground plane, gravity, drive and dissipation (ROS-free).
 
-Every addition is off by default: ``Scene()`` is today's flat, free, conservative scene,
-and the motion of such a scene is today's :class:`~twodisk_ros.physics.motion.MotionStream`
+Every addition is off by default: ``Scene()`` is the flat, free, conservative scene,
+and the motion of such a scene is the plain :class:`~twodisk_ros.physics.motion.MotionStream`
 (docs/physics.md#scenes).
 
 Frames (all right-handed, metres):
@@ -138,7 +138,7 @@ class Scene:
 
     @property
     def flat_free(self):
-        """True for today's scene: horizontal ground, no drive, no dissipation."""
+        """True for the flat free scene: horizontal ground, no drive, no dissipation."""
         return self.slope == 0.0 and self.conservative
 
     # -- frames ----------------------------------------------------------------------------

@@ -38,7 +38,7 @@ each stretch between two stops (w = 0) is integrated on its own, and at a stop t
 stays at rest if |V_γ − τ| ≤ μ_r ρ N_g (it sticks: the time to rest is exact). A start
 from rest exactly where |ω_u| = 0 (t(τ) would not advance) takes its first 1e-3 rad of u in
 closed form (:data:`LEAVE_STOP`). Where the flat fast paths hold (:func:`scene_stream`)
-today's :class:`~twodisk_ros.physics.motion.MotionStream` is used unchanged, and a
+the plain :class:`~twodisk_ros.physics.motion.MotionStream` is used unchanged, and a
 conservative scene on a slope has the closed forms of
 :mod:`~twodisk_ros.physics.scene_closed` (:class:`ClosedSceneStream`).
 """
@@ -407,9 +407,9 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
     ``angular_speed`` w0 = |ω_u(u0)| u̇0 (rad/s) replaces u̇0 if given: the one form of the
     start where the body stops turning in u (u̇0 infinite).
 
-    * flat, free, conservative (``Scene()``): today's dynamic MotionStream, bit for bit;
+    * flat, free, conservative (``Scene()``): the plain dynamic MotionStream, bit for bit;
     * speed drive whose command equals the initial speed (Ω₀ = w0, to 1e-12): the
-      motion is today's kinematic MotionStream on any slope and with any dissipation (u(t)
+      motion is the plain kinematic MotionStream on any slope and with any dissipation (u(t)
       is then kinematic; only the drive torque depends on the scene);
     * conservative on a slope, ``method='table'``: the closed forms of
       :func:`~twodisk_ros.physics.scene_closed.conservative_solution` (rolling on, rocking,
@@ -423,7 +423,7 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
     if angular_speed is not None:
         if dynamics.general:
             kwargs['angular_speed'] = omega0
-        else:                   # the ellipse turns everywhere: today's state (u, u̇)
+        else:                   # the ellipse turns everywhere: the state (u, u̇)
             u_dot0 = omega0 / rate0
     if scene.flat_free:
         return MotionStream(dynamics, u0, u_dot0, mode='dynamic', **kwargs)

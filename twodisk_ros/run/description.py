@@ -5,7 +5,7 @@ the inspector (:func:`~twodisk_ros.inspect.model.build_model`) and the tools tha
 run from its parameters, so that every reader builds the same body:
 
 - ``shape`` ellipse: :class:`~twodisk_ros.physics.body.TwoDiskBody` (a, b, delta), the closed
-  forms, and today's mass models of a, b, delta (``settings.ellipse_mass_properties()``), bit for bit;
+  forms, and the closed-form mass models of a, b, delta (``settings.ellipse_mass_properties()``), bit for bit;
 - any other shape: :class:`~twodisk_ros.physics.lamina_body.LaminaBody` (lamina, delta,
   arrangement) on the lamina of :func:`~twodisk_ros.run.shape.lamina_of`, with the mass model
   of :func:`twodisk_ros.physics.mass_models.centred_on_mass` (imported when first needed):

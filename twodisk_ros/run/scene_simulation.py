@@ -1,10 +1,11 @@
 """The node's motion in a scene other than the flat free one (no rclpy here).
 
-:class:`~twodisk_ros.run.simulation.Simulation` keeps today's path (its MotionStream, poses
-and contact forces, bit for bit) where the settings describe the flat, free, conservative
-scene and the motion starts at ``theta0``; everything else is a :class:`SceneMotion`: the
-scene's stream (:func:`~twodisk_ros.physics.scene_motion.scene_stream`, or the integrator of
-the speed drive), poses and ground forces in the gravity-aligned ``frame_id``
+:class:`~twodisk_ros.run.simulation.Simulation` keeps the flat free scene's path (its
+MotionStream, poses and contact forces, bit for bit) where the settings describe the flat,
+free, conservative scene and the motion starts at ``theta0``; everything else is a
+:class:`SceneMotion`: the scene's stream
+(:func:`~twodisk_ros.physics.scene_motion.scene_stream`, or the integrator of the speed
+drive), poses and ground forces in the gravity-aligned ``frame_id``
 (:class:`~twodisk_ros.physics.scene_terms.SceneTerms`), and the energy balance
 E + W − W_d = E₀ carried across commands, time-outs and runtime scene changes (each continues
 the motion from the state of the last published sample, in a new stretch).
@@ -40,7 +41,7 @@ TORQUE_LIMIT = 10.0
 
 
 def flat_free(settings):
-    """True if the settings describe today's scene: no slope, drive or dissipation."""
+    """True if the settings describe the flat free scene: no slope, drive or dissipation."""
     s = settings
     return (s.slope == 0.0 and s.drive == 'none' and s.rolling_resistance == 0.0
             and s.damping == 0.0)
@@ -140,7 +141,7 @@ class SceneMotion:
             terms = copy(terms)
             terms.scene = scene
         self.terms = terms
-        regular = speed if general else None      # the ellipse: today's (u, u̇)
+        regular = speed if general else None      # the ellipse: the state (u, u̇)
         if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
             self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance,
                                       angular_speed=regular)
@@ -173,7 +174,7 @@ class SceneMotion:
                                        s.rolling_speed)
             values = SceneValues(s.energy, s.dissipated + w0, s.drive_work + wd0,
                                  s.drive_torque, s.power)
-        else:         # today's MotionStream (flat, free, conservative from here on)
+        else:         # the plain MotionStream (flat, free, conservative from here on)
             u, u_dot, speed = self.stream.sample_with_speed(t)
             m, v, dm, dv = np.moveaxis(self.terms.energy_jet(u)[..., :4], -1, 0)
             with np.errstate(divide='ignore', invalid='ignore'):

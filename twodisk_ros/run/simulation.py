@@ -90,8 +90,8 @@ class Simulation:
         in force and its command, the state at t = 0 (a
         :class:`~twodisk_ros.physics.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
         ``omega0``), the work
-        done before and the balance's E₀, reused tables. Today's path is taken where the
-        settings are flat, free and conservative and ``start`` is None.
+        done before and the balance's E₀, reused tables. The flat free scene's path is taken
+        where the settings are flat, free and conservative and ``start`` is None.
     orientation : array (4,), optional
         The last quaternion published before (the signs stay continuous).
 
@@ -114,7 +114,7 @@ class Simulation:
         self.invalid = None        # ValidityReport of the first sample outside the model
         self._last_quaternion = orientation
         self.angular_speed0 = abs(s.omega0)
-        #: None on today's path, else the SceneMotion of this stretch
+        #: None on the flat free scene's path, else the SceneMotion of this stretch
         self.scene = None
         if start is None and flat_free(s):
             self.stream = run.stream()
