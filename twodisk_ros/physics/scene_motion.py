@@ -92,6 +92,8 @@ class SceneStream:
         if not isinstance(terms, SceneTerms):
             raise TypeError(f'terms must be a SceneTerms, got {type(terms).__name__}')
         self.terms, self.scene, self.tolerance = terms, terms.scene, float(tolerance)
+        import scipy.integrate  # noqa: F401  (here, not in the first chunk: a real-time node
+        # must not pay its ~0.6 s import inside its loop, where it drops samples)
         self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
         u0 = float(u0)
         w0 = float(angular_speed) if angular_speed is not None else \
