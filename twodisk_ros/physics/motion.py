@@ -243,9 +243,6 @@ class MotionStream:
             self._end_state = (u0, u_dot0)
             self._speed = abs(u_dot0 * float(dynamics.angular_speed_per_phase(u0)))
             self.initial_energy = float(dynamics.energy(u0, u_dot0))
-        if not self._sol.closed_form:
-            import scipy.integrate  # noqa: F401  (here, not in the first chunk: a real-time
-            # node must not pay its ~0.6 s import inside its loop, where it drops samples)
         #: right-hand-side evaluations of the ODE segments so far (0 for a closed form)
         self.nfev = 0
 
