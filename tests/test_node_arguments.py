@@ -25,10 +25,10 @@ import pytest  # noqa: E402
 
 import twodisk_ros  # noqa: E402
 from twodisk_ros.node.arguments import (ArgumentError, check_arguments, node_fqn,  # noqa: E402
-                                        params_file_values, rclpy_type_hint)
+                                        rclpy_type_hint)
 from roller_here import run_roller_main  # noqa: E402
 from twodisk_ros.run.params_yaml import (MAX_ENTRIES, load_params_file,  # noqa: E402
-                                          node_matches, parse_value)
+                                         node_matches, params_file_values, parse_value)
 
 REPO = Path(__file__).resolve().parents[1]
 MEMORY_LIMIT = 2 << 30     # bytes of address space: a refused run needs about 0.5 GiB (VmPeak)

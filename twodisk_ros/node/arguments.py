@@ -21,9 +21,9 @@ import re
 from ..run.parameters import BY_NAME, ROS_OWN, SHAPE_ONLY
 from .usage import split_ros_args
 from ..run.params_yaml import (ArgumentError, MAX_ENTRIES, NODE_NAME, at, flat, load_params_file,
-                               params_file_values, parse_value)
+                               parse_value)
 
-__all__ = ['ArgumentError', 'check_arguments', 'node_fqn', 'params_file_values',
+__all__ = ['ArgumentError', 'check_arguments', 'node_fqn',
            'rclpy_type_hint', 'type_problem']
 
 UNKNOWN_SHOWN = 5            #: unknown names warned about one by one; the rest are counted

@@ -51,6 +51,7 @@ from .motion import MotionStream
 from .scene_closed import DriftQuadrature, conservative_solution
 from .cycle import TWO_PI
 from .scene_samples import Piece, SceneSamples, samples_from
+from .solvers import import_integrator
 from .scene_terms import DJ, DW, J, PW, QA, RHO, SceneTerms, W
 
 #: a start from rest where |ω_u| is below this fraction of its largest value is taken in
@@ -92,8 +93,7 @@ class SceneStream:
         if not isinstance(terms, SceneTerms):
             raise TypeError(f'terms must be a SceneTerms, got {type(terms).__name__}')
         self.terms, self.scene, self.tolerance = terms, terms.scene, float(tolerance)
-        import scipy.integrate  # noqa: F401  (here, not in the first chunk: a real-time node
-        # must not pay its ~0.6 s import inside its loop, where it drops samples)
+        import_integrator()
         self._chunk, self._lookahead = float(chunk), min(float(lookahead), float(chunk))
         u0 = float(u0)
         w0 = float(angular_speed) if angular_speed is not None else \

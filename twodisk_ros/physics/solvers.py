@@ -17,7 +17,13 @@ from .spectral import (STALL, refine_grid, spectral_antiderivative, spectral_der
 from .tables import HermiteTable
 
 __all__ = ['LibrationSolution', 'OdeSolution', 'PhaseSolution', 'QuadratureSolution',
-           'RestSolution', 'SundmanSolution']
+           'RestSolution', 'SundmanSolution', 'import_integrator']
+
+
+def import_integrator():
+    """Import scipy.integrate (~0.6 s) now: when a stream that will integrate is built, never
+    in its first chunk, inside a real-time node's loop, where the stall drops samples."""
+    import scipy.integrate  # noqa: F401
 
 
 class PhaseSolution:
@@ -93,8 +99,7 @@ class OdeSolution(PhaseSolution):
     closed_form = False
 
     def __init__(self, dense, y0, t_end, rate=None, centre=None):
-        import scipy.integrate  # noqa: F401  (~0.6 s: when the stream is built, never inside
-        # a real-time node's loop, where the stall drops samples; it integrates with it)
+        import_integrator()
         self._dense, self._y0, self._rate = dense, np.asarray(y0, dtype=float), rate
         self.t_end = float(t_end)
         self.centre = None if centre is None else float(centre)
@@ -372,8 +377,7 @@ class SundmanSolution(PhaseSolution):
     closed_form = False
 
     def __init__(self, dense, y0, tau_end, rotation_rate):
-        import scipy.integrate  # noqa: F401  (~0.6 s: when the stream is built, never inside
-        # a real-time node's loop, where the stall drops samples; it integrates with it)
+        import_integrator()
         self._dense, self._y0, self._rotation_rate = dense, np.asarray(y0, dtype=float), \
             rotation_rate
         self._tau_end = float(tau_end)

@@ -51,35 +51,25 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
         str, all of the length of the inputs.
     """
     if exponent != ELLIPSE_EXPONENT or body_factory is not None:
-        return _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed,
-                              timings, body_factory, mass_factory)
+        return _body_by_body(b_values, delta_values, lambda b, d: general_body_quantities(
+            b, d, exponent, mass_model, reference_speed, timings, body_factory, mass_factory))
     if method == 'batch':
         return batch_quantities(b_values, delta_values, mass_model, reference_speed, timings)
     if method != 'scalar':
         raise ValueError(f"method must be 'batch' or 'scalar', got {method!r}")
+    return _body_by_body(b_values, delta_values, lambda b, d: body_quantities(
+        b, d, mass_model, reference_speed, timings))
+
+
+def _body_by_body(b_values, delta_values, quantities):
+    """:func:`chunk_quantities` one body after the other: ``quantities(b, d)`` → (values,
+    failure) of each pair of the flattened inputs, gathered into arrays and a list."""
     b_values = np.asarray(b_values, dtype=float).ravel()
     delta_values = np.asarray(delta_values, dtype=float).ravel()
     out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
     failures = []
     for k, (b, d) in enumerate(zip(b_values, delta_values)):
-        values, failure = body_quantities(b, d, mass_model, reference_speed, timings)
-        for name, value in values.items():
-            out[name][k] = value
-        failures.append(failure)
-    out['failure'] = failures
-    return out
-
-
-def _general_chunk(b_values, delta_values, exponent, mass_model, reference_speed, timings,
-                   body_factory, mass_factory):
-    """:func:`chunk_quantities` on the per-body general path (one body after the other)."""
-    b_values = np.asarray(b_values, dtype=float).ravel()
-    delta_values = np.asarray(delta_values, dtype=float).ravel()
-    out = {name: np.full(b_values.size, math.nan) for name in VARIABLES}
-    failures = []
-    for k, (b, d) in enumerate(zip(b_values, delta_values)):
-        values, failure = general_body_quantities(b, d, exponent, mass_model, reference_speed,
-                                                  timings, body_factory, mass_factory)
+        values, failure = quantities(b, d)
         for name, value in values.items():
             out[name][k] = value
         failures.append(failure)
