@@ -14,6 +14,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings as hsettings, strategies as st
 
 from twodisk_ros.node import arguments
+from twodisk_ros.run.params_yaml import params_file_values
 from twodisk_ros.run.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
 from twodisk_ros.run.simulation import Simulation
 from twodisk_ros.physics.body import TwoDiskBody
@@ -271,7 +272,7 @@ def test_a_superellipse_params_file_runs_the_contract(tmp_path):
                                  'delta: 0.04\narrangement: swapped')
     argv = ['roller', '--ros-args', '--params-file', path]
     assert arguments.check_arguments(argv) == []
-    s = DEFAULTS.with_values(**arguments.params_file_values(path)).checked()
+    s = DEFAULTS.with_values(**params_file_values(path)).checked()
     assert (s.shape, s.exponent, s.arrangement) == ('superellipse', 6.0, 'swapped')
 
 
