@@ -125,9 +125,10 @@ def inspect_recording(path):
     RecordingError
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
 
-    The cyclic garbage collector is paused meanwhile (:func:`~twodisk_ros.io.reader.collector_paused`):
-    the messages make no cycles, they are freed when this returns, and with the collector on
-    its full collections walked them all repeatedly (2 of 6 s for a 15 s, 1 kHz recording).
+    The cyclic garbage collector is paused meanwhile
+    (:func:`~twodisk_ros.io.reader.collector_paused`): the messages make no cycles, they are
+    freed when this returns, and with the collector on its full collections walked them all
+    repeatedly (2 of 6 s for a 15 s, 1 kHz recording).
     """
     with collector_paused():
         return _inspect(path)

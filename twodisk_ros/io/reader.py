@@ -1,7 +1,8 @@
 """Reading MCAP recordings (rosbag2 layout), tolerant of cut and damaged files.
 
 The records are found by :func:`twodisk_ros.io.mcap_scan.scan_mcap` (its docstring states the
-recovery rule); here they become decoded messages, channels and metadata.
+recovery rule); here they become decoded messages, channels and metadata.  Messages are
+decoded by :mod:`twodisk_ros.io.cdr_decode`: what ``mcap_ros2`` returns, faster.
 
 Needs only ``mcap`` and ``mcap-ros2-support``: no rclpy, so recordings are read and checked
 offline on any machine.
@@ -43,7 +44,7 @@ class RecordedMessage:
     publish_time_ns : int
         Publish time.
     msg : object
-        The message decoded by ``mcap_ros2`` (attribute access like the ROS class), or the raw
+        The message as ``mcap_ros2`` decodes it (attribute access like the ROS class), or the raw
         bytes if the channel is not CDR with a ``ros2msg`` schema or its topic was not selected
         for decoding (``read_recording(..., decode=...)``).
     """
@@ -251,41 +252,54 @@ def _decoder(message_encoding, schema_name, schema_encoding, schema_data):
 
 
 def _decode(scan, recording, decode):
-    """Decode the scanned messages into ``recording``; failures are counted, not raised."""
+    """Decode the scanned messages into ``recording``; failures are counted, not raised.
+
+    What to do with a channel's messages (its topic, type, decoder or schema error) is
+    settled once per channel, at its first message; ``decode(topic)`` is asked once per
+    channel.
+    """
     schemas = {**scan.summary_schemas, **scan.schemas}
     channels = {**scan.summary_channels, **scan.channels}
-    decoders = {}
     counts = {channel.topic: 0 for channel in channels.values()}
+    plans = {}
 
-    def decoder_of(channel):
-        if channel.id not in decoders:
-            schema = schemas.get(channel.schema_id)
-            decoders[channel.id] = _decoder(
+    def plan_of(channel_id):
+        """``(topic, type name, decoder or None, schema error or None)``, or None: orphan."""
+        channel = channels.get(channel_id)
+        if channel is None:
+            return None
+        schema = schemas.get(channel.schema_id)
+        decoder = reason = None
+        if decode is None or decode(channel.topic):
+            decoder, reason = _decoder(
                 channel.message_encoding, *((None, None, None) if schema is None else
                                             (schema.name, schema.encoding, bytes(schema.data))))
-        return decoders[channel.id]
+        return channel.topic, schema.name if schema else '', decoder, reason
 
+    messages = recording.messages
+    undecodable = recording.undecodable
     for raw in scan.messages:
-        channel = channels.get(raw.channel_id)
-        if channel is None:
+        channel_id = raw.channel_id
+        if channel_id not in plans:
+            plans[channel_id] = plan_of(channel_id)
+        plan = plans[channel_id]
+        if plan is None:
             recording.orphans += 1
             continue
-        schema = schemas.get(channel.schema_id)
-        msg = bytes(raw.data)
-        if decode is None or decode(channel.topic):
-            decoder, reason = decoder_of(channel)
+        topic, type_name, decoder, reason = plan
+        msg = raw.data
+        if decoder is not None:
             try:
-                if decoder is not None:
-                    msg = decoder(raw.data)
+                msg = decoder(msg)
             except Exception as error:  # noqa: BLE001 - malformed CDR, any decoder failure
                 reason = reason_of(error)
-            if reason is not None:
-                count, first = recording.undecodable.get(channel.topic, (0, reason))
-                recording.undecodable[channel.topic] = (count + 1, first)
-                continue
-        recording.messages.append(RecordedMessage(
-            channel.topic, schema.name if schema else '', raw.log_time, raw.publish_time, msg))
-        counts[channel.topic] += 1
+        if reason is not None:
+            count, first = undecodable.get(topic, (0, reason))
+            undecodable[topic] = (count + 1, first)
+            continue
+        messages.append(RecordedMessage(topic, type_name, raw.log_time, raw.publish_time,
+                                        msg))
+        counts[topic] += 1
     for channel in channels.values():
         schema = schemas.get(channel.schema_id)
         recording.topics[channel.topic] = TopicInfo(
