@@ -360,6 +360,20 @@ def test_what_is_not_compiled_is_decoded_by_mcap_ros2(text, unsupported):
         assert ours[1] == theirs[1]
 
 
+def test_a_class_made_from_one_of_two_definitions_is_the_one_mcap_ros2_makes():
+    # Duration has no section: mcap_ros2 reads it with its own Time definition (uint32 sec),
+    # whose class is keyed 'builtin_interfaces/Time' like the schema's Time (int32 sec); with
+    # no Duration in the message, mcap_ros2 makes that class from the schema's Time
+    text = ('builtin_interfaces/Duration[] ds\nbuiltin_interfaces/Time t\n' + '=' * 80
+            + '\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n')
+    schema = Schema(id=6, name='test_pkg/msg/Two', encoding='ros2msg', data=text.encode())
+    payload = b'\x00\x01\x00\x00' + struct.pack('<IiI', 0, -1, 5)
+    msg = DecoderFactory().decoder_for('cdr', schema)(payload)
+    assert (msg.ds, msg.t.sec, msg.t.nanosec) == ([], -1, 5)
+    assert type(msg.t)._full_text.endswith('\nint32 sec\nuint32 nanosec')
+    assert_same(msg, McapDecoderFactory().decoder_for('cdr', schema)(payload))
+
+
 @pytest.mark.parametrize('name, text', [
     ('test_pkg/msg/Bad', 'floa64 x\n'), ('test_pkg/msg/Bad', 'float64 x y z\n'),
     ('test_pkg/msg/Bad', 'float64[-1] x\n'), ('', 'float64 x\n'),

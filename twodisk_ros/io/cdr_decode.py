@@ -35,8 +35,8 @@ raises what it raises:
   decoded again by ``mcap_ros2``'s own decoding function (``_read_message`` on the same
   definitions), whose value or exception stands, so error texts are ``mcap_ros2``'s;
 - a schema using what is not compiled here (``wstring``, a field type with no definition, a
-  field name that is a Python keyword, nesting deeper than 64) is decoded by ``mcap_ros2``
-  only.  Schema errors raise exactly what ``mcap_ros2``'s factory raises.
+  field name that is a Python keyword, nesting deeper than 64, two definitions of one type
+  name in use) is decoded by ``mcap_ros2`` only.  Schema errors raise exactly what ``mcap_ros2``'s factory raises.
 
 ``tests/test_cdr_decode.py`` checks the guarantee field by field (floats bit for bit) on
 recordings of the node, on random definitions and bytes, and on damaged payloads.  Only the
@@ -174,6 +174,7 @@ class _Compiler:
         self.namespace = {'_sequence': _sequence}
         self.values = {}
         self.readers = {}
+        self.class_defs = {}
         self.elements = {}
         self.sources = []
 
@@ -225,6 +226,11 @@ class _Compiler:
         """Code reading a message inline; returns the local holding it."""
         if depth > _MAX_INLINE_DEPTH:
             raise _Unsupported('nesting too deep')
+        key = str(msgdef.base_type)
+        if self.class_defs.setdefault(key, msgdef) is not msgdef:
+            # two definitions share a class (builtin_interfaces Time and Duration, one from
+            # the schema, one mcap_ros2's): which one makes it depends on the messages
+            raise _Unsupported(f'two definitions of {key}')
         cls = self.constant('C', _message_class(msgdef, self.class_cache))
         var = fn.local('m')
         fn.emit(f'{var} = {cls}()' if target is None else f'{target} = {var} = {cls}()')
@@ -355,6 +361,7 @@ def compile_decoder(schema_name, schema_text):
         source = '\n\n'.join(compiler.sources) + '\n'
         exec(compile(source, f'<cdr_decode {schema_name}>', 'exec'), compiler.namespace)
     except Exception:  # noqa: BLE001 - _Unsupported, or anything not foreseen here
+        class_cache.clear()     # mcap_ros2 makes its classes as it meets them
         return None, reference
     fast = compiler.namespace['decode']
     fast.source = source
