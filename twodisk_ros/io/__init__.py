@@ -3,6 +3,7 @@
 - :mod:`~twodisk_ros.io.writer`: :class:`McapRecorder` (needs rclpy only for its defaults);
 - :mod:`~twodisk_ros.io.reader`: :func:`read_recording` (mcap and mcap-ros2-support only);
 - :mod:`~twodisk_ros.io.mcap_scan`: the records of a cut or damaged file (recovery rule);
+- :mod:`~twodisk_ros.io.cdr_decode`: the reader's message decoders (mcap_ros2's results, faster);
 - :mod:`~twodisk_ros.io.msgdefs`: the ``ros2msg`` schema texts;
 - :mod:`~twodisk_ros.io.rosbag2_metadata`: the QoS and bag-metadata YAML;
 - :mod:`~twodisk_ros.io.errors`: :class:`RecordingError`.
