@@ -11,10 +11,10 @@ import time
 
 import numpy as np
 
-from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics import RollingDynamics, simulate
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.contact_forces import ContactForceModel
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.forces.contact import ContactForceModel
 
 STATES = 10**6
 REPEAT = 5

@@ -36,12 +36,12 @@ if ROOT not in sys.path:
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace  # noqa: E402
-from twodisk_ros.physics.dynamics import RollingDynamics  # noqa: E402
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse  # noqa: E402
-from twodisk_ros.physics.lamina_body import LaminaBody  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties_of  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace  # noqa: E402
+from twodisk_ros.physics.motion.dynamics import RollingDynamics  # noqa: E402
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse  # noqa: E402
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties_of  # noqa: E402
 
 REPEATS = 3
 SAMPLES = 1_000_000

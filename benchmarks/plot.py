@@ -8,7 +8,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from scenarios import BODIES  # noqa: E402
 
-from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
+from twodisk_ros.physics.motion.simulate import CLOSED_FORM_SOLVERS  # noqa: E402
 
 KIND_COLORS = {'rolling': '#1f77b4', 'oscillating': '#d62728', 'kinematic': '#2ca02c'}
 KIND_LABELS = {'rolling': 'dynamic, rolling over', 'oscillating': 'dynamic, oscillating',

@@ -10,7 +10,7 @@ import sweep_exponent
 import sweep_scaling
 from scenarios import BODIES, GRAVITY, MASS
 
-from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS
+from twodisk_ros.physics.motion.simulate import CLOSED_FORM_SOLVERS
 
 KIND_TEXT = {'rolling': 'dynamic, rolling over', 'oscillating': 'dynamic, oscillating',
              'kinematic': 'kinematic'}
@@ -80,7 +80,7 @@ def write_report(path, ctx):
 
     # --- setup
     w('## Setup\n')
-    w(f'- Mass model `twodisk_ros.physics.mass_models.laminae`, M = {MASS:g} kg, g = {GRAVITY} m/s²; '
+    w(f'- Mass model `twodisk_ros.physics.mass.models.laminae`, M = {MASS:g} kg, g = {GRAVITY} m/s²; '
       'every run is sampled at 1 kHz (`t_eval`) and the poses of G, A and B are computed '
       'with `RollingMotion.positions()`.')
     w('- Methods: `simulate(..., method=\'direct\')` (DOP853 on the closed forms) and '

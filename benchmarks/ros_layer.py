@@ -29,8 +29,8 @@ from targets import poses_throughput
 import view_rate
 
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.mass_models import clear_hull_cache, mass_properties, solid_hull
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.mass.models import clear_hull_cache, mass_properties, solid_hull
 
 TARGET_POSES, TARGET_POSITIONS, TARGET_FLOOR_SHARE = 1.5e6, 3e6, 0.6
 

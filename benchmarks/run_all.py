@@ -55,7 +55,7 @@ from reference import ReferenceBody  # noqa: E402
 
 from twodisk_ros import TwoDiskBody  # noqa: E402
 from twodisk_ros.outputs import OutputError, check_output  # noqa: E402
-from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
+from twodisk_ros.physics.motion.simulate import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
 import sweep_exponent  # noqa: E402
 import sweep_scaling  # noqa: E402

@@ -9,7 +9,7 @@ scene's tables are built beforehand and their cost reported on its own), best of
 
 * the flat free scene: today's ``MotionStream`` (the table method's quadrature);
 * conservative scenes on a slope through ``scene_stream`` (the closed forms of
-  physics/scene_closed.py): rolling on down a 0.05 rad slope (quadrature with the drift
+  physics/scenes/closed.py): rolling on down a 0.05 rad slope (quadrature with the drift
   composed) and swinging across a 0.2 rad slope (oscillation between turning points);
   target: within 2× of the flat case (``TARGET_RATIO``);
 * the general integrator (DOP853, ``SceneStream``) where the scene needs it: on flat ground
@@ -35,10 +35,10 @@ if ROOT not in sys.path:
 import numpy as np  # noqa: E402
 
 from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
-from twodisk_ros.physics.scene import Scene  # noqa: E402
-from twodisk_ros.physics.scene_motion import SceneStream, scene_stream  # noqa: E402
-from twodisk_ros.physics.scene_terms import SceneTerms  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
+from twodisk_ros.physics.scenes.scene import Scene  # noqa: E402
+from twodisk_ros.physics.scenes.motion import SceneStream, scene_stream  # noqa: E402
+from twodisk_ros.physics.scenes.terms import SceneTerms  # noqa: E402
 
 REPEATS = 3
 DURATION, RATE = 10.0, 1000.0

@@ -33,8 +33,8 @@ if __name__ == '__main__':
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.sweep.chunks import chunk_quantities  # noqa: E402
 from twodisk_ros.sweep.quantities import STAGES  # noqa: E402
 from twodisk_ros.sweep.request import (CORE_SECONDS_PER_BODY, DEFAULT_CHUNK_SIZE,  # noqa: E402

@@ -30,7 +30,7 @@ from work_precision import (REFERENCE_CHECK_RTOL, REFERENCE_RTOL, position_error
                             _timed)
 
 from twodisk_ros import simulate  # noqa: E402
-from twodisk_ros.physics.motion import CLOSED_FORM_SOLVERS  # noqa: E402
+from twodisk_ros.physics.motion.simulate import CLOSED_FORM_SOLVERS  # noqa: E402
 
 TWO_PI = 2 * math.pi
 

@@ -11,7 +11,7 @@ from reference import ReferenceBody, ReferenceSolution
 from scenarios import BODIES, GRAVITY, MASS
 
 from twodisk_ros import RollingCycle, RollingDynamics, TwoDiskBody, simulate
-from twodisk_ros.physics.mass_models import laminae
+from twodisk_ros.physics.mass.models import laminae
 
 METHODS = ('direct', 'table')
 TOLERANCES = (1e-6, 1e-8, 1e-10, 1e-12)

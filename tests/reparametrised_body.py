@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.body import PhaseGeometry
-from twodisk_ros.physics.rolling_body import RollingBody
+from twodisk_ros.physics.bodies.ellipse import PhaseGeometry
+from twodisk_ros.physics.bodies.protocol import RollingBody
 
 __all__ = ['ReparametrisedBody']
 

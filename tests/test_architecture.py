@@ -34,7 +34,7 @@ def test_physics_imports_without_rclpy_or_matplotlib():
 def test_a_default_node_run_does_not_import_scipy_spatial(tmp_path):
     """scipy.spatial costs half a second of CPU at import (k-d trees, sparse matrices, qhull),
     and the node needs only rotation matrices to quaternions of it (Markley's method in
-    physics/orientation.py, checked against scipy in tests/test_poses.py)."""
+    physics/bodies/orientation.py, checked against scipy in tests/test_poses.py)."""
     record = tmp_path / 'run.mcap'
     code = ('import sys\n'
             'from twodisk_ros.node.main import main\n'
@@ -117,8 +117,10 @@ def test_modules_stay_small(path):
 
 def test_import_linter_contracts_hold_and_place_every_module():
     """The layers of .importlinter (import-linter: every import, deferred ones too), the
-    ROS-free and matplotlib-free rules, no import cycles; and every subpackage and top-level module of the
-    package has its place in the layers (a new one must be placed)."""
+    ROS-free and matplotlib-free rules, no import cycles, the physics' own layers; and every
+    subpackage and top-level module of the package, and every subpackage of the physics, has
+    its place in the layers (a new one must be placed), and the physics has no module outside
+    a subpackage."""
     import configparser
     config = configparser.ConfigParser()
     config.read(REPO / '.importlinter', encoding='utf-8')
@@ -128,12 +130,17 @@ def test_import_linter_contracts_hold_and_place_every_module():
                if (p.suffix == '.py' and p.stem != '__init__')
                or (p.is_dir() and (p / '__init__.py').is_file())}
     assert placed == present, (sorted(present - placed), sorted(placed - present))
+    physics = config['importlinter:contract:physics-layers']['layers'].split()
+    concepts = {p.name for p in (PACKAGE / 'physics').iterdir()
+                if p.is_dir() and (p / '__init__.py').is_file()}
+    assert {name for name in physics if name != '|'} == concepts
+    assert [p.name for p in (PACKAGE / 'physics').glob('*.py')] == ['__init__.py']
     lint = Path(sys.executable).parent / 'lint-imports'
     result = subprocess.run([str(lint), '--config', str(REPO / '.importlinter'),
                              '--no-cache'], cwd=REPO, capture_output=True, text=True,
                             timeout=120, env=ENV)
     assert result.returncode == 0, result.stdout[-4000:] + result.stderr[-2000:]
-    assert 'Contracts: 4 kept, 0 broken.' in result.stdout, result.stdout[-2000:]
+    assert 'Contracts: 5 kept, 0 broken.' in result.stdout, result.stdout[-2000:]
 
 
 NOTHING_IMPORTED_WHILE_SAMPLING = '''

@@ -1,4 +1,4 @@
-"""Tests of the closed forms in :mod:`twodisk_ros.physics.body` against an independent construction.
+"""Tests of the closed forms in :mod:`twodisk_ros.physics.bodies.ellipse` against an independent construction.
 
 Body frame ``G e1 e2 e3`` (m): disk 1 in ``x3 = 0`` centred at ``(0, -delta, 0)``, disk 2 in
 ``x1 = 0`` centred at ``(0, +delta, 0)``, semi-axis ``a`` along e2 and ``b`` across.
@@ -29,7 +29,7 @@ from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 
 # -- tolerances (all measured with the reference below; the margin is ~100x) ----------------
 #: ψ (rad) and unit vectors, interior points |η| ≤ 0.99 η_max of the hypothesis range

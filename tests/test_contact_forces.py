@@ -34,12 +34,12 @@ from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics import RollingDynamics, simulate
-from twodisk_ros.physics.equilibria import STABLE, equilibria
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.contact_forces import ContactForceModel, squeeze_split
-from twodisk_ros.physics.contact_validity import (
+from twodisk_ros.physics.stability.equilibria import STABLE, equilibria
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.forces.contact import ContactForceModel, squeeze_split
+from twodisk_ros.physics.forces.validity import (
     check_validity, liftoff_speed, motion_validity, mu_required_dynamic, mu_required_kinematic)
 
 MASS = 1.3        # kg: not 1, so a missing factor M shows

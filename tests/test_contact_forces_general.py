@@ -22,14 +22,14 @@ from scipy.integrate import quad
 
 from reparametrised_body import ReparametrisedBody
 from test_contact_forces import GRAVITY, MASS, newton_euler_forces
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.contact_validity import (
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.forces.validity import (
     check_validity, liftoff_speed, mu_required_dynamic, mu_required_kinematic)
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.mass_models import laminae, laminae_of
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.mass.models import laminae, laminae_of
 
 TWO_PI = 2 * math.pi
 FIGURE3 = (0.2, 0.1, 0.1)

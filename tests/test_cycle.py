@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.physics.cycle`: whole rolling cycles in the world frame.
+"""Tests of :mod:`twodisk_ros.physics.bodies.cycle`: whole rolling cycles in the world frame.
 
 World frame (m): Z up, the ground is Z = 0; ``state.rotation`` maps body → world.
 References never come from the code under test:
@@ -30,8 +30,8 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace
 
 TWO_PI = 2 * math.pi
 SQRT2, SQRT3 = math.sqrt(2.0), math.sqrt(3.0)

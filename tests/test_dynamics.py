@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.physics.dynamics` against independent references.
+"""Tests of :mod:`twodisk_ros.physics.motion.dynamics` against independent references.
 
 Nothing here compares the module with its own output. The references are:
 
@@ -32,11 +32,11 @@ from scipy.interpolate import CubicSpline
 
 from paper_forms import curvature_at_half_pi
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle, integrate_contact_trace
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace
 from twodisk_ros.physics import MotionStream, RollingDynamics, simulate, simulate_phase
-from twodisk_ros.physics.equilibria import STABLE, UNSTABLE, equilibria
-from twodisk_ros.physics.mass_models import laminae, solid_hull
+from twodisk_ros.physics.stability.equilibria import STABLE, UNSTABLE, equilibria
+from twodisk_ros.physics.mass.models import laminae, solid_hull
 
 # ----------------------------------------------------------------------------- constants
 

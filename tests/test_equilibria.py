@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.physics.equilibria`: the eight rest positions per cycle and their stability.
+"""Tests of :mod:`twodisk_ros.physics.stability.equilibria`: the eight rest positions per cycle and their stability.
 
 Heights are those of G above the ground (m), i.e. the potential energy per unit M g.
 The reference height used here is built independently of the code and of the triple-product
@@ -20,9 +20,10 @@ from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0, height_slope
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.equilibria import NEUTRAL, STABLE, UNSTABLE, equilibria, stability_map
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.stability.equilibria import (NEUTRAL, STABLE, UNSTABLE, equilibria,
+                                                     stability_map)
 
 SQRT2 = math.sqrt(2.0)
 

@@ -1,4 +1,4 @@
-"""Equilibria of any RollingBody (physics/equilibria_general.py) against independent references.
+"""Equilibria of any RollingBody (physics/stability/certified.py) against independent references.
 
 The reference body is an ellipse seen through another phase (tests/reparametrised_body.py):
 u = g(v), smooth (g = v + ε sin 2v) or degenerate (g = v − ½ sin 2v: the body does not turn
@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.equilibria import STABLE, UNSTABLE, equilibria
-from twodisk_ros.physics.equilibria_general import certified_roots
-from twodisk_ros.physics.symmetric_stability import symmetric_equilibria
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.stability.equilibria import STABLE, UNSTABLE, equilibria
+from twodisk_ros.physics.stability.certified import certified_roots
+from twodisk_ros.physics.stability.symmetric import symmetric_equilibria
 
 #: θ and z_G (rad, relative to the size) of the general search against the ellipse's exact
 #: angles: measured ≤ 9e-16 (docs: ≤ 1e-14; issue 20 asks ≤ 1e-11).
@@ -123,9 +123,9 @@ def test_flat_vertex_equilibria_sit_exactly_on_the_vertex(shape, delta):
     flat-vertex pose (bisection of the sign of dz_G/du stopped 1.3e-5 rad off: z_G − z* is
     below rounding there), with θ, stability and order of symmetric_stability's closed forms
     (an independent derivation from the vertex's order of contact)."""
-    from twodisk_ros.physics.equilibria_general import flat_vertex_phases
-    from twodisk_ros.physics.lamina import Superellipse
-    from twodisk_ros.physics.lamina_body import LaminaBody
+    from twodisk_ros.physics.stability.certified import flat_vertex_phases
+    from twodisk_ros.physics.laminae.shapes import Superellipse
+    from twodisk_ros.physics.bodies.lamina_body import LaminaBody
     body = LaminaBody(Superellipse(*shape), delta)
     phases = flat_vertex_phases(body)
     found = equilibria(body)

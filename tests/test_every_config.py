@@ -9,7 +9,7 @@ description). ``rolling_validity`` is the model's verdict on the motion (lift-of
 spike where a contact crosses a flat vertex (the contact point runs along the rim infinitely
 fast per unit of turn), physics, not an error. For it the test asserts that the inspector,
 from the recorded wrenches, reaches the verdict the node reached while it ran
-(:func:`~twodisk_ros.physics.contact_forces.check_validity` in the node, which logs "outside
+(:func:`~twodisk_ros.physics.forces.validity.check_validity` in the node, which logs "outside
 the rolling model"): two readers of the same forces agree.
 
 Nodes run as subprocesses in ROS domain 60 (discovery localhost-only); the view runs with

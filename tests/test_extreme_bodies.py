@@ -22,11 +22,11 @@ from scipy.integrate import IntegrationWarning, quad
 
 from rounding import ulps
 from twodisk_ros.physics import RollingCycle, RollingDynamics, TwoDiskBody, equilibria
-from twodisk_ros.physics.body import LENGTH_RANGE
-from twodisk_ros.physics.mass_models import laminae
-from twodisk_ros.physics.motion import MotionStream, simulate_phase
-from twodisk_ros.physics.solvers import LibrationSolution
-from twodisk_ros.physics.startup import NOTICE_SECONDS, startup_estimate
+from twodisk_ros.physics.bodies.ellipse import LENGTH_RANGE
+from twodisk_ros.physics.mass.models import laminae
+from twodisk_ros.physics.motion.simulate import MotionStream, simulate_phase
+from twodisk_ros.physics.motion.solvers import LibrationSolution
+from twodisk_ros.physics.motion.startup import NOTICE_SECONDS, startup_estimate
 
 GRAVITY = 9.81
 

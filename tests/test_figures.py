@@ -18,7 +18,7 @@ from numpy.testing import assert_allclose  # noqa: E402
 
 from rounding import ulps  # noqa: E402
 from twodisk_ros.plotting import figures  # noqa: E402
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 
 EXPECTED = ['figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png',
             'laminae_traces.png']
@@ -120,7 +120,7 @@ def test_stability_map_neutral_curve():
 
 def test_core_does_not_import_matplotlib():
     code = ('import sys; import twodisk_ros.physics; '
-            'import twodisk_ros.physics.tables; print("matplotlib" in sys.modules)')
+            'import twodisk_ros.physics.numerics.tables; print("matplotlib" in sys.modules)')
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == 'False'
@@ -148,7 +148,7 @@ def test_contact_force_figures_are_written(tmp_path, capsys):
 
 def test_coinciding_liftoff_speeds_are_named_together():
     """The oloid (8.2810) and the Fig. 3 body (8.2796 rad/s) share one dotted line: said."""
-    from twodisk_ros.physics.contact_validity import liftoff_speed
+    from twodisk_ros.physics.forces.validity import liftoff_speed
     from twodisk_ros.plotting import contact_forces
     criticals = [liftoff_speed(contact_forces.force_model(shape))[0]
                  for _, shape in contact_forces.BODIES]
@@ -222,7 +222,7 @@ def test_overwrite_replaces_the_figures(tmp_path, capsys):
 # -- the sweep maps -----------------------------------------------------------------------
 def _sweep(b_over_a, delta_over_a):
     import xarray as xr
-    from twodisk_ros.physics.equilibria import stability_map
+    from twodisk_ros.physics.stability.equilibria import stability_map
     b, d = np.meshgrid(b_over_a, delta_over_a, indexing='ij')
     return xr.Dataset({
         'stable_family': (('b_over_a', 'delta_over_a'), stability_map(b, d).astype(float),

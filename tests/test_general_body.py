@@ -1,4 +1,4 @@
-"""physics/general_body.py (issue 20, step 2) against independent references.
+"""physics/bodies/contact_solver.py (issue 20, step 2) against independent references.
 
 References: TwoDiskBody's closed forms (the paper's, a different derivation: Q(θ), its exact
 factorisation and the eccentric-anomaly phase) for ellipses; the oloid's literature values;
@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.general_body import GeneralTwoDiskBody
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
 
 #: (a, b, Δ): oloid, Two-Circle-Roller, thin (b/a = 0.2) and wide (b/a = 3) at several Δ/a
 ELLIPSE_BODIES = [(1.0, 1.0, 0.5), (1.0, 1.0, 1 / math.sqrt(2)), (1.0, 0.2, 0.05),
@@ -275,7 +275,7 @@ def test_root_finder_pins_each_root_between_adjacent_floats_in_few_evaluations()
     References: the roots are cbrt(k) and sqrt(k) (to 16 ulps: the root as evaluated is within
     an ulp or two of the exact one); the evaluations are
     counted (plain bisection: ~55 per root, ~1075 with a root at 0)."""
-    from twodisk_ros.physics.general_body import _bisect
+    from twodisk_ros.physics.bodies.contact_solver import _bisect
     k = np.concatenate([[0.0, 8.0], np.linspace(1e-6, 7.9, 97)])
     calls = []
 

@@ -23,13 +23,13 @@ from numpy.testing import assert_allclose
 from scipy.spatial import ConvexHull
 from scipy.special import ellipe, ellipk
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.general_body import GeneralTwoDiskBody
-from twodisk_ros.physics.hull import unit_hull_moments
-from twodisk_ros.physics.hull_general import SWAP, MirroredLamina, general_hull_moments
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
-from twodisk_ros.physics.lamina_fit import Outline
-from twodisk_ros.physics.mass_models import mass_properties, mass_properties_of
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.mass.hull import unit_hull_moments
+from twodisk_ros.physics.mass.hull_laminae import SWAP, MirroredLamina, general_hull_moments
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.fit import Outline
+from twodisk_ros.physics.mass.models import mass_properties, mass_properties_of
 
 OLOID_VOLUME = 2.0 / 3.0 * (2.0 * ellipe(0.75) + ellipk(0.75))
 

@@ -27,9 +27,9 @@ from std_msgs.msg import Header  # noqa: E402
 
 from twodisk_ros.inspect import cli as inspect_cli  # noqa: E402
 from twodisk_ros.inspect import finite_differences, inspect_recording  # noqa: E402
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.io import McapRecorder, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros

@@ -29,10 +29,10 @@ from twodisk_ros.inspect import inspect_recording  # noqa: E402
 from twodisk_ros.inspect.differences import finite_differences, second_differences  # noqa
 from twodisk_ros.io import McapRecorder  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.contact_forces import ContactForceModel  # noqa: E402
-from twodisk_ros.physics.contact_validity import check_validity, liftoff_speed  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
+from twodisk_ros.physics.forces.validity import check_validity, liftoff_speed  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

@@ -1,4 +1,4 @@
-"""The lamina protocol (physics/lamina.py, lamina_fit.py) against independent references.
+"""The lamina protocol (physics/laminae/shapes.py, lamina_fit.py) against independent references.
 
 References: closed forms from the literature (ellipse area, moments, curvature; the
 superellipse's Gamma-function area), and a generic numeric path written here from the
@@ -14,8 +14,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from rounding import ulps
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
-from twodisk_ros.physics.lamina_fit import Outline, read_outline
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.fit import Outline, read_outline
 
 SHAPES = [Ellipse(2.0, 1.0), Ellipse(0.3, 1.7), Superellipse(1.0, 1.5, 2.0),
           Superellipse(2.0, 1.0, 3.0), Superellipse(1.0, 1.0, 4.0), Superellipse(1.0, 2.0, 10.0),

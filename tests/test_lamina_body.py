@@ -1,4 +1,4 @@
-"""physics/lamina_body.py (LaminaBody: the regular phase of any two laminae) against
+"""physics/bodies/lamina_body.py (LaminaBody: the regular phase of any two laminae) against
 independent references.
 
 References: TwoDiskBody's closed forms (eccentric-anomaly phase, complex step) for ellipses,
@@ -19,12 +19,12 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.lamina_fit import Outline
-from twodisk_ros.physics.rolling_body import RollingBody
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.laminae.fit import Outline
+from twodisk_ros.physics.bodies.protocol import RollingBody
 
 TWO_PI = 2 * math.pi
 #: (a, b, Δ): oloid, Two-Circle-Roller, thin (b/a = 0.2) and wide (b/a = 3) at several Δ/a

@@ -15,13 +15,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.lamina import Egg, Superellipse
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.mass_models import centred_on_mass, mass_properties_of
-from twodisk_ros.physics.motion import simulate
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.mass.models import centred_on_mass, mass_properties_of
+from twodisk_ros.physics.motion.simulate import simulate
 
 TWO_PI = 2 * math.pi
 GRAVITY = 9.81

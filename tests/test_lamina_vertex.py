@@ -14,9 +14,9 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 from rounding import ulps
-from twodisk_ros.physics.lamina import Egg, Ellipse, Lamina, Superellipse
-from twodisk_ros.physics.lamina_fit import Outline
-from twodisk_ros.physics.symmetric_stability import symmetric_equilibria
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Lamina, Superellipse
+from twodisk_ros.physics.laminae.fit import Outline
+from twodisk_ros.physics.stability.symmetric import symmetric_equilibria
 
 
 @pytest.mark.parametrize('a, b', [(2.0, 1.0), (1.0, 3.0), (1.0, 1.0)])

@@ -35,7 +35,7 @@ from scipy.integrate import solve_ivp
 
 from rounding import ulps
 from twodisk_ros.physics import TwoDiskBody, RollingDynamics, simulate, simulate_phase
-from twodisk_ros.physics.mass_models import laminae
+from twodisk_ros.physics.mass.models import laminae
 
 MASS, GRAVITY = 1.0, 9.81
 BODIES = {'oloid': (0.1, 0.1, 0.05),          # θ = ±π/2 stable

@@ -1,4 +1,4 @@
-"""Tests of :mod:`twodisk_ros.physics.mass_models` against independent references.
+"""Tests of :mod:`twodisk_ros.physics.mass.models` against independent references.
 
 Body frame ``G e1 e2 e3`` (m): disk 1 in ``x3 = 0`` centred at ``(0, -delta, 0)``, disk 2 in
 ``x1 = 0`` centred at ``(0, +delta, 0)``, semi-axis ``a`` along e2 and ``b`` across.
@@ -22,8 +22,9 @@ from scipy.spatial import ConvexHull
 from scipy.special import ellipe, ellipk
 
 from rounding import ulps
-from twodisk_ros.physics import hull, mass_models
-from twodisk_ros.physics.mass_models import MassProperties, custom, laminae, mass_properties, solid_hull
+from twodisk_ros.physics.mass import hull, models as mass_models
+from twodisk_ros.physics.mass.models import (MassProperties, custom, laminae, mass_properties,
+                                             solid_hull)
 
 # Oloid volume / r**3 = (2/3) (2 E(m) + K(m)) with parameter m = 3/4 (Dirnboeck & Stachel 1997,
 # "The development of the oloid"; numerically 3.0524184684...). Its surface area is 4 pi r**2.

@@ -27,7 +27,7 @@ from twodisk_ros.model.mesh import (DEFAULT_THICKNESS, Mesh, body_mesh, hull_mes
 from twodisk_ros.model.stl import cache_directory, cached_stl, stl_bytes
 from twodisk_ros.outputs import OutputError
 from twodisk_ros.physics import TwoDiskBody
-from twodisk_ros.physics.mass_models import laminae, mass_properties, solid_hull
+from twodisk_ros.physics.mass.models import laminae, mass_properties, solid_hull
 
 # Oloid volume / r³ = (2/3)(2E(3/4) + K(3/4)) = 3.0524184684...
 OLOID_VOLUME = 2.0 / 3.0 * (2.0 * ellipe(0.75) + ellipk(0.75))

@@ -26,8 +26,8 @@ from twodisk_ros.model.mesh import body_mesh, mesh_parts
 from twodisk_ros.model.outline import frame_rims, lamina_outline
 from twodisk_ros.model.stl import cached_stl
 from twodisk_ros.physics import TwoDiskBody
-from twodisk_ros.physics.general_body import GeneralTwoDiskBody
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
 
 LAMINAE = [Ellipse(1.0, 0.3), Ellipse(0.5, 0.5), Superellipse(1.0, 1.0, 6),
            Superellipse(1.0, 0.5, 100), Superellipse(0.3, 0.8, 2.5), Egg(1.0, 0.8, 0.06),
@@ -71,7 +71,7 @@ def test_outline_misses_the_support_function_by_at_most_its_tolerance(lamina, to
 def test_outline_of_a_fitted_outline():
     # a lamina fitted from points (lamina_fit.Outline: a support-function lamina whose
     # parameter is the normal angle) is drawn to the same guarantee
-    from twodisk_ros.physics.lamina_fit import Outline
+    from twodisk_ros.physics.laminae.fit import Outline
     given = Egg(1.0, 0.7, 0.05).point(np.linspace(0, 2 * np.pi, 200, endpoint=False))
     lamina = Outline.from_points(given)
     points = lamina_outline(lamina, 1e-4)

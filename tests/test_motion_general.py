@@ -1,4 +1,4 @@
-"""Motions of any RollingBody (physics/motion_general.py) against the ellipse's own motions.
+"""Motions of any RollingBody (physics/motion/sundman.py) against the ellipse's own motions.
 
 The reference body is an ellipse seen through another phase (tests/reparametrised_body.py),
 smooth or degenerate (the body does not turn in u at v = 0, π: m = 0, u̇ infinite there). Its
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.mass_models import laminae
-from twodisk_ros.physics.motion import simulate
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.mass.models import laminae
+from twodisk_ros.physics.motion.simulate import simulate
 
 BASE = (1.0, 1.6, 0.4)
 #: G's position, closed-form solutions (quadrature, libration, rest) of both paths: measured
@@ -95,7 +95,7 @@ LAMINA_TOL, LAMINA_PERIOD_RTOL = 5e-12, 1e-10
 def test_lamina_body_of_an_ellipse_moves_as_the_ellipse(bodies, mode):
     """Claim: the general path on LaminaBody(Ellipse) (the lamina's support function, not the
     ellipse's closed forms) moves the body as the ellipse path does, with its periods."""
-    from twodisk_ros.physics.lamina_body import LaminaBody
+    from twodisk_ros.physics.bodies.lamina_body import LaminaBody
     reference, _ = bodies
     dynamics = RollingDynamics(LaminaBody(reference.body.lamina, reference.body.delta),
                                reference.mass)

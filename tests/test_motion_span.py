@@ -1,4 +1,4 @@
-"""Oscillations over several wells (physics/turning.py) of a body with unequal maxima of V.
+"""Oscillations over several wells (physics/motion/turning.py) of a body with unequal maxima of V.
 
 The parallel egg's V has maxima V(0) < V(π/2): an energy between them crosses the lower
 maximum and swings between two turning points around two minima. References, independent of
@@ -14,13 +14,13 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.contact_validity import mu_required_dynamic
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.lamina import Egg
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.mass_models import centred_on_mass
-from twodisk_ros.physics.motion import MotionStream, simulate
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.forces.validity import mu_required_dynamic
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.laminae.shapes import Egg
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.mass.models import centred_on_mass
+from twodisk_ros.physics.motion.simulate import MotionStream, simulate
 
 #: G's position against the DOP853 reference over 3 s: measured ≤ 1.8e-9 of the size (over
 #: the 2 s of T, one period and both turning points: ≤ 1e-9); the

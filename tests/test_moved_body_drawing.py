@@ -16,9 +16,9 @@ from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.frames import disk_rims
 from twodisk_ros.model.outline import DEFAULT_TOLERANCE
 from twodisk_ros.model.rulings import hull_rulings
-from twodisk_ros.physics.lamina import Egg
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.mass_models import centred_on_mass
+from twodisk_ros.physics.laminae.shapes import Egg
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.mass.models import centred_on_mass
 
 LAMINA = Egg(0.1, 0.08, 0.5 * Egg.epsilon_max(0.1, 0.08))      # config/egg.yaml's laminae
 

@@ -17,9 +17,9 @@ import pytest  # noqa: E402
 
 from twodisk_ros.io import read_recording  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.contact_forces import ContactForceModel  # noqa: E402
-from twodisk_ros.physics.contact_validity import liftoff_speed  # noqa: E402
-from twodisk_ros.physics.mass_models import laminae  # noqa: E402
+from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
+from twodisk_ros.physics.forces.validity import liftoff_speed  # noqa: E402
+from twodisk_ros.physics.mass.models import laminae  # noqa: E402
 
 pytestmark = pytest.mark.ros
 WEIGHT = 9.81   # M g of the default 1 kg body (N)

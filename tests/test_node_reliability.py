@@ -366,7 +366,7 @@ def test_direct_method_in_real_time_runs_past_its_integration_chunks(ros_context
         node.close()
         node.destroy_node()
     from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
-    from twodisk_ros.physics.mass_models import laminae
+    from twodisk_ros.physics.mass.models import laminae
     dynamics = RollingDynamics(TwoDiskBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
     stream = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=0.5, tolerance=1e-8)
     reference = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=100.0, tolerance=1e-8)

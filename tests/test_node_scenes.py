@@ -21,8 +21,8 @@ import pytest  # noqa: E402
 from rounding import ulps  # noqa: E402
 from twodisk_ros.io import read_recording  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.mass_models import laminae  # noqa: E402
-from twodisk_ros.physics.motion import MotionStream  # noqa: E402
+from twodisk_ros.physics.mass.models import laminae  # noqa: E402
+from twodisk_ros.physics.motion.simulate import MotionStream  # noqa: E402
 
 pytestmark = pytest.mark.ros
 BATCH_DOMAIN, LIVE_DOMAIN = 68, 67
@@ -179,9 +179,9 @@ def test_the_time_to_rest_is_in_the_diagnostics(context, tmp_path, losses):
     Losses of 0.03 bring the default oloid to rest after 5.8 s (damping) and 3.4 s (rolling
     resistance) instead of 18 s and 9.3 s at 0.01: the same claim on a shorter run."""
     from twodisk_ros.run.parameters import DEFAULTS
-    from twodisk_ros.physics.scene import Scene
-    from twodisk_ros.physics.scene_events import settle
-    from twodisk_ros.physics.scene_terms import SceneTerms
+    from twodisk_ros.physics.scenes.scene import Scene
+    from twodisk_ros.physics.scenes.events import settle
+    from twodisk_ros.physics.scenes.terms import SceneTerms
     rate, s = 100.0, DEFAULTS
     u0 = float(DYNAMICS.body.phase_from_theta(s.theta0, s.branch))
     t_rest, _, _ = settle(SceneTerms(DYNAMICS, Scene(gravity=s.gravity, **losses)), u0,

@@ -1,9 +1,9 @@
 """The node with the shape parameters: bad input at start-up and at run time, and recorded runs
 of non-elliptic bodies checked by ``twodisk-inspect`` (issue 20).
 
-The end-to-end runs need :class:`~twodisk_ros.physics.lamina_body.LaminaBody`; while it is a
-placeholder they are skipped, saying so. Subprocess nodes use ROS domain 62, in-process ones
-63; discovery is localhost-only.
+The end-to-end runs build :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` in the
+node and fail if it cannot be built (nothing is skipped). Subprocess nodes use ROS domain 62,
+in-process ones 63; discovery is localhost-only.
 """
 
 import os
@@ -17,8 +17,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from twodisk_ros.physics.lamina import Egg, Superellipse  # noqa: E402
-from twodisk_ros.physics import lamina_body  # noqa: E402
+from twodisk_ros.physics.laminae.shapes import Egg, Superellipse  # noqa: E402
 
 from roller_here import run_roller_main  # noqa: E402
 
@@ -28,21 +27,6 @@ REPO = Path(__file__).resolve().parents[1]
 SUBPROCESS_DOMAIN = 62
 IN_PROCESS_DOMAIN = 63
 TIMEOUT = 120      # s: a short batch run starts and ends in a few seconds on a loaded machine
-
-
-def _lamina_body_missing():
-    """Why LaminaBody cannot be built yet, or None once it is implemented."""
-    if getattr(lamina_body.LaminaBody, '__abstractmethods__', None):
-        return 'LaminaBody is still the placeholder (abstract methods)'
-    try:
-        lamina_body.LaminaBody(Superellipse(1.0, 1.0, 4.0), 0.5)
-    except NotImplementedError as error:
-        return f'LaminaBody is not implemented: {error}'
-    return None
-
-
-needs_lamina_body = pytest.mark.skipif(_lamina_body_missing() is not None,
-                                       reason=str(_lamina_body_missing()))
 
 
 def env():
@@ -158,7 +142,6 @@ def assert_consistent(checks, shape_words):
     assert shape_words in ' '.join(checks['inputs'].detail), checks['inputs'].detail
 
 
-@needs_lamina_body
 @pytest.mark.parametrize('params, words', [
     (['-p', 'shape:=superellipse', '-p', 'exponent:=4.0', '-p', 'b:=0.08', '-p',
       'delta:=0.04'], 'body superellipse a = 0.1 m, b = 0.08 m, exponent 4'),
@@ -196,7 +179,6 @@ def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words, 
     assert code in (0, 1) and 'result: ' in out, err
 
 
-@needs_lamina_body
 def test_a_points_run_is_checked_without_its_shape_file(tmp_path, monkeypatch, capfd):
     """The node through its entry function in this process (the shape file relative to it)."""
     np.savetxt(tmp_path / 'egg.csv', egg_points(), delimiter=',', header='x,y', comments='')

@@ -64,7 +64,7 @@ def test_figures_and_animation_take_their_colours_from_the_palette():
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    from twodisk_ros.physics.body import TwoDiskBody
+    from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
     from twodisk_ros.plotting import animation, figures
     fig, ax = plt.subplots()
     try:

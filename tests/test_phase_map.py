@@ -1,4 +1,4 @@
-"""physics/phase_map.py (the phase parameter of a lamina) and LaminaBody.flat_vertex_phases.
+"""physics/laminae/phase_map.py (the phase parameter of a lamina) and LaminaBody.flat_vertex_phases.
 
 References: the map's own definition evaluated in mpmath-free closed form (t − α sin 4t / 4,
 its Taylor series at a vertex), central differences, the superellipse's vertices from its
@@ -12,9 +12,9 @@ import pytest
 from numpy.testing import assert_allclose
 
 from rounding import ulps
-from twodisk_ros.physics.lamina import Egg, Superellipse
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.phase_map import PhaseMap, phase_map
+from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.laminae.phase_map import PhaseMap, phase_map
 
 
 @pytest.mark.parametrize('alphas', [(1.0,), (1.0, 1.0), (-0.8,), (0.5, -0.3)])

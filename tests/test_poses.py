@@ -1,7 +1,7 @@
 """Tests of the fast pose path :meth:`RollingCycle.poses` and its continuous quaternion.
 
 Convention under test: quaternions (x, y, z, w), body → world, a continuous function of the
-phase u with w > 0 at u = 0 (:mod:`twodisk_ros.physics.orientation`). References:
+phase u with w > 0 at u = 0 (:mod:`twodisk_ros.physics.bodies.orientation`). References:
 
 * the orientation: ``Rotation.from_matrix(state.rotation)``, the closed-form R = R_z(α) C(u)
   (C from the body's closed-form t1 and n, per sample); quaternions are compared as
@@ -24,10 +24,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.orientation import quaternion_from_matrix
-from twodisk_ros.physics.tables import HermiteTable
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.bodies.orientation import quaternion_from_matrix
+from twodisk_ros.physics.numerics.tables import HermiteTable
 
 TWO_PI = 2 * math.pi
 

@@ -32,8 +32,8 @@ from nav_msgs.msg import Path as PathMsg  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from visualization_msgs.msg import MarkerArray  # noqa: E402
 
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.equilibria import equilibria  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.stability.equilibria import equilibria  # noqa: E402
 from twodisk_ros.io import read_recording  # noqa: E402
 from twodisk_ros.node.roller import Roller  # noqa: E402
 

@@ -2,8 +2,8 @@
 
 References are independent of the code under test: the ellipse's closed forms (TwoDiskBody's
 θ_max, the superellipse at n = 2 is the ellipse), the egg's closed forms (ε_max = r/8 for a
-circle, its ends at −(a + ε) and a − ε), points sampled from a known ellipse, and today's
-ellipse path built by hand (TwoDiskBody, mass_properties, RollingDynamics, MotionStream).
+circle, its ends at −(a + ε) and a − ε), points sampled from a known ellipse, and the energy
+integral of a free motion (tests/energy_integral.py).
 """
 
 import json
@@ -17,13 +17,12 @@ from twodisk_ros.node import arguments
 from twodisk_ros.run.params_yaml import params_file_values
 from twodisk_ros.run.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
 from twodisk_ros.run.simulation import Simulation
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.lamina import Egg
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.motion import MotionStream
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.laminae.shapes import Egg
 from twodisk_ros.run import shape as shapes
 from twodisk_ros.run.description import RunDescription
+
+from energy_integral import phase_rate, times_to
 
 #: Ellipse used for the points outlines (m): half length a along the common axis, b across.
 A, B = 0.1, 0.06
@@ -63,22 +62,28 @@ def test_shape_parameters_are_in_the_contract_and_restart_the_motion():
     assert points.with_values(delta=0.02).physics_differs(points)
 
 
-def test_the_default_ellipse_run_is_todays_bit_for_bit():
-    # today's path, built by hand: TwoDiskBody, its closed-form mass model, the stream
+def test_an_ellipse_run_starts_where_its_parameters_say_and_is_the_energy_integral():
+    """A run of two ellipses (solid hull) from its settings alone: it starts at θ0 with the
+    body turning at ω0, and its motion is the energy integral of its own dynamics
+    (tests/energy_integral.py; the phase to 1e-11 rad, the accuracy docs/physics.md states
+    for the table method). The poses are the closed-form cycle at the recorded phases."""
     s = DEFAULTS.with_values(realtime=False, duration=1.0, mass_model='solid', theta0=0.7)
-    body = TwoDiskBody(s.a, s.b, s.delta)
-    dynamics = RollingDynamics(body, mass_properties('solid', s.a, s.b, s.delta, s.mass),
-                               s.gravity)
-    u0 = float(body.phase_from_theta(s.theta0, s.branch))
-    stream = MotionStream(dynamics, u0, dynamics.initial_phase_rate(u0, s.omega0),
-                          mode=s.mode, method=s.method, tolerance=s.tolerance)
-    t = np.linspace(0.0, 1.0, 101)
-    u, u_dot = stream.sample(t)
     simulation = Simulation(s)
     assert isinstance(simulation.body, TwoDiskBody)
+    t = np.linspace(0.0, 1.0, 101)
     sample = simulation.sample(t)
-    assert np.array_equal(sample.phase, u) and np.array_equal(sample.phase_rate, u_dot)
-    assert np.array_equal(sample.position_g, dynamics.cycle.poses(u).position_g)
+    dynamics = simulation.dynamics
+    assert abs(sample.theta[0] - s.theta0) < 1e-14
+    turning = float(dynamics.angular_speed_per_phase(sample.phase[0]))
+    assert abs(abs(sample.phase_rate[0]) * turning - s.omega0) < 1e-12 * s.omega0
+    u0, rate0 = sample.phase[0], sample.phase_rate[0]
+    assert np.all(np.diff(sample.phase) > 0)        # it rolls over: u̇ never 0
+    energy = float(dynamics.energy(u0, rate0))
+    assert np.max(np.abs(sample.phase_rate - phase_rate(dynamics, energy, sample.phase))) \
+        < 1e-11 * rate0
+    times = times_to(dynamics, energy, u0, sample.phase[10::10])
+    assert np.max(np.abs(times - t[10::10]) * sample.phase_rate[10::10]) < 1e-11
+    assert np.array_equal(sample.position_g, dynamics.cycle.poses(sample.phase).position_g)
     assert simulation.run.metadata() == s.as_strings()      # no outline keys for ellipses
 
 

@@ -22,14 +22,14 @@ import pytest
 
 from reparametrised_body import ReparametrisedBody
 from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.scene import Scene, command_error
-from twodisk_ros.physics.scene_closed import (DriftQuadrature, OscillationSolution,
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.scenes.scene import Scene, command_error
+from twodisk_ros.physics.scenes.closed import (DriftQuadrature, OscillationSolution,
                                               conservative_solution)
-from twodisk_ros.physics.scene_events import first_failure, settle
-from twodisk_ros.physics.scene_motion import ClosedSceneStream, SceneStream, scene_stream
-from twodisk_ros.physics.scene_terms import SceneTerms
-from twodisk_ros.physics.solvers import LibrationSolution
+from twodisk_ros.physics.scenes.events import first_failure, settle
+from twodisk_ros.physics.scenes.motion import ClosedSceneStream, SceneStream, scene_stream
+from twodisk_ros.physics.scenes.terms import SceneTerms
+from twodisk_ros.physics.motion.solvers import LibrationSolution
 
 OLOID = (0.1, 0.1, 0.05)
 #: u(t) of a closed form against DOP853 at rtol 1e-13 over 10 s (rad): the tables' ~1e-13

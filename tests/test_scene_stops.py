@@ -26,14 +26,14 @@ from reparametrised_body import ReparametrisedBody
 from test_scene import d5, kinematics, stencil
 import test_scene
 from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.lamina import Egg, Superellipse
-from twodisk_ros.physics.lamina_body import LaminaBody
-from twodisk_ros.physics.mass_models import laminae_of, mass_properties
-from twodisk_ros.physics.scene import Scene
-from twodisk_ros.physics.scene_closed import DriftQuadrature, conservative_solution
-from twodisk_ros.physics.scene_motion import ClosedSceneStream, SceneStream, scene_stream
-from twodisk_ros.physics.scene_terms import W, SceneTerms
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.bodies.lamina_body import LaminaBody
+from twodisk_ros.physics.mass.models import laminae_of, mass_properties
+from twodisk_ros.physics.scenes.scene import Scene
+from twodisk_ros.physics.scenes.closed import DriftQuadrature, conservative_solution
+from twodisk_ros.physics.scenes.motion import ClosedSceneStream, SceneStream, scene_stream
+from twodisk_ros.physics.scenes.terms import W, SceneTerms
 
 MASS, GRAVITY = test_scene.MASS, test_scene.GRAVITY
 BODIES = {'superellipse': (Superellipse(0.1, 0.1, 4), 0.05), 'egg': (Egg(0.1, 0.08, 0.004), 0.04)}

@@ -19,14 +19,14 @@ import pytest
 from dask_helpers import free_port
 from harsh_start import harshly
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.contact_validity import liftoff_speed, mu_required_kinematic
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.equilibria import equilibria, stability_map
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.motion import simulate_phase
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.forces.validity import liftoff_speed, mu_required_kinematic
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.stability.equilibria import equilibria, stability_map
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.motion.simulate import simulate_phase
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_netcdf
 from twodisk_ros.sweep.chunks import chunk_quantities

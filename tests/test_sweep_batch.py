@@ -16,10 +16,10 @@ import pytest
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.cycle import RollingCycle
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.mass_models import mass_properties
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.cycle import RollingCycle
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.sweep import batch
 from twodisk_ros.sweep.batch import batch_quantities
 from twodisk_ros.sweep.chunks import chunk_quantities
@@ -190,7 +190,7 @@ def test_liftoff_refinement_reaches_a_minimum_between_nodes():
     # the sweep's bodies have their lift-off minima at symmetric phases (nodes); here a
     # minimum of -N0/N2 between nodes, against scipy's bounded Brent on the exact functions
     from scipy.optimize import minimize_scalar
-    from twodisk_ros.physics.contact_validity import liftoff_speed_batch
+    from twodisk_ros.physics.forces.validity import liftoff_speed_batch
 
     def columns(u):
         n0 = np.stack([1.2 + 0.4 * np.cos(u - 0.3137), 1.5 + 0.2 * np.cos(3 * u)])
@@ -231,7 +231,7 @@ def test_cycle_samples_are_the_scalar_bodys_closed_forms():
     # closed forms (measured ≤ 3.5e-16 of the largest; bitwise at the edges), and ω_u, whose
     # u-derivatives of n and t1 are closed forms in the batch, against the scalar body's
     # complex step (measured ≤ 3.1e-13 of max |ω_u| at b/a = 0.01, ≤ 3e-15 elsewhere)
-    from twodisk_ros.physics.body_batch import TwoDiskBodies
+    from twodisk_ros.physics.bodies.ellipse_batch import TwoDiskBodies
     b = np.array([0.01, 0.01, 100.0, 100.0, 1.0, 0.3])
     d = np.array([1e-3, 1 - 1e-6, 1e-3, 1 - 1e-6, 0.5, 0.2])
     n = 4096

@@ -21,8 +21,8 @@ import re
 import numpy as np
 import pytest
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.mass_models import mass_properties
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.sweep import general
 from twodisk_ros.sweep.batch import batch_quantities
 from twodisk_ros.sweep.cli import main
@@ -95,7 +95,7 @@ def _today(spec):
 # -- the axis, its blocks, its input ---------------------------------------------------------
 
 def test_exponent_range_is_the_laminas():
-    from twodisk_ros.physics.lamina import SUPERELLIPSE_EXPONENT
+    from twodisk_ros.physics.laminae.shapes import SUPERELLIPSE_EXPONENT
     assert EXPONENT_RANGE == SUPERELLIPSE_EXPONENT
 
 
@@ -282,8 +282,8 @@ def test_a_real_superellipse_n4_body():
     got = chunk_quantities([b], [d], exponent=n)
     failure = got['failure'][0]
     assert failure == ''      # LaminaBody is on main: a failing body is a failure, no skip
-    from twodisk_ros.physics.symmetric_stability import symmetric_equilibria
-    from twodisk_ros.physics.lamina import Superellipse
+    from twodisk_ros.physics.stability.symmetric import symmetric_equilibria
+    from twodisk_ros.physics.laminae.shapes import Superellipse
     first, turning, side = symmetric_equilibria(Superellipse(1.0, b, n), d)
     # claim (issue 20): the general path is exact to <= 1e-11 of the size (size ~ 1.5 a)
     size = 1.5

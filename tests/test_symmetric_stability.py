@@ -1,4 +1,4 @@
-"""physics/symmetric_stability.py (issue 20): the closed-form stability of the symmetric
+"""physics/stability/symmetric.py (issue 20): the closed-form stability of the symmetric
 equilibria against independent references.
 
 References, sharing no code with the module under test:
@@ -28,13 +28,13 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from scipy.optimize import brentq
 
 from rounding import ulps
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.general_body import GeneralTwoDiskBody
-from twodisk_ros.physics.lamina import Egg, Ellipse, Superellipse, SupportLamina
-from twodisk_ros.physics.lamina_fit import Outline
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.symmetric_stability import (NOT_AN_EQUILIBRIUM,
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse, SupportLamina
+from twodisk_ros.physics.laminae.fit import Outline
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.stability.symmetric import (NOT_AN_EQUILIBRIUM,
                                                      symmetric_equilibria)
 
 #: rolling-angle step of the finite differences (rad); halved down to H / 64 while the

@@ -1,4 +1,4 @@
-"""Quintic Hermite tables (physics/tables.py).
+"""Quintic Hermite tables (physics/numerics/tables.py).
 
 Reference: a quintic polynomial, which the quintic Hermite interpolant of its values and
 first two derivatives at the nodes reproduces exactly (so f and f′ between the nodes are
@@ -8,7 +8,7 @@ the polynomial's own, to rounding).
 import numpy as np
 import pytest
 
-from twodisk_ros.physics.tables import HermiteTable
+from twodisk_ros.physics.numerics.tables import HermiteTable
 
 COEFFS = np.array([0.7, -1.3, 2.1, 0.4, -0.9, 0.25])     # p(x) = Σ c_k x^k
 

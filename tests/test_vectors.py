@@ -1,11 +1,11 @@
-"""physics/vectors.py against numpy: ``cross`` against :func:`numpy.cross` (real, complex,
+"""physics/numerics/vectors.py against numpy: ``cross`` against :func:`numpy.cross` (real, complex,
 broadcast), ``vector`` against :func:`numpy.stack` (a copy of the values: exact)."""
 
 import numpy as np
 import pytest
 
 from rounding import ulps
-from twodisk_ros.physics.vectors import cross, vector
+from twodisk_ros.physics.numerics.vectors import cross, vector
 
 
 @pytest.mark.parametrize('shapes', [((3,), (3,)), ((7, 3), (7, 3)), ((4, 1, 3), (5, 3)),

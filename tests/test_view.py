@@ -32,11 +32,11 @@ from batch_recording import record
 from foxglove_client import SUBPROTOCOL, collect, refused, stamp_ns
 from view_process import ENV, RUNNER, View, wait_for_handlers
 from twodisk_ros.model.mesh import mesh_parts
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.contact_forces import ContactForceModel
-from twodisk_ros.physics.dynamics import RollingDynamics
-from twodisk_ros.physics.mass_models import mass_properties
-from twodisk_ros.physics.motion import simulate
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.forces.contact import ContactForceModel
+from twodisk_ros.physics.motion.dynamics import RollingDynamics
+from twodisk_ros.physics.mass.models import mass_properties
+from twodisk_ros.physics.motion.simulate import simulate
 from twodisk_ros.model import palette
 
 REPO = Path(__file__).resolve().parents[1]

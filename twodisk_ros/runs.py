@@ -23,8 +23,8 @@ from .run.parameters import BY_NAME, DEFAULTS
 from .run.params_yaml import ArgumentError, params_file_values
 from .run.scene_simulation import flat_free
 from .run.simulation import Simulation
-from .physics.contact_forces import ContactForceModel
-from .physics.motion import simulate
+from .physics.forces.contact import ContactForceModel
+from .physics.motion.simulate import simulate
 from .run.description import RunDescription
 
 __all__ = ['Run', 'RunError', 'library_run', 'recorded_run', 'settings_from',

@@ -24,7 +24,7 @@ so, and shows the lift-off the poses imply, for information). W = M g is the for
     evaluated.
 ``force_split``
     The recorded F_A·ê equals the split that needs the least friction (the node's rule,
-    :func:`~twodisk_ros.physics.contact_forces.squeeze_split`) applied to the recorded
+    :func:`~twodisk_ros.physics.forces.contact.squeeze_split`) applied to the recorded
     determinate components: max |Δ| / W ≤ 1e-7, at samples where both |N| > 1e-6 W (the rule
     jumps to S/2 where a contact lifts off).
 ``rolling_validity``

@@ -14,7 +14,7 @@ determinate components are N_A = F_A·e_z, N_B = F_B·e_z, T_A = F_A·p, T_B = F
 total along AB, S = F·ê; the split of S between A and B is free (an internal squeeze).
 
 The recorded wrenches give the same components (and the split); the exact forces of the
-model at a state (u, u̇) come from :class:`~twodisk_ros.physics.contact_forces.
+model at a state (u, u̇) come from :class:`~twodisk_ros.physics.forces.contact.
 ContactForceModel`. Invalid stretches (lift-off, slip) are found by :func:`invalid_stretches`.
 Units: N, N m, s.
 """
@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from ..physics.contact_forces import squeeze_split
+from ..physics.forces.contact import squeeze_split
 
 __all__ = ['ForceComponents', 'Stretch', 'exact_components', 'invalid_stretches',
            'newton_euler', 'recorded_components']

@@ -16,8 +16,8 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ..physics.dynamics import RollingDynamics
-from ..physics.rolling_body import RollingBody
+from ..physics.motion.dynamics import RollingDynamics
+from ..physics.bodies.protocol import RollingBody
 from ..run.scene_simulation import flat_free, ground_normal
 from ..run.description import RunDescription
 
@@ -45,9 +45,9 @@ class RecordedModel:
 
     @cached_property
     def forces(self):
-        """The :class:`~twodisk_ros.physics.contact_forces.ContactForceModel` of the dynamics
+        """The :class:`~twodisk_ros.physics.forces.contact.ContactForceModel` of the dynamics
         (its tables built when first read)."""
-        from ..physics.contact_forces import ContactForceModel
+        from ..physics.forces.contact import ContactForceModel
         return ContactForceModel(self.dynamics)
 
 

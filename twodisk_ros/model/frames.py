@@ -21,10 +21,10 @@ and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
     centre C2 = +Δ e2 − G; x = +e2, y = −e3, z = −e1.
 
 G is the laminae's centroid seen from the midpoint of the centres
-(:attr:`GeneralTwoDiskBody.centroid <twodisk_ros.physics.general_body.GeneralTwoDiskBody>`,
+(:attr:`GeneralTwoDiskBody.centroid <twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody>`,
 along e2): zero for laminae symmetric along the common axis (ellipses, superellipses), not
 for an egg in the 'parallel' arrangement. A body moved by
-:meth:`LaminaBody.about <twodisk_ros.physics.lamina_body.LaminaBody.about>` (the solid egg,
+:meth:`LaminaBody.about <twodisk_ros.physics.bodies.lamina_body.LaminaBody.about>` (the solid egg,
 centred on its centre of mass) has its origin at P = ``body.origin`` instead, and G above
 reads P (the centres at ∓Δ e2 − P). The two rotations are exact (quaternion components
 0, ±1/2, ±√½) and the same for every body; only the translations depend on it.

@@ -42,8 +42,8 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.mass_models import MODELS
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.mass.models import MODELS
 
 from .frames import disk_frames
 from .outline import frame_rims, resolution_tolerance
@@ -135,7 +135,7 @@ def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickne
     Parameters
     ----------
     body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
-    mass_model : str or twodisk_ros.physics.mass_models.MassProperties
+    mass_model : str or twodisk_ros.physics.mass.models.MassProperties
         ``'solid'`` gives the convex hull (:func:`hull_mesh`); ``'laminae'`` and ``'custom'``
         the two plates (:func:`laminae_mesh`).
     resolution : int

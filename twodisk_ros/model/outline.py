@@ -21,7 +21,7 @@ the lamina (``lamina.point``). :func:`resolution_tolerance` converts a mesh reso
 lamina point (x, y) sits at (x, y − Δ, 0) − G and disk 2's at (0, Δ + σy, x) − G, σ = ±1 the
 arrangement ('parallel', 'swapped'); G = GeneralTwoDiskBody(lamina, Δ, arrangement).centroid,
 the midpoint of the centres for laminae symmetric along y (ellipses, superellipses). A body
-moved by :meth:`LaminaBody.about <twodisk_ros.physics.lamina_body.LaminaBody.about>` (its
+moved by :meth:`LaminaBody.about <twodisk_ros.physics.bodies.lamina_body.LaminaBody.about>` (its
 origin P = ``body.origin``, the centre of mass of a solid egg) is drawn about P: every
 point above minus ``body.offset`` e2, so that the world pose of P places the laminae. In the
 disk frames of :mod:`~twodisk_ros.model.frames` (x towards the disk's far tip along e2, z
@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.body import TwoDiskBody
-from twodisk_ros.physics.general_body import ARRANGEMENTS, GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import ARRANGEMENTS, GeneralTwoDiskBody
 
 __all__ = ['BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
            'frame_rims', 'general_body', 'lamina_outline', 'resolution_tolerance']

@@ -77,8 +77,8 @@ def robot_description(body, mass, body_frame='twodisk_body', mesh_uris=None, *,
 
     Parameters
     ----------
-    body : twodisk_ros.physics.body.TwoDiskBody
-    mass : twodisk_ros.physics.mass_models.MassProperties
+    body : twodisk_ros.physics.bodies.ellipse.TwoDiskBody
+    mass : twodisk_ros.physics.mass.models.MassProperties
         Mass (kg), centre of mass (m) and inertia about G (kg m²), body frame.
     body_frame : str
         Name of the root link, the body frame (see frames.check_frame_id).

@@ -65,7 +65,7 @@ class Description:
 
 def describe(settings, body, mass):
     """The :class:`Description` of checked ``settings``, their body and its
-    :class:`~twodisk_ros.physics.mass_models.MassProperties` (the simulation's).
+    :class:`~twodisk_ros.physics.mass.models.MassProperties` (the simulation's).
 
     The URDF's meshes are written to the mesh cache if missing
     (:func:`~twodisk_ros.model.urdf.body_description`). If the cache cannot be written

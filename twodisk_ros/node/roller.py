@@ -35,7 +35,7 @@ from .. import __version__
 from ..io import McapRecorder, cdr
 from ..io.cdr_markers import encode_markers
 from ..outputs import check_output
-from ..physics.startup import startup_estimate
+from ..physics.motion.startup import startup_estimate
 from ..run import schedule
 from ..run.description import RunDescription
 from ..run.parameters import BY_NAME, DEFAULTS, PARAMETERS

@@ -34,7 +34,7 @@ from std_srvs.srv import Empty, SetBool
 
 from ..io import cdr
 from ..run.scene_simulation import SPEED_LIMIT, TORQUE_LIMIT
-from ..physics.scene import command_error
+from ..physics.scenes.scene import command_error
 
 __all__ = ['EVENTS_TOPIC', 'EVENTS_QOS', 'SceneControl']
 

@@ -1,34 +1,26 @@
 """The physics of the rolling two-disk body: pure numpy/scipy, no ROS, plots or files.
 
-Modules, from geometry to motion (docs/physics.md derives each):
+One subpackage per concept, each importing only those below it (the physics layers of
+.importlinter, checked by the tests; docs/architecture.md); docs/physics.md derives each:
 
-- :mod:`~twodisk_ros.physics.body`: the body and the closed forms, in θ and in the phase u
-  (:mod:`~twodisk_ros.physics.body_batch`: the same closed forms for many bodies at once);
-- :mod:`~twodisk_ros.physics.cycle`: poses and contact traces over whole cycles;
-- :mod:`~twodisk_ros.physics.equilibria`: the eight equilibria and their stability;
-- :mod:`~twodisk_ros.physics.mass_models` (with :mod:`~twodisk_ros.physics.hull`): inertia;
-- :mod:`~twodisk_ros.physics.dynamics`: the equation of motion in u;
-- :mod:`~twodisk_ros.physics.solvers`, :mod:`~twodisk_ros.physics.motion`: u(t);
-- :mod:`~twodisk_ros.physics.startup`: what a body's tables will cost, before paying it;
-- :mod:`~twodisk_ros.physics.lamina` (with :mod:`~twodisk_ros.physics.lamina_fit`): laminae
-  of any symmetric convex shape (ellipse, superellipse, egg, a fitted outline): the
-  foundation of general bodies, with :mod:`~twodisk_ros.physics.general_body` (their
-  contact geometry from the support function) and
-  :mod:`~twodisk_ros.physics.symmetric_stability` (the stability of their symmetric
-  equilibria in closed form); :mod:`~twodisk_ros.physics.lamina_body` makes them rolling
-  bodies (:mod:`~twodisk_ros.physics.rolling_body`: the protocol the cycle, dynamics, forces
-  and equilibria read, which :class:`TwoDiskBody` implements with its closed forms);
-- :mod:`~twodisk_ros.physics.analytic`, :mod:`~twodisk_ros.physics.spectral`,
-  :mod:`~twodisk_ros.physics.tables`, :mod:`~twodisk_ros.physics.vectors`: the numerical
-  tools they share.
+- :mod:`.scenes`: the ground, gravity, drive and dissipation, and a body's motion in them;
+- :mod:`.forces`: the contact forces at A and B, and where the rolling model holds;
+- :mod:`.motion`: the equation of motion in the phase u on a level plane, and u(t);
+- :mod:`.stability`: the equilibria and their stability; :mod:`.mass`: the mass models;
+- :mod:`.bodies`: the rolling bodies (the ellipse in closed form, any two laminae through
+  their contact solver) and their poses over whole cycles;
+- :mod:`.laminae`: the planar laminae (ellipse, superellipse, egg, a fitted outline);
+- :mod:`.numerics`: the spectral, table and analytic tools they share.
+
+The names below are the library's public API (also importable from :mod:`twodisk_ros`).
 """
 
-from .body import PhaseGeometry, TwoDiskBody
-from .cycle import CycleDisplacement, RollingCycle, RollingState, integrate_contact_trace
-from .dynamics import RollingDynamics
-from .equilibria import Equilibrium, equilibria, stability_map
-from .mass_models import MassProperties, mass_properties
-from .motion import MotionStream, RollingMotion, simulate, simulate_phase
+from .bodies.cycle import CycleDisplacement, RollingCycle, RollingState, integrate_contact_trace
+from .bodies.ellipse import PhaseGeometry, TwoDiskBody
+from .mass.models import MassProperties, mass_properties
+from .motion.dynamics import RollingDynamics
+from .motion.simulate import MotionStream, RollingMotion, simulate, simulate_phase
+from .stability.equilibria import Equilibrium, equilibria, stability_map
 
 __all__ = [
     'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState', 'CycleDisplacement',

@@ -13,11 +13,11 @@ import sys
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.body import TwoDiskBody  # noqa: E402
-from twodisk_ros.physics.dynamics import RollingDynamics  # noqa: E402
-from twodisk_ros.physics.mass_models import mass_properties  # noqa: E402
-from twodisk_ros.physics.contact_forces import ContactForceModel  # noqa: E402
-from twodisk_ros.physics.contact_validity import (  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.motion.dynamics import RollingDynamics  # noqa: E402
+from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
+from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
+from twodisk_ros.physics.forces.validity import (  # noqa: E402
     liftoff_speed, mu_required_kinematic)
 from twodisk_ros.outputs import OutputError, check_output_dir, replacing  # noqa: E402
 

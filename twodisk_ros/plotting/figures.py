@@ -22,13 +22,13 @@ from pathlib import Path
 
 import numpy as np  # noqa: E402
 
-from ..physics.body import TwoDiskBody  # noqa: E402
-from ..physics.lamina import Egg, Superellipse  # noqa: E402
-from ..physics.lamina_body import LaminaBody  # noqa: E402
+from ..physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from ..physics.laminae.shapes import Egg, Superellipse  # noqa: E402
+from ..physics.bodies.lamina_body import LaminaBody  # noqa: E402
 from ..outputs import OutputError, check_output_dir, replacing  # noqa: E402
 from ..model import palette  # noqa: E402
-from ..physics.cycle import RollingCycle  # noqa: E402
-from ..physics.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
+from ..physics.bodies.cycle import RollingCycle  # noqa: E402
+from ..physics.stability.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
 __all__ = ['FIGURE3', 'FIGURE4', 'LAMINA_BODIES', 'NAMES', 'plot_traces', 'plot_height',
            'plot_outline', 'plot_stability_map',

@@ -4,11 +4,11 @@ Read by the node (:class:`~twodisk_ros.run.simulation.Simulation`, the start-up 
 the inspector (:func:`~twodisk_ros.inspect.model.build_model`) and the tools that rebuild a
 run from its parameters, so that every reader builds the same body:
 
-- ``shape`` ellipse: :class:`~twodisk_ros.physics.body.TwoDiskBody` (a, b, delta), the closed
+- ``shape`` ellipse: :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (a, b, delta), the closed
   forms, and the closed-form mass models of a, b, delta (``settings.ellipse_mass_properties()``), bit for bit;
-- any other shape: :class:`~twodisk_ros.physics.lamina_body.LaminaBody` (lamina, delta,
+- any other shape: :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` (lamina, delta,
   arrangement) on the lamina of :func:`~twodisk_ros.run.shape.lamina_of`, with the mass model
-  of :func:`twodisk_ros.physics.mass_models.centred_on_mass` (imported when first needed):
+  of :func:`twodisk_ros.physics.mass.models.centred_on_mass` (imported when first needed):
   the body is moved (``LaminaBody.about``) so that its origin is the mass model's centre of
   mass, as RollingDynamics needs. Only the solid hull of an egg in the parallel arrangement
   has its centre of mass off the laminae's centroid G (2.7e-3 m for config/egg.yaml's
@@ -21,9 +21,9 @@ checking settings, describing the URDF and building the simulation pay for a bod
 from functools import cached_property, lru_cache
 
 from .parameters import parse_recorded
-from ..physics.body import TwoDiskBody
-from ..physics.dynamics import RollingDynamics
-from ..physics.motion import MotionStream
+from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.motion.dynamics import RollingDynamics
+from ..physics.motion.simulate import MotionStream
 from . import shape as shapes
 
 __all__ = ['RunDescription', 'clear_caches']
@@ -31,13 +31,13 @@ __all__ = ['RunDescription', 'clear_caches']
 
 @lru_cache(maxsize=4)
 def _lamina_body(lamina, delta, arrangement):
-    from ..physics.lamina_body import LaminaBody
+    from ..physics.bodies.lamina_body import LaminaBody
     return LaminaBody(lamina, delta, arrangement)
 
 
 @lru_cache(maxsize=8)
 def _centred(body, model, mass, moments):
-    from ..physics.mass_models import centred_on_mass
+    from ..physics.mass.models import centred_on_mass
     return centred_on_mass(model, body, mass, moments)
 
 
@@ -119,23 +119,23 @@ class RunDescription:
 
     @property
     def body(self):
-        """The run's :class:`~twodisk_ros.physics.rolling_body.RollingBody`, its origin at
+        """The run's :class:`~twodisk_ros.physics.bodies.protocol.RollingBody`, its origin at
         the centre of mass (G, or P = ``body.origin`` for the solid parallel egg)."""
         return self._body_and_mass[0]
 
     @property
     def mass(self):
-        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of the run (centre of
+        """The :class:`~twodisk_ros.physics.mass.models.MassProperties` of the run (centre of
         mass at the body's origin)."""
         return self._body_and_mass[1]
 
     @cached_property
     def dynamics(self):
-        """:class:`~twodisk_ros.physics.dynamics.RollingDynamics` of body, mass and gravity."""
+        """:class:`~twodisk_ros.physics.motion.dynamics.RollingDynamics` of body, mass and gravity."""
         return RollingDynamics(self.body, self.mass, self.settings.gravity)
 
     def start(self):
-        """The :class:`~twodisk_ros.physics.dynamics.PhaseState` of theta0, branch and omega0:
+        """The :class:`~twodisk_ros.physics.motion.dynamics.PhaseState` of theta0, branch and omega0:
         u0 (rad), the angular speed w0 = omega0 about AB (rad/s: the regular chart, well
         defined also at a flat vertex, where the body does not turn in u) and u̇0 = w0/|ω_u(u0)|
         (rad/s; infinite there)."""
@@ -144,7 +144,7 @@ class RunDescription:
         return self.dynamics.initial_state(u0, s.omega0)
 
     def stream(self):
-        """A new :class:`~twodisk_ros.physics.motion.MotionStream` of the run from t = 0
+        """A new :class:`~twodisk_ros.physics.motion.simulate.MotionStream` of the run from t = 0
         (started from w0 for any body but the ellipse, as :func:`~twodisk_ros.physics.simulate`
         does: u̇0 is infinite where the body does not turn in u)."""
         s = self.settings

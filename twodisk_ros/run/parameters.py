@@ -16,10 +16,10 @@ import math
 import re
 
 from ..model.frames import DISK_SUFFIXES, check_frame_id
-from ..physics.lamina import SUPERELLIPSE_EXPONENT
-from ..physics.mass_models import MODELS, custom, mass_properties
-from ..physics.motion import METHODS, MODES
-from ..physics.scene import DRIVES
+from ..physics.laminae.shapes import SUPERELLIPSE_EXPONENT
+from ..physics.mass.models import MODELS, custom, mass_properties
+from ..physics.motion.simulate import METHODS, MODES
+from ..physics.scenes.scene import DRIVES
 from . import shape as shapes
 
 __all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
@@ -297,7 +297,7 @@ class _SettingsMethods:
         return replace(self, **{k: _check_one(BY_NAME[k], v) for k, v in values.items()})
 
     def ellipse_mass_properties(self):
-        """The :class:`~twodisk_ros.physics.mass_models.MassProperties` of ellipse settings:
+        """The :class:`~twodisk_ros.physics.mass.models.MassProperties` of ellipse settings:
         the closed forms of a, b, delta. Other shapes: the run's body's
         (:attr:`twodisk_ros.run.description.RunDescription.mass`)."""
         if self.shape != 'ellipse':

@@ -4,9 +4,9 @@
 MotionStream, poses and contact forces, bit for bit) where the settings describe the flat,
 free, conservative scene and the motion starts at ``theta0``; everything else is a
 :class:`SceneMotion`: the scene's stream
-(:func:`~twodisk_ros.physics.scene_motion.scene_stream`, or the integrator of the speed
+(:func:`~twodisk_ros.physics.scenes.motion.scene_stream`, or the integrator of the speed
 drive), poses and ground forces in the gravity-aligned ``frame_id``
-(:class:`~twodisk_ros.physics.scene_terms.SceneTerms`), and the energy balance
+(:class:`~twodisk_ros.physics.scenes.terms.SceneTerms`), and the energy balance
 E + W − W_d = E₀ carried across commands, time-outs and runtime scene changes (each continues
 the motion from the state of the last published sample, in a new stretch).
 
@@ -23,10 +23,10 @@ import math
 
 import numpy as np
 
-from ..physics.contact_validity import ValidityReport
-from ..physics.scene import Scene
-from ..physics.scene_motion import SceneStream, scene_stream
-from ..physics.scene_terms import SceneTerms
+from ..physics.forces.validity import ValidityReport
+from ..physics.scenes.scene import Scene
+from ..physics.scenes.motion import SceneStream, scene_stream
+from ..physics.scenes.terms import SceneTerms
 
 __all__ = ['REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues',
            'flat_free', 'frame_metadata', 'ground_normal', 'scene_of']
@@ -48,7 +48,7 @@ def flat_free(settings):
 
 
 def scene_of(settings, drive=None, command=None, speed=0.0):
-    """The :class:`~twodisk_ros.physics.scene.Scene` of the settings with the drive in force.
+    """The :class:`~twodisk_ros.physics.scenes.scene.Scene` of the settings with the drive in force.
 
     ``drive``: 'none', 'speed' or 'torque' (default ``settings.drive``); ``command``: its
     command (rad/s or N m), None for none yet: the speed drive then holds ``speed`` (the
@@ -120,7 +120,7 @@ class SceneMotion:
         The drive in force and its command (:func:`scene_of`; None: none yet).
     start : PhaseState
         (u (rad), u̇ (rad/s), w (rad/s)) at the stretch's t = 0
-        (:class:`~twodisk_ros.physics.dynamics.PhaseState`; a body other than the ellipse
+        (:class:`~twodisk_ros.physics.motion.dynamics.PhaseState`; a body other than the ellipse
         starts from w, finite also where it stops turning in u).
     carry : (float, float, float), optional
         (W, W_d, E₀) (J) at the stretch's start: the work done before it and the energy
@@ -186,7 +186,7 @@ class SceneMotion:
         return u, u_dot, u_ddot, speed, values, self.terms.poses(u)
 
     def forces(self, u, u_dot, u_ddot):
-        """The ground's forces (:class:`~twodisk_ros.physics.scene_terms.SceneForces`)."""
+        """The ground's forces (:class:`~twodisk_ros.physics.scenes.terms.SceneForces`)."""
         return self.terms.forces(u, u_dot, u_ddot)
 
     @property
@@ -210,7 +210,7 @@ class SceneMotion:
 
     def track_rest(self, t, u, u_dot, u_ddot, energy):
         """Note the first time (s, the node's) at which a scene with losses is at rest, the
-        criterion of :func:`~twodisk_ros.physics.scene_events.settle`: stuck (rolling
+        criterion of :func:`~twodisk_ros.physics.scenes.events.settle`: stuck (rolling
         resistance holds it: u̇ = ü = 0) or E − V(u*) ≤ :data:`REST_ENERGY` × M g L; judged
         at every sample, so to within one sample period."""
         if not self.comes_to_rest or not math.isnan(self.rested) or not len(t):

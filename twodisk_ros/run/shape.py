@@ -4,16 +4,16 @@ ROS-free and lazy-free: :mod:`twodisk_ros.run.parameters` checks settings with i
 description (:mod:`~twodisk_ros.run.description`) builds the body on it. Settings are read by
 attribute (any object with the parameter names: ``RollerSettings`` in practice).
 
-- ``ellipse``: :class:`~twodisk_ros.physics.lamina.Ellipse` (a, b); the body is
-  :class:`~twodisk_ros.physics.body.TwoDiskBody` (closed forms);
-- ``superellipse``: :class:`~twodisk_ros.physics.lamina.Superellipse` (a, b, ``exponent``);
-- ``egg``: :class:`~twodisk_ros.physics.lamina.Egg` (a, b, ε) with
+- ``ellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` (a, b); the body is
+  :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (closed forms);
+- ``superellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Superellipse` (a, b, ``exponent``);
+- ``egg``: :class:`~twodisk_ros.physics.laminae.shapes.Egg` (a, b, ε) with
   ε = ``egg_asymmetry`` × ε_max(a, b) (m): ``egg_asymmetry`` is dimensionless, |·| ≤
   :data:`EGG_ASYMMETRY`, so that the radius of curvature stays ≥ (1 − |egg_asymmetry|) times
   the ellipse's at every normal angle (the egg's radius is ρ_E − 8ε cos 3φ and ε_max is the
   least ρ_E / (8 cos 3φ)); > 0 makes the lamina's −y end (disk 1's outer end) the sharper;
-- ``points``: an :class:`~twodisk_ros.physics.lamina_fit.Outline` fitted to the points of
-  ``shape_file`` (CSV or YAML, :func:`~twodisk_ros.physics.lamina_fit.read_outline`), in metres;
+- ``points``: an :class:`~twodisk_ros.physics.laminae.fit.Outline` fitted to the points of
+  ``shape_file`` (CSV or YAML, :func:`~twodisk_ros.physics.laminae.fit.read_outline`), in metres;
   a and b are then the outline's own half length along the common axis and half width
   (:func:`axes_of`), and the parameters ``a`` and ``b`` are not used. A recording keeps the
   fitted outline's coefficients (:func:`outline_metadata`), so the recording is checked
@@ -28,10 +28,10 @@ import math
 import os
 import stat
 
-from ..physics.body import TwoDiskBody
-from ..physics.general_body import GeneralTwoDiskBody
-from ..physics.lamina import Egg, Ellipse, Superellipse
-from ..physics.lamina_fit import Outline, read_outline
+from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.bodies.contact_solver import GeneralTwoDiskBody
+from ..physics.laminae.shapes import Egg, Ellipse, Superellipse
+from ..physics.laminae.fit import Outline, read_outline
 
 __all__ = ['ARRANGEMENT_NAMES', 'EGG_ASYMMETRY', 'MAX_SHAPE_FILE_BYTES', 'OUTLINE_KEYS',
            'SHAPES', 'axes_of', 'clear_caches', 'describe_shape', 'lamina_of',
@@ -71,7 +71,7 @@ def shape_key(settings, outline=None):
 
 
 def lamina_of(settings, outline=None):
-    """The :class:`~twodisk_ros.physics.lamina.Lamina` of the settings (cached by its key).
+    """The :class:`~twodisk_ros.physics.laminae.shapes.Lamina` of the settings (cached by its key).
 
     ``outline``: for ``points``, an :class:`Outline` to use instead of reading
     ``shape_file`` (a recording's). Raises ValueError (one line).
@@ -174,8 +174,8 @@ def clear_caches():
 def theta_max_of(lamina, delta, arrangement):
     """θ_max (rad) of two such laminae at Δ in the arrangement (ValueError if no cycle).
 
-    An :class:`~twodisk_ros.physics.lamina.Ellipse` takes the closed form of
-    :class:`~twodisk_ros.physics.body.TwoDiskBody` (both arrangements are the same body).
+    An :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` takes the closed form of
+    :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (both arrangements are the same body).
     """
     if type(lamina) is Ellipse:
         return TwoDiskBody(lamina.a, lamina.b, delta).theta_max

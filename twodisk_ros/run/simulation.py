@@ -11,9 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.frames import disk_rims
-from ..physics.contact_forces import ContactForceModel
-from ..physics.contact_validity import check_validity
-from ..physics.dynamics import PhaseState
+from ..physics.forces.contact import ContactForceModel
+from ..physics.forces.validity import check_validity
+from ..physics.motion.dynamics import PhaseState
 from .description import RunDescription
 from .scene_simulation import SceneMotion, flat_free
 
@@ -88,7 +88,7 @@ class Simulation:
     drive, command, start, carry, terms
         A scene's motion (:class:`~twodisk_ros.run.scene_simulation.SceneMotion`): the drive
         in force and its command, the state at t = 0 (a
-        :class:`~twodisk_ros.physics.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
+        :class:`~twodisk_ros.physics.motion.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
         ``omega0``), the work
         done before and the balance's E₀, reused tables. The flat free scene's path is taken
         where the settings are flat, free and conservative and ``start`` is None.
@@ -177,7 +177,7 @@ class Simulation:
         return nxt
 
     def initial_state(self):
-        """The :class:`~twodisk_ros.physics.dynamics.PhaseState` (u0, u̇0, w0) this stretch
+        """The :class:`~twodisk_ros.physics.motion.dynamics.PhaseState` (u0, u̇0, w0) this stretch
         starts from: w0 the angular speed about AB, finite also at a flat vertex."""
         return self.run.start() if self.start is None else self.start
 
@@ -324,7 +324,7 @@ class Simulation:
         """World end points A, B of the hull's rulings over one cycle: two arrays (points + 1, 3).
 
         The convex hull of the disks is ruled by the contact segments AB of the rolling
-        cycle (:mod:`~twodisk_ros.physics.hull`); for the hull marker of ``body_markers``.
+        cycle (:mod:`~twodisk_ros.physics.mass.hull`); for the hull marker of ``body_markers``.
         """
         u = np.linspace(0.0, 2 * np.pi, points + 1)
         r1, r2 = self.body.phase_vectors(u)[:2]

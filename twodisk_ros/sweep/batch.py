@@ -8,10 +8,10 @@ bodies as array operations (docs/sweeps.md, "The batched path"):
    (microseconds each; a body the scalar path refuses at these stages goes through it, so
    its reason is the scalar path's own line);
 2. the cycle resolution of every body, by the scalar construction's own test
-   (:func:`~twodisk_ros.physics.cycle.required_resolutions`, batched);
+   (:func:`~twodisk_ros.physics.bodies.cycle.required_resolutions`, batched);
 3. bodies of one resolution are evaluated together in blocks of at most :data:`POINTS`
    nodes × bodies: the closed forms on the 4 × resolution nodes of the scalar path's tables
-   (:meth:`~twodisk_ros.physics.body_batch.TwoDiskBodies.cycle_samples`), then every
+   (:meth:`~twodisk_ros.physics.bodies.ellipse_batch.TwoDiskBodies.cycle_samples`), then every
    quantity from these samples with numpy over the batch axis: the cycle's displacement
    (spectral integration), the eight equilibria, the cycle time (trapezoidal), the extremes
    of |AB| (nodes, then Newton on the closed form), the kinematic contact-force columns,
@@ -32,15 +32,15 @@ import time
 
 import numpy as np
 
-from ..physics.analytic import COMPLEX_STEP
-from ..physics.body import TwoDiskBody
-from ..physics.body_batch import TwoDiskBodies, dot
-from ..physics.contact_forces import kinematic_coefficients
-from ..physics.contact_validity import liftoff_speed_batch, mu_required_kinematic_batch
-from ..physics.cycle import TWO_PI, displacement_from_rates, required_resolutions
-from ..physics.equilibria import equilibria_batch
-from ..physics.mass_models import mass_properties
-from ..physics.spectral import node_sum
+from ..physics.numerics.analytic import COMPLEX_STEP
+from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.bodies.ellipse_batch import TwoDiskBodies, dot
+from ..physics.forces.contact import kinematic_coefficients
+from ..physics.forces.validity import liftoff_speed_batch, mu_required_kinematic_batch
+from ..physics.bodies.cycle import TWO_PI, displacement_from_rates, required_resolutions
+from ..physics.stability.equilibria import equilibria_batch
+from ..physics.mass.models import mass_properties
+from ..physics.numerics.spectral import node_sum
 from .quantities import VARIABLES, body_quantities
 
 __all__ = ['POINTS', 'BATCH_STAGES', 'batch_quantities']

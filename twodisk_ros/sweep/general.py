@@ -2,13 +2,13 @@
 
 A body of exponent n is two congruent superellipse laminae |x/b|ⁿ + |y/a|ⁿ ≤ 1 (a = 1 along
 the common axis, b = b/a across it) with centres at ∓Δ:
-``LaminaBody(Superellipse(1.0, b, n), Δ)`` (:mod:`~twodisk_ros.physics.lamina_body`). It has
+``LaminaBody(Superellipse(1.0, b, n), Δ)`` (:mod:`~twodisk_ros.physics.bodies.lamina_body`). It has
 no closed forms, so it is computed one body at a time through the
-:class:`~twodisk_ros.physics.rolling_body.RollingBody` protocol: its
-:class:`~twodisk_ros.physics.cycle.RollingCycle`, :class:`~twodisk_ros.physics.dynamics.
-RollingDynamics` with the mass model of :func:`~twodisk_ros.physics.mass_models.
+:class:`~twodisk_ros.physics.bodies.protocol.RollingBody` protocol: its
+:class:`~twodisk_ros.physics.bodies.cycle.RollingCycle`, :class:`~twodisk_ros.physics.motion.dynamics.
+RollingDynamics` with the mass model of :func:`~twodisk_ros.physics.mass.models.
 mass_properties_of`, the equilibria the dynamics finds (every root of dz_G/du over the cycle)
-and :class:`~twodisk_ros.physics.contact_forces.ContactForceModel`. The stages and the failure
+and :class:`~twodisk_ros.physics.forces.contact.ContactForceModel`. The stages and the failure
 lines are those of :func:`~twodisk_ros.sweep.quantities.body_quantities`.
 
 Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exponent axis";
@@ -17,7 +17,7 @@ Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exp
 - ``stability_margin`` is NaN: b² − 2a² + 2Δ² is the ellipse's criterion; a superellipse with
   n > 2 has flat vertices (zero curvature) where no quadratic criterion exists;
 - ``stable_family`` comes from the closed-form stability of the symmetric equilibria of any
-  lamina (:func:`~twodisk_ros.physics.symmetric_stability.symmetric_equilibria`): +1 the tips
+  lamina (:func:`~twodisk_ros.physics.stability.symmetric.symmetric_equilibria`): +1 the tips
   (θ = 0 and the turning points), −1 the side vertices (θ = ±π/2), **2 both** (what flat
   vertices give: each symmetric pose is a shallow local minimum), 0 neutral, NaN neither;
 - ``oscillation_period`` is the dynamics' period about the lowest stable equilibrium, NaN where
@@ -36,8 +36,8 @@ import math
 
 import numpy as np
 
-from ..physics.dynamics import RollingDynamics
-from ..physics.equilibria import NEUTRAL, STABLE
+from ..physics.motion.dynamics import RollingDynamics
+from ..physics.stability.equilibria import NEUTRAL, STABLE
 
 __all__ = ['GENERAL_FAMILIES', 'GENERAL_MEANINGS', 'superellipse_body', 'lamina_mass',
            'general_body_quantities', 'axis_inertia', 'symmetric_family']
@@ -70,14 +70,14 @@ GENERAL_MEANINGS = {
 
 def superellipse_body(b_over_a, delta_over_a, exponent):
     """``LaminaBody(Superellipse(1.0, b/a, n), Δ/a)``: the body of one grid point."""
-    from ..physics.lamina import Superellipse
-    from ..physics.lamina_body import LaminaBody
+    from ..physics.laminae.shapes import Superellipse
+    from ..physics.bodies.lamina_body import LaminaBody
     return LaminaBody(Superellipse(1.0, b_over_a, exponent), delta_over_a)
 
 
 def lamina_mass(mass_model, body):
     """The mass model ``mass_model`` of ``body`` with M = 1 (``mass_properties_of``)."""
-    from ..physics.mass_models import mass_properties_of     # (issue 20: any RollingBody)
+    from ..physics.mass.models import mass_properties_of     # (issue 20: any RollingBody)
     return mass_properties_of(mass_model, body, 1.0)
 
 
@@ -99,7 +99,7 @@ def axis_inertia(body, props, u):
 def symmetric_family(body):
     """stable_family of ``body`` from its symmetric equilibria (:data:`GENERAL_FAMILIES`):
     +1 a tip (θ = 0 or the turning point) stable, −1 the side vertices, 2 both, NaN neither."""
-    from ..physics.symmetric_stability import symmetric_equilibria
+    from ..physics.stability.symmetric import symmetric_equilibria
     first, turning, side = symmetric_equilibria(body.lamina, body.delta, body.arrangement)
     tips = STABLE in (first.stability, turning.stability)
     sides = side.stability == STABLE

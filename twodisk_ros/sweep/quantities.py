@@ -22,13 +22,13 @@ import time
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..physics.body import TwoDiskBody
-from ..physics.contact_forces import ContactForceModel
-from ..physics.contact_validity import liftoff_speed, mu_required_kinematic
-from ..physics.cycle import RollingCycle, TWO_PI
-from ..physics.dynamics import RollingDynamics
-from ..physics.equilibria import NEUTRAL, STABLE
-from ..physics.mass_models import mass_properties
+from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.forces.contact import ContactForceModel
+from ..physics.forces.validity import liftoff_speed, mu_required_kinematic
+from ..physics.bodies.cycle import RollingCycle, TWO_PI
+from ..physics.motion.dynamics import RollingDynamics
+from ..physics.stability.equilibria import NEUTRAL, STABLE
+from ..physics.mass.models import mass_properties
 from .request import ELLIPSE_EXPONENT
 
 __all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities', 'run_stages',
