@@ -39,7 +39,8 @@ import numpy as np  # noqa: E402
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace  # noqa: E402
 from twodisk_ros.physics.motion.dynamics import RollingDynamics  # noqa: E402
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse  # noqa: E402
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse  # noqa: E402
+from twodisk_ros.physics.laminae.support import Egg  # noqa: E402
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties_of  # noqa: E402
 

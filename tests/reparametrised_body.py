@@ -45,6 +45,9 @@ class ReparametrisedBody(RollingBody):
     def __repr__(self):
         return f'ReparametrisedBody({self.base!r}, {self.kind!r}, epsilon={self.epsilon!r})'
 
+    def describe(self):
+        return f'{self.base.describe()} in a {self.kind} phase'
+
     # -- the map and its inverse -----------------------------------------------------------
     def g(self, v):
         """u = g(v) (complex-safe)."""

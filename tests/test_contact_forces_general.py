@@ -27,7 +27,8 @@ from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import (
     check_validity, liftoff_speed, mu_required_dynamic, mu_required_kinematic)
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import laminae, laminae_of
 

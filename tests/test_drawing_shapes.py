@@ -17,7 +17,8 @@ from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.frames import disk_rims
 from twodisk_ros.model.outline import DEFAULT_TOLERANCE
 from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
-from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.laminae.shapes import Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.plotting.animation import still
 from twodisk_ros.runs import Run, RunError
 

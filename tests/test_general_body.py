@@ -16,7 +16,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 
 #: (a, b, Δ): oloid, Two-Circle-Roller, thin (b/a = 0.2) and wide (b/a = 3) at several Δ/a
 ELLIPSE_BODIES = [(1.0, 1.0, 0.5), (1.0, 1.0, 1 / math.sqrt(2)), (1.0, 0.2, 0.05),

@@ -27,7 +27,8 @@ from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
 from twodisk_ros.physics.mass.hull import unit_hull_moments
 from twodisk_ros.physics.mass.hull_laminae import SWAP, MirroredLamina, general_hull_moments
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.laminae.fit import Outline
 from twodisk_ros.physics.mass.models import mass_properties, mass_properties_of
 

@@ -14,7 +14,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from rounding import ulps
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.laminae.fit import Outline, read_outline
 
 SHAPES = [Ellipse(2.0, 1.0), Ellipse(0.3, 1.7), Superellipse(1.0, 1.5, 2.0),
@@ -396,3 +397,46 @@ def test_any_points_give_an_outline_or_one_line(count, scale, wobble, seed, shuf
     # accepted: the promise holds (fit error within the tolerance, strictly convex)
     assert outline.fit_error <= 1e-3 * outline.size * 1.01
     assert np.min(outline.radius_of_curvature(np.linspace(0, np.pi, 1001))) > 0
+
+
+# -- what each lamina answers for itself (issue 29: no switches on the lamina's class) -------
+
+from twodisk_ros.physics.laminae.shapes import Lamina  # noqa: E402
+from twodisk_ros.physics.mass.hull_laminae import MirroredLamina  # noqa: E402
+
+SPEED_LAMINAE = [Ellipse(0.1, 0.07), Superellipse(0.1, 0.08, 4.0), Superellipse(0.1, 0.1, 7.5),
+                 Egg(0.1, 0.08, 0.004), MirroredLamina(Egg(0.1, 0.08, 0.004)),
+                 MirroredLamina(Superellipse(0.1, 0.08, 4.0))]
+
+
+@pytest.mark.parametrize('lamina', SPEED_LAMINAE, ids=repr)
+def test_rim_speed_is_the_derivative_of_the_points(lamina):
+    """|dr/ds| in closed form (ellipse, superellipse, support function, mirror) against the
+    protocol's eighth-order central difference of ``point`` (~1e-12 relative); away from a
+    superellipse's vertices, where |s|ⁿ terms spoil a difference of step 1e-2."""
+    s = np.linspace(0.05, 1.5, 40)
+    s = np.concatenate([s, math.pi - s, -s])
+    reference = Lamina.rim_speed(lamina, s)
+    assert np.max(np.abs(lamina.rim_speed(s) / reference - 1)) < 1e-9
+
+
+def test_superellipse_log_curvature_is_log_kappa_and_stays_finite():
+    """log κ without underflow: the log of the curvature where κ is representable (to 1e-12,
+    i.e. κ to 1e-12 relative: two formulas of the same κ, each good to rounding), finite
+    near the side vertices of n = 100 where κ itself underflows to 0."""
+    lamina = Superellipse(0.1, 0.08, 4.0)
+    s = np.linspace(0.01, 3.1, 200)
+    assert np.max(np.abs(lamina.log_curvature(s) - np.log(lamina.curvature(s)))) < 1e-12
+    sharp = Superellipse(0.1, 0.1, 100.0)
+    near = np.array([0.5 * math.pi - 1e-4, 0.5 * math.pi + 1e-4])
+    assert np.all(sharp.curvature(near) == 0.0)
+    assert np.all(np.isfinite(sharp.log_curvature(near)))
+
+
+def test_laminae_describe_themselves():
+    assert Ellipse(0.1, 0.07).describe() == 'ellipse a = 0.1 m, b = 0.07 m'
+    assert Superellipse(0.1, 0.08, 4.0).describe() == \
+        'superellipse a = 0.1 m, b = 0.08 m, n = 4'
+    assert Egg(0.1, 0.08, 0.004).describe() == 'egg a = 0.1 m, b = 0.08 m, ε = 0.004 m'
+    assert MirroredLamina(Ellipse(0.1, 0.07)).describe() == \
+        'mirroredlamina x_max = 0.07 m, y from -0.1 to 0.1 m'

@@ -21,7 +21,8 @@ from scipy.spatial.transform import Rotation
 from rounding import ulps
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.laminae.fit import Outline
 from twodisk_ros.physics.bodies.protocol import RollingBody
@@ -445,3 +446,43 @@ def test_random_shapes_give_a_body_or_one_line(kind, b, n, eps_fraction, delta_f
     assert_allclose(np.sum(m * a_o, -1), h1, rtol=0, atol=tol)
     assert_allclose(np.sum(m * b_o, -1), h2, rtol=0, atol=tol)
     assert_allclose(body.phase_geometry(math.pi / 2).theta, body.theta_max, atol=1e-13)
+
+
+# -- what each body answers for itself (issue 29: no switches on the body's class) -----------
+
+def test_bodies_describe_themselves_and_what_their_tables_cost():
+    oloid = TwoDiskBody(0.1, 0.1, 0.05)
+    assert oloid.describe() == 'a = 0.1 m, b = 0.1 m, Δ = 0.05 m'
+    assert oloid.resolution_cause() == 'b/a = 1, delta/a = 0.5'
+    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    assert square.describe() == 'superellipse a = 0.1 m, b = 0.1 m, n = 4, Δ = 0.05 m, parallel'
+    assert square.resolution_cause().startswith(repr(square) + ', feature width ')
+
+
+def test_contact_solver_and_origin_of_every_body():
+    """The drawings' exact contact geometry: the ellipse's solver is that of its lamina (same
+    θ_max as the closed form to 1e-15 relative), its origin the midpoint of the centres; a
+    lamina body's solver is its own, its origin the centroid (G)."""
+    body = TwoDiskBody(0.1, 0.07, 0.04)
+    solver = body.contact_solver
+    assert solver is body.contact_solver and solver.contact_solver is solver
+    assert abs(solver.theta_max / body.theta_max - 1) < 1e-15
+    assert np.array_equal(body.origin, np.zeros(3)) and body.offset == 0.0
+    egg = LaminaBody(Egg(0.1, 0.08, 0.004), 0.04)
+    assert egg.contact_solver is egg.general
+    assert np.array_equal(egg.origin, egg.general.centroid) and egg.general.centroid[1] != 0
+
+
+def test_flat_vertex_phases_from_the_vertices_are_the_bodys_own():
+    """The protocol's phases (A on a flat vertex of the lamina, from ``phase_from_theta``:
+    θ = 0 and ±π/2 on both branches) are among those LaminaBody finds from its phase charts
+    (A and B: the turning points u = π/2, 3π/2 too, B on its tip vertex), to 1e-12 rad; none
+    for an ellipse or an egg."""
+    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    generic = RollingBody.flat_vertex_phases(square)
+    own = square.flat_vertex_phases()
+    assert generic.size == 6 and own.size == 8
+    gaps = np.abs(np.remainder(generic[:, None] - own[None, :] + math.pi, 2 * math.pi) - math.pi)
+    assert np.max(np.min(gaps, axis=1)) < 1e-12
+    assert TwoDiskBody(0.1, 0.07, 0.04).flat_vertex_phases().size == 0
+    assert LaminaBody(Egg(0.1, 0.08, 0.004), 0.04).flat_vertex_phases().size == 0

@@ -18,7 +18,8 @@ from rounding import ulps
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
-from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.laminae.shapes import Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import centred_on_mass, mass_properties_of
 from twodisk_ros.physics.motion.simulate import simulate

@@ -14,7 +14,8 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 from rounding import ulps
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Lamina, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Lamina, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.laminae.fit import Outline
 from twodisk_ros.physics.stability.symmetric import symmetric_equilibria
 

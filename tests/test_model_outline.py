@@ -27,7 +27,8 @@ from twodisk_ros.model.outline import frame_rims, lamina_outline
 from twodisk_ros.model.stl import cached_stl
 from twodisk_ros.physics import TwoDiskBody
 from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 
 LAMINAE = [Ellipse(1.0, 0.3), Ellipse(0.5, 0.5), Superellipse(1.0, 1.0, 6),
            Superellipse(1.0, 0.5, 100), Superellipse(0.3, 0.8, 2.5), Egg(1.0, 0.8, 0.06),

@@ -188,7 +188,7 @@ def test_urdf_of_a_non_elliptic_body(model, arrangement, tmp_path):
     # parsers read its meshes, and its joint origins put the exact contact points A and B of
     # GeneralTwoDiskBody on the egg, mapped into the disk frames as frames.py documents
     from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
-    from twodisk_ros.physics.laminae.shapes import Egg
+    from twodisk_ros.physics.laminae.support import Egg
     lamina = Egg(0.2, 0.16, 0.012)
     body = GeneralTwoDiskBody(lamina, 0.08, arrangement)
     # the URDF only carries the mass model's numbers: an ellipse's stand in for the egg's

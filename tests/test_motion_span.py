@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import mu_required_dynamic
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
-from twodisk_ros.physics.laminae.shapes import Egg
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import centred_on_mass
 from twodisk_ros.physics.motion.simulate import MotionStream, simulate

@@ -17,7 +17,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from twodisk_ros.physics.laminae.shapes import Egg, Superellipse  # noqa: E402
+from twodisk_ros.physics.laminae.shapes import Superellipse  # noqa: E402
+from twodisk_ros.physics.laminae.support import Egg  # noqa: E402
 
 from roller_here import run_roller_main  # noqa: E402
 

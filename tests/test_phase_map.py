@@ -12,9 +12,10 @@ import pytest
 from numpy.testing import assert_allclose
 
 from rounding import ulps
-from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.laminae.shapes import Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
-from twodisk_ros.physics.laminae.phase_map import PhaseMap, phase_map
+from twodisk_ros.physics.laminae.phase_map import PhaseMap
 
 
 @pytest.mark.parametrize('alphas', [(1.0,), (1.0, 1.0), (-0.8,), (0.5, -0.3)])
@@ -50,12 +51,12 @@ def test_vertex_map_stops_with_the_cubic_order():
 
 
 def test_choice_of_map():
-    assert phase_map(Superellipse(1, 1, 2.1)).alphas == (1.0, 1.0)
-    assert phase_map(Superellipse(1, 1, 7.5)).alphas == (1.0,)
-    assert phase_map(Superellipse(1, 1, 4.0)).alphas == ()
-    assert phase_map(Superellipse(1, 1, 64.0)).alphas == (-0.8,)
-    assert phase_map(Superellipse(1, 100, 64.0)).alphas == ()
-    assert phase_map(Egg(1.3, 1.0, 0.08)).alphas == ()
+    assert Superellipse(1, 1, 2.1).phase_map().alphas == (1.0, 1.0)
+    assert Superellipse(1, 1, 7.5).phase_map().alphas == (1.0,)
+    assert Superellipse(1, 1, 4.0).phase_map().alphas == ()
+    assert Superellipse(1, 1, 64.0).phase_map().alphas == (-0.8,)
+    assert Superellipse(1, 100, 64.0).phase_map().alphas == ()
+    assert Egg(1.3, 1.0, 0.08).phase_map().alphas == ()
     with pytest.raises(ValueError, match='alphas'):
         PhaseMap((1.5,))
 

@@ -18,7 +18,7 @@ from twodisk_ros.run.params_yaml import params_file_values
 from twodisk_ros.run.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
 from twodisk_ros.run.simulation import Simulation
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
-from twodisk_ros.physics.laminae.shapes import Egg
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.run import shape as shapes
 from twodisk_ros.run.description import RunDescription
 
@@ -324,7 +324,7 @@ def test_a_points_outline_round_trips_through_the_metadata_exactly(tmp_path):
     assert (outline.fit_error, outline.point_count) == (fitted.fit_error, 200)
     # the rebuilt outline gives the recorded body: θ_max of the ellipse it was sampled from
     limit = TwoDiskBody(A, B, 0.03).theta_max
-    assert shapes.theta_max_of(outline, 0.03, 'parallel') == pytest.approx(limit, rel=1e-12)
+    assert shapes.theta_max_of(parsed, outline) == pytest.approx(limit, rel=1e-12)
 
 
 @pytest.mark.parametrize('outline, says', [

@@ -27,7 +27,8 @@ from test_scene import d5, kinematics, stencil
 import test_scene
 from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
-from twodisk_ros.physics.laminae.shapes import Egg, Superellipse
+from twodisk_ros.physics.laminae.shapes import Superellipse
+from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import laminae_of, mass_properties
 from twodisk_ros.physics.scenes.scene import Scene

@@ -31,7 +31,8 @@ from rounding import ulps
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
-from twodisk_ros.physics.laminae.shapes import Egg, Ellipse, Superellipse, SupportLamina
+from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
+from twodisk_ros.physics.laminae.support import Egg, SupportLamina
 from twodisk_ros.physics.laminae.fit import Outline
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.physics.stability.symmetric import (NOT_AN_EQUILIBRIUM,

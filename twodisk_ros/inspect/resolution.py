@@ -136,8 +136,7 @@ def _span(t, samples):
 
 def _vertex_stretches(samples, index, stretches, body):
     """', each around a flat vertex ...' if the stretches' stencils cross flat vertices."""
-    finder = getattr(body, 'flat_vertex_phases', None)
-    vertices = np.asarray(finder() if finder is not None else [], dtype=float)
+    vertices = np.asarray(body.flat_vertex_phases(), dtype=float)
     if vertices.size == 0:
         return ''
     phase = np.unwrap(samples.angles[:, 2])

@@ -33,11 +33,10 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
-from twodisk_ros.physics.bodies.contact_solver import ARRANGEMENTS, GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import ARRANGEMENTS
 
 __all__ = ['BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
-           'frame_rims', 'general_body', 'lamina_outline', 'resolution_tolerance']
+           'frame_rims', 'lamina_outline', 'resolution_tolerance']
 
 #: Default polygon error of a drawn outline, as a fraction of the lamina's size: below a
 #: pixel for a body 500 pixels wide; a circle gets 64 vertices (error 1.2e-3), as the
@@ -125,29 +124,13 @@ class BodyShape:
     #: along e2): G, or P = ``body.origin`` for a body moved by LaminaBody.about
 
 
-def general_body(body):
-    """``body`` itself if it is a GeneralTwoDiskBody, else the one it holds as ``general``
-    (LaminaBody), else the GeneralTwoDiskBody of its lamina, Δ and arrangement (the exact
-    contact geometry of any lamina)."""
-    for candidate in (body, getattr(body, 'general', None)):
-        if isinstance(candidate, GeneralTwoDiskBody):
-            return candidate
-    return GeneralTwoDiskBody(body.lamina, body.delta, getattr(body, 'arrangement', 'parallel'))
-
-
 def body_shape(body):
     """:class:`BodyShape` of a TwoDiskBody, a LaminaBody or a GeneralTwoDiskBody."""
-    arrangement = getattr(body, 'arrangement', 'parallel')
+    arrangement = body.arrangement
     if arrangement not in ARRANGEMENTS:
         raise ValueError(f'arrangement must be one of {sorted(ARRANGEMENTS)}, '
                          f'got {arrangement!r}')
-    centroid = getattr(body, 'origin', None)        # a moved LaminaBody: P = G + offset e2
-    if centroid is None:
-        centroid = getattr(body, 'centroid', None)
-    if centroid is None:
-        centroid = (np.zeros(3) if isinstance(body, TwoDiskBody)
-                    else general_body(body).centroid)
-    centroid = np.array(centroid, dtype=float)
+    centroid = np.array(body.origin, dtype=float)     # a moved LaminaBody: P = G + offset e2
     centroid.setflags(write=False)
     return BodyShape(body.lamina, float(body.delta), arrangement, ARRANGEMENTS[arrangement],
                      centroid)

@@ -29,7 +29,7 @@ import math
 
 import numpy as np
 
-from .outline import chord_deviation, general_body, resolution_tolerance
+from .outline import chord_deviation, resolution_tolerance
 
 __all__ = ['hull_rulings', 'ruled_hull']
 
@@ -92,7 +92,7 @@ def hull_rulings(body, resolution):
     Ruling j joins A[j] and B[j], branch +1, θ increasing from 0 (j = 0) to θ_max (j = m),
     sampled as the module docstring says; :func:`ruled_hull` mirrors them into the cycle.
     """
-    general = general_body(body)
+    general = body.contact_solver
     quarter = _Quarter(general)
     step = 2 * math.sin(math.pi / resolution) * general.size
     limit = resolution_tolerance(resolution) * general.lamina.size
@@ -110,7 +110,7 @@ def hull_rulings(body, resolution):
         a, b, a_l, b_l = (np.concatenate([old, added])[order]
                           for old, added in zip((a, b, a_l, b_l), new))
     # from the body's origin: P = G + offset e2 for a body moved by LaminaBody.about
-    shift = np.array([0.0, float(getattr(body, 'offset', 0.0)), 0.0])
+    shift = np.array([0.0, float(body.offset), 0.0])
     return a - shift, b - shift
 
 

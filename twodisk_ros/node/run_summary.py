@@ -35,8 +35,7 @@ def start_note(body, start):
     """One line if the start is a phase where the body does not turn in u (a contact on a flat
     vertex of its laminae), else None. ``start``: the run's
     :class:`~twodisk_ros.physics.motion.dynamics.PhaseState`."""
-    finder = getattr(body, 'flat_vertex_phases', None)
-    vertices = np.asarray(finder() if finder is not None else [], dtype=float)
+    vertices = np.asarray(body.flat_vertex_phases(), dtype=float)
     gap = np.abs(np.remainder(start.phase - vertices + math.pi, 2 * math.pi) - math.pi)
     if not vertices.size or float(np.min(gap)) > VERTEX_GAP:
         return None

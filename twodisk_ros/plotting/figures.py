@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np  # noqa: E402
 
 from ..physics.bodies.ellipse import TwoDiskBody  # noqa: E402
-from ..physics.laminae.shapes import Egg, Superellipse  # noqa: E402
+from ..physics.laminae.shapes import Superellipse  # noqa: E402
+from ..physics.laminae.support import Egg  # noqa: E402
 from ..physics.bodies.lamina_body import LaminaBody  # noqa: E402
 from ..outputs import OutputError, check_output_dir, replacing  # noqa: E402
 from ..model import palette  # noqa: E402
@@ -68,16 +69,6 @@ def _pyplot():
         plt.rcParams.update(STYLE)
         _styled.append(True)
     return plt
-
-
-def _describe(body):
-    if isinstance(body, TwoDiskBody):
-        return f'a = {body.a:.4g} m, b = {body.b:.4g} m, Δ = {body.delta:.4g} m'
-    lamina = body.lamina
-    extra = (f', n = {lamina.n:g}' if isinstance(lamina, Superellipse) else
-             f', ε = {lamina.epsilon:.3g} m' if isinstance(lamina, Egg) else '')
-    return (f'{type(lamina).__name__.lower()} a = {lamina.a:.4g} m, b = {lamina.b:.4g} m{extra}, '
-            f'Δ = {body.delta:.4g} m, {body.arrangement}')
 
 
 def plot_outline(lamina, ax, samples=721):
@@ -161,7 +152,7 @@ def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, 
     ax.set_xlabel('X (m)')
     ax.set_ylabel('Y (m)')
     prefix = f'{name}: ' if name else ''
-    ax.set_title(f'{prefix}{_describe(body)}\n{_cycles(cycles)} of the phase u (0 to '
+    ax.set_title(f'{prefix}{body.describe()}\n{_cycles(cycles)} of the phase u (0 to '
                  f'{2 * cycles}π), one lobe of each trace per half-cycle; '
                  f'{_advance(cycle.displacement)}')
     ax.legend(loc='upper center', bbox_to_anchor=(0.5, 0.0), borderaxespad=3.6, ncol=3,

@@ -222,7 +222,7 @@ def _check_together(s, outline=None):
     if not DELTA_OVER_A[0] <= ratio <= DELTA_OVER_A[1]:
         raise ValueError(f'delta/a must be in [{DELTA_OVER_A[0]:g}, 1 - 1e-6] (0 < delta < a), '
                          f'got delta = {s.delta!r} m, {what}a = {a!r} m (delta/a = {ratio:.6g})')
-    theta_max = shapes.theta_max_of(shapes.lamina_of(s, outline), s.delta, s.arrangement)
+    theta_max = shapes.theta_max_of(s, shapes.lamina_of(s, outline))
     if abs(s.theta0) > theta_max:
         raise ValueError(f'theta0 must satisfy |theta0| <= theta_max = {theta_max:.6g} '
                          f'rad for this body, got {s.theta0!r}')

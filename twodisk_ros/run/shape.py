@@ -7,7 +7,7 @@ attribute (any object with the parameter names: ``RollerSettings`` in practice).
 - ``ellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` (a, b); the body is
   :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (closed forms);
 - ``superellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Superellipse` (a, b, ``exponent``);
-- ``egg``: :class:`~twodisk_ros.physics.laminae.shapes.Egg` (a, b, ε) with
+- ``egg``: :class:`~twodisk_ros.physics.laminae.support.Egg` (a, b, ε) with
   ε = ``egg_asymmetry`` × ε_max(a, b) (m): ``egg_asymmetry`` is dimensionless, |·| ≤
   :data:`EGG_ASYMMETRY`, so that the radius of curvature stays ≥ (1 − |egg_asymmetry|) times
   the ellipse's at every normal angle (the egg's radius is ρ_E − 8ε cos 3φ and ε_max is the
@@ -30,7 +30,8 @@ import stat
 
 from ..physics.bodies.ellipse import TwoDiskBody
 from ..physics.bodies.contact_solver import GeneralTwoDiskBody
-from ..physics.laminae.shapes import Egg, Ellipse, Superellipse
+from ..physics.laminae.shapes import Ellipse, Superellipse
+from ..physics.laminae.support import Egg
 from ..physics.laminae.fit import Outline, read_outline
 
 __all__ = ['ARRANGEMENT_NAMES', 'EGG_ASYMMETRY', 'MAX_SHAPE_FILE_BYTES', 'OUTLINE_KEYS',
@@ -171,15 +172,19 @@ def clear_caches():
     _general.cache_clear()
 
 
-def theta_max_of(lamina, delta, arrangement):
-    """θ_max (rad) of two such laminae at Δ in the arrangement (ValueError if no cycle).
+def theta_max_of(settings, lamina):
+    """θ_max (rad) of the body the settings describe, made of ``lamina`` (their lamina,
+    :func:`lamina_of`): ValueError if the laminae at Δ in the arrangement have no cycle.
 
-    An :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` takes the closed form of
-    :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (both arrangements are the same body).
+    Only the contact geometry is built (not a rolling body's tables): for ``shape`` ellipse
+    the closed form of :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (both
+    arrangements are the same body), for the others the
+    :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody` of the lamina.
     """
-    if type(lamina) is Ellipse:
-        return TwoDiskBody(lamina.a, lamina.b, delta).theta_max
-    return _general(lamina, delta, arrangement).theta_max
+    s = settings
+    if s.shape == 'ellipse':
+        return TwoDiskBody(s.a, s.b, s.delta).theta_max
+    return _general(lamina, s.delta, s.arrangement).theta_max
 
 
 def describe_shape(settings, lamina):

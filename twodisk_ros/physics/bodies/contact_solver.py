@@ -199,6 +199,19 @@ class GeneralTwoDiskBody:
         #: largest |θ| (rad): disk 1 stands vertical, B at the far tip of disk 2
         self.theta_max = float(np.arctan2(max(float(point[0]), 0.0), -float(point[1])))
 
+    @property
+    def contact_solver(self):
+        """The solver itself (as a rolling body's ``contact_solver``)."""
+        return self
+
+    @property
+    def origin(self):
+        """The body-frame origin G from the midpoint O of the centres (m): the centroid."""
+        return self.centroid
+
+    #: The body-frame origin's offset from G along e2 (m): none (as a rolling body's).
+    offset = 0.0
+
     def __repr__(self):
         return (f'GeneralTwoDiskBody({self.lamina!r}, delta={self.delta!r}, '
                 f'arrangement={self.arrangement!r})')

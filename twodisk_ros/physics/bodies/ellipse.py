@@ -368,6 +368,17 @@ class TwoDiskBody(TwoDiskForms, RollingBody):
     def __repr__(self):
         return f'TwoDiskBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
 
+    def describe(self):
+        return f'a = {self.a:.4g} m, b = {self.b:.4g} m, Δ = {self.delta:.4g} m'
+
+    @property
+    def origin(self):
+        return np.zeros(3)      # G is the midpoint of the centres (the ellipses' symmetry)
+
+    def resolution_cause(self):
+        """Its two ratios: b/a and Δ/a set the sharpest feature of the closed forms."""
+        return f'b/a = {self.b / self.a:.6g}, delta/a = {self.delta / self.a:.6g}'
+
     # -- named bodies ------------------------------------------------------------------------
     @classmethod
     def oloid(cls, radius=1.0):

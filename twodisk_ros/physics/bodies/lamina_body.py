@@ -146,6 +146,13 @@ class LaminaBody(RollingBody):
         return (f'LaminaBody({self.lamina!r}, delta={self.delta!r}, '
                 f'arrangement={self.arrangement!r}){moved}')
 
+    def describe(self):
+        return f'{self.lamina.describe()}, Δ = {self.delta:.4g} m, {self.arrangement}'
+
+    @property
+    def contact_solver(self):
+        return self.general
+
     def about(self, offset):
         """The same body with its reference point (the body-frame origin) moved by offset e2.
 

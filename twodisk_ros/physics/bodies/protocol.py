@@ -31,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .contact_solver import GeneralTwoDiskBody
+
 __all__ = ['PhaseGeometry', 'RollingBody', 'check_rolling_body']
 
 
@@ -120,6 +122,58 @@ class RollingBody(abc.ABC):
     @abc.abstractmethod
     def contact_angle_psi(self, theta, branch=1):
         """ψ(θ) (rad) on a branch."""
+
+    def flat_vertex_phases(self):
+        """The phases u ∈ [0, 2π) (rad, sorted) where a contact sits on a flat vertex of the
+        lamina (zero curvature): the body does not turn there (|ω_u| = 0) and z_G is flat to
+        high order. Here from the lamina's vertices on −y and ±x whose radius of curvature is
+        infinite, the phases where A sits on them (``phase_from_theta`` of θ = 0, ±π/2 on
+        both branches; B's are then not known); a body that knows all of them overrides it.
+        Empty for the ellipse."""
+        thetas = []
+        for axis, theta in (('-y', (0.0,)), ('+x', (0.5 * np.pi, -0.5 * np.pi))):
+            try:
+                flat = np.isinf(self.lamina.vertex(axis).radius)
+            except ValueError as error:     # Lamina.vertex: flat, no order of contact given
+                flat = 'flat' in str(error)
+            if flat:
+                thetas.extend(t for t in theta if abs(t) <= self.theta_max)
+        phases = [float(self.phase_from_theta(t, branch)) for t in thetas for branch in (1, -1)]
+        phases = [0.0 if abs(p) < 1e-300 else p for p in phases]   # θ = 0 gives a subnormal
+        return np.unique(np.mod(np.array(phases, dtype=float), 2 * np.pi))
+
+    # -- words -------------------------------------------------------------------------------
+    @abc.abstractmethod
+    def describe(self):
+        """One line naming the body by its parameters (lengths in m), for titles and logs."""
+
+    # -- the exact contact geometry (drawings) ------------------------------------------------
+    @property
+    def contact_solver(self):
+        """The :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody` of the
+        body's lamina, Δ and arrangement: its contact geometry solved from the support
+        function, whose rims every drawing of the body takes (built once)."""
+        solver = self.__dict__.get('_contact_solver')
+        if solver is None:
+            solver = GeneralTwoDiskBody(self.lamina, self.delta, self.arrangement)
+            self.__dict__['_contact_solver'] = solver
+        return solver
+
+    @property
+    def origin(self):
+        """The body-frame origin from the midpoint O of the disk centres (m, body frame)."""
+        return self.contact_solver.centroid
+
+    @property
+    def offset(self):
+        """The body-frame origin's offset from G along e2 (m): 0 unless the body was moved
+        (:meth:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody.about`)."""
+        return 0.0
+
+    def resolution_cause(self):
+        """What sets the resolution of the body's tables, for the start-up notice of an
+        extreme body (:mod:`~twodisk_ros.physics.motion.startup`): its feature width."""
+        return f'{self!r}, feature width {self.feature_width:.3g} rad'
 
 
 def check_rolling_body(body, what='body'):

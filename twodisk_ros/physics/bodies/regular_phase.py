@@ -33,8 +33,6 @@ import math
 
 import numpy as np
 
-from ..laminae.phase_map import phase_map
-
 __all__ = ['BRANCH_FLIP', 'COLUMNS', 'PhaseSolver', 'THETA_FLIP', 'unfold']
 
 #: The sampled functions of u, in table order (lengths in m, angles in rad): r1 = GA has no
@@ -62,7 +60,7 @@ class PhaseSolver:
 
     def __init__(self, general):
         self.general = general
-        self.map = phase_map(general.lamina)
+        self.map = general.lamina.phase_map()
         self.s_max = general.s_max
         self.t_max = float(self.map.inverse(self.s_max))
         self.tip = general.far_tip

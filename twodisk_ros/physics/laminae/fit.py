@@ -1,6 +1,6 @@
 """A user's outline as a lamina: a smooth, strictly convex, symmetric fit of its points.
 
-The fitted lamina is a :class:`~twodisk_ros.physics.laminae.shapes.SupportLamina` whose support
+The fitted lamina is a :class:`~twodisk_ros.physics.laminae.support.SupportLamina` whose support
 function is a cosine series h(φ) = Σ_{k=0..M} c_k cos kφ of the outward normal's angle φ
 (measured from −y): even in φ, so symmetric about the common axis y, exactly. The fit
 (docs/physics.md#laminae-other-than-ellipses), for points in order around the
@@ -32,7 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .shapes import SupportLamina, normal_of_angle
+from .shapes import normal_of_angle
+from .support import SupportLamina
 
 __all__ = ['MIN_POINTS', 'MAX_POINTS', 'RADIUS_RANGE', 'Outline', 'read_outline']
 

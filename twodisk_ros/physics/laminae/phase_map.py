@@ -17,7 +17,8 @@ diagonals π/4 + kπ/2 are fixed). α = 1 stops at the vertices: s − kπ/2 ≈
 so |s − kπ/2|ⁿ becomes |t − kπ/2|^(3n) (three times the derivatives; nested d times,
 3^d n). α < 0 dwells at the corners: w′ = 1 − |α| there, 1 + |α| at the vertices, spreading
 the corner's curvature over 1/(1 − |α|) times more of t. Other laminae (ellipse, egg,
-fitted outline) are analytic in their parameters and keep t = s.
+fitted outline) are analytic in their parameters and keep t = s. Each lamina gives its own
+map (``Lamina.phase_map``); this module holds the maps and the superellipse's rule.
 """
 
 import math
@@ -25,7 +26,7 @@ import math
 import numpy as np
 
 __all__ = ['CORNER_ASPECT', 'CORNER_DWELL', 'CORNER_EXPONENT', 'PhaseMap', 'VERTEX_SMOOTHNESS',
-           'phase_map']
+           'superellipse_phase_map']
 
 HALF_PI = 0.5 * math.pi
 #: Nested vertex maps (α = 1) for a superellipse of non-even exponent n < this: the least
@@ -137,18 +138,14 @@ def _inverse_once(s, alpha):
     return np.copysign(t, s)
 
 
-def phase_map(lamina):
-    """The :class:`PhaseMap` of a lamina's phase parameter (module docstring): for a
-    superellipse of non-even exponent n < VERTEX_SMOOTHNESS, d vertex maps with 3^d n ≥
+def superellipse_phase_map(n, aspect):
+    """The :class:`PhaseMap` of a superellipse of exponent n and aspect ratio b/a (module
+    docstring): for a non-even n < VERTEX_SMOOTHNESS, d vertex maps with 3^d n ≥
     VERTEX_SMOOTHNESS; for n ≥ CORNER_EXPONENT one corner map (b/a within CORNER_ASPECT);
     otherwise the identity."""
-    from .shapes import Superellipse
-    if not isinstance(lamina, Superellipse):
-        return PhaseMap()
-    n = lamina.n
     if n >= CORNER_EXPONENT:
         low, high = CORNER_ASPECT
-        return PhaseMap((-CORNER_DWELL,) if low <= lamina.b / lamina.a <= high else ())
+        return PhaseMap((-CORNER_DWELL,) if low <= aspect <= high else ())
     alphas = []
     if n % 2.0 != 0.0:
         while 3.0 ** len(alphas) * n < VERTEX_SMOOTHNESS:

@@ -1,4 +1,4 @@
-"""A planar lamina in its own plane: one protocol, and the ellipse, superellipse and egg.
+"""A planar lamina in its own plane: one protocol, the ellipse and the superellipse.
 
 The foundation of bodies of any two congruent symmetric laminae: :mod:`general_body` solves
 their contact geometry from it and :mod:`lamina_body` makes them rolling bodies
@@ -22,7 +22,10 @@ Protocol (:class:`Lamina`): ``point(s)``, ``tangent(s)`` (unit, s increasing), `
 (unit, outward), ``curvature(s)`` (1/m, ≥ 0), ``support(direction)`` (the support function
 h(n) = max over the boundary of r·n, the point attaining it and its parameter), ``moments``
 (area, centroid, second moments of area about the lamina's origin), ``extents``, ``size`` and
-``vertex(axis)`` (extent, radius of curvature and order of contact where the normal is ±y, +x).
+``vertex(axis)`` (extent, radius of curvature and order of contact where the normal is ±y, +x),
+``rim_speed(s)`` (|dr/ds|), ``log_curvature(s)`` and ``phase_map()`` (how the body's regular
+phase re-spaces s). Laminae given by their support function (the egg, a fitted outline) are
+in :mod:`.support`.
 """
 
 import abc
@@ -31,18 +34,17 @@ import math
 
 import numpy as np
 
-__all__ = ['AreaMoments', 'Egg', 'Ellipse', 'Lamina', 'LENGTH_RANGE', 'SUPERELLIPSE_EXPONENT',
-           'Superellipse', 'Support', 'SupportLamina', 'VERTEX_AXES', 'Vertex', 'check_length']
+from .phase_map import PhaseMap, superellipse_phase_map
+
+__all__ = ['AreaMoments', 'Ellipse', 'Lamina', 'LENGTH_RANGE', 'SUPERELLIPSE_EXPONENT',
+           'Superellipse', 'Support', 'VERTEX_AXES', 'Vertex', 'check_length', 'direction_angle',
+           'normal_of_angle']
 
 #: Allowed lengths (m), as for TwoDiskBody: the forms hold up to sixth powers of lengths.
 LENGTH_RANGE = (1e-30, 1e30)
 #: Allowed superellipse exponents n: from the ellipse (2) to a rounded rectangle whose corner
 #: radius of curvature is a few per cent of its size (about 0.05 b at n = 100, b = a).
 SUPERELLIPSE_EXPONENT = (2.0, 100.0)
-#: Area moments of support-function laminae: the trapezoidal rule in φ (exponentially
-#: convergent) doubles its nodes until two results agree to this, relative to the largest.
-MOMENT_RTOL = 2e-15
-_MAX_MOMENT_NODES = 1 << 17
 #: A vertex radius of curvature above this multiple of the size is a flat vertex (zero
 #: curvature, up to rounding), whose order of contact the lamina must give itself.
 FLAT_RADIUS = 1e12
@@ -69,7 +71,7 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def _direction_angle(direction):
+def direction_angle(direction):
     """Normal angle φ of a direction: n(φ) = (sin φ, −cos φ); also |direction|."""
     d = np.asarray(direction, dtype=float)
     if d.shape[-1:] != (2,):
@@ -166,6 +168,33 @@ class Lamina(abc.ABC):
         n = self.normal(s)
         return np.stack([-n[..., 1], n[..., 0]], axis=-1)
 
+    def rim_speed(self, s):
+        """|dr/ds| (m per rad) of the boundary parameter: here an eighth-order central
+        difference of :meth:`point` (about 1e-12 relative); the shipped laminae give it in
+        closed form."""
+        s = np.asarray(s, dtype=float)
+        step = 1e-2
+        coefficients = (4 / 5, -1 / 5, 4 / 105, -1 / 280)
+        derivative = sum(c * (self.point(s + k * step) - self.point(s - k * step))
+                         for k, c in enumerate(coefficients, start=1)) / step
+        return np.linalg.norm(derivative, axis=-1)
+
+    def log_curvature(self, s):
+        """log κ(s) (κ in 1/m); a lamina whose curvature underflows overrides it."""
+        return np.log(self.curvature(np.asarray(s, dtype=float)))
+
+    def phase_map(self):
+        """The :class:`~twodisk_ros.physics.laminae.phase_map.PhaseMap` of the regular phase:
+        the identity unless the lamina has vertices the phase must dwell at."""
+        return PhaseMap()
+
+    def describe(self):
+        """One line naming the lamina by its parameters (m), for titles and logs; here by its
+        extents (the shipped laminae name their own parameters)."""
+        x_max, y_min, y_max = self.extents
+        return (f'{type(self).__name__.lower()} x_max = {x_max:.4g} m, y from {y_min:.4g} '
+                f'to {y_max:.4g} m')
+
     def _vertex_radius(self, s):
         curvature = float(self.curvature(s))
         return 1.0 / curvature if curvature > 0 else math.inf
@@ -225,6 +254,9 @@ class Ellipse(Lamina):
     def __repr__(self):
         return f'{type(self).__name__}(a={self.a!r}, b={self.b!r})'
 
+    def describe(self):
+        return f'ellipse a = {self.a:.4g} m, b = {self.b:.4g} m'
+
     def point(self, s):
         s = np.asarray(s, dtype=float)
         return np.stack([self.b * np.sin(s), -self.a * np.cos(s)], axis=-1)
@@ -238,9 +270,14 @@ class Ellipse(Lamina):
         a, b = self.a, self.b
         return a * b / np.hypot(b * np.cos(s), a * np.sin(s)) ** 3
 
+    def rim_speed(self, s):
+        """|dr/ds| = √(b² cos² s + a² sin² s) (m per rad of the eccentric anomaly)."""
+        s = np.asarray(s, dtype=float)
+        return np.hypot(self.b * np.cos(s), self.a * np.sin(s))
+
     def support(self, direction):
         d = np.asarray(direction, dtype=float)
-        _direction_angle(d)
+        direction_angle(d)
         a, b = self.a, self.b
         h = np.hypot(b * d[..., 0], a * d[..., 1])
         point = np.stack([b * b * d[..., 0] / h, a * a * d[..., 1] / h], axis=-1)
@@ -295,6 +332,9 @@ class Superellipse(Lamina):
     def __repr__(self):
         return f'Superellipse(a={self.a!r}, b={self.b!r}, n={self.n!r})'
 
+    def describe(self):
+        return f'superellipse a = {self.a:.4g} m, b = {self.b:.4g} m, n = {self.n:g}'
+
     def _sin_cos(self, s):
         s = np.asarray(s, dtype=float)
         sin, cos = np.sin(s), np.cos(s)
@@ -321,7 +361,7 @@ class Superellipse(Lamina):
 
     def support(self, direction):
         d = np.asarray(direction, dtype=float)
-        _direction_angle(d)
+        direction_angle(d)
         q, a, b = self.q, self.a, self.b
         bx, ay = np.abs(b * d[..., 0]), np.abs(a * d[..., 1])
         h = (bx**q + ay**q) ** (1.0 / q)
@@ -337,6 +377,36 @@ class Superellipse(Lamina):
         factor = 4 * math.gamma(3 / n) * math.gamma(1 / n) / (n * n * math.gamma(1 + 4 / n))
         return AreaMoments(area, np.zeros(2), factor * a * b**3, factor * a**3 * b, 0.0)
 
+    def rim_speed(self, s):
+        """|dr/ds| (m per rad) from r = (b sin s, −a cos s)/N(s), N = (|sin s|ⁿ + |cos s|ⁿ)^(1/n)."""
+        s = np.asarray(s, dtype=float)
+        n, sin, cos = self.n, np.sin(s), np.cos(s)
+        norm = (np.abs(sin) ** n + np.abs(cos) ** n) ** (1.0 / n)
+        dnorm = (np.sign(sin) * np.abs(sin) ** (n - 1) * cos
+                 - np.sign(cos) * np.abs(cos) ** (n - 1) * sin) / norm ** (n - 1)
+        dx = self.b * (cos * norm - sin * dnorm) / norm ** 2
+        dy = self.a * (sin * norm + cos * dnorm) / norm ** 2
+        return np.hypot(dx, dy)
+
+    def log_curvature(self, s):
+        """log κ(s), without underflow where the curvature vanishes: for large n,
+        κ ~ |cos s|^(n−2) near the side vertices underflows to 0 within about 1e-3 rad of them
+        (n = 100), while the ratio of two rims' curvatures stays finite."""
+        s = np.asarray(s, dtype=float)
+        n, a, b = self.n, self.a, self.b
+        with np.errstate(divide='ignore'):
+            log_sin, log_cos = np.log(np.abs(np.sin(s))), np.log(np.abs(np.cos(s)))
+        log_norm = np.logaddexp(n * log_sin, n * log_cos) / n
+        log_gx, log_gy = (n - 1) * log_sin - math.log(b), (n - 1) * log_cos - math.log(a)
+        log_hx = math.log(n - 1) + (n - 2) * log_sin - 2 * math.log(b)
+        log_hy = math.log(n - 1) + (n - 2) * log_cos - 2 * math.log(a)
+        return (log_norm + np.logaddexp(2 * log_gy + log_hx, 2 * log_gx + log_hy)
+                - 1.5 * np.logaddexp(2 * log_gx, 2 * log_gy))
+
+    def phase_map(self):
+        """Vertex maps for a non-even n, a corner map for large n (module phase_map)."""
+        return superellipse_phase_map(self.n, self.b / self.a)
+
     def vertex(self, axis):
         """For n > 2 the four vertices are flat: h(d + t d⊥) = e + |r t|^q e^(1−q)/q + O(|t|^2q),
         e the extent (a or b) and r the other semi-axis (from the closed-form h)."""
@@ -346,144 +416,3 @@ class Superellipse(Lamina):
         extent, other = (self.b, self.a) if axis == '+x' else (self.a, self.b)
         return Vertex(axis, direction, extent * direction, extent, math.inf, self.q,
                       other**self.q * extent ** (1.0 - self.q) / self.q)
-
-
-class SupportLamina(Lamina):
-    """A lamina given by its support function h(φ) of the normal angle, n(φ) = (sin φ, −cos φ).
-
-    The parameter s is φ itself. With t(φ) = (cos φ, sin φ): r(φ) = h n + h′ t,
-    dr/dφ = (h + h″) t, curvature 1/(h + h″); the lamina is strictly convex where the radius
-    of curvature h + h″ > 0 everywhere. Symmetric about the common axis: h(−φ) = h(φ).
-    Subclasses give :meth:`support_jet`; the area moments follow by Green's theorem in φ.
-    """
-
-    @abc.abstractmethod
-    def support_jet(self, phi):
-        """(h, h′, h″) at normal angles φ (m)."""
-
-    def radius_of_curvature(self, phi):
-        """h + h″ at φ (m)."""
-        h, _, h2 = self.support_jet(phi)
-        return h + h2
-
-    def _vertex_radius(self, s):
-        return float(self.radius_of_curvature(s))
-
-    def point(self, s):
-        s = np.asarray(s, dtype=float)
-        h, h1, _ = self.support_jet(s)
-        n = normal_of_angle(s)
-        return h[..., None] * n + h1[..., None] * np.stack([-n[..., 1], n[..., 0]], axis=-1)
-
-    def normal(self, s):
-        return normal_of_angle(s)
-
-    def curvature(self, s):
-        return 1.0 / self.radius_of_curvature(np.asarray(s, dtype=float))
-
-    def support(self, direction):
-        phi, length = _direction_angle(direction)
-        h, _, _ = self.support_jet(phi)
-        return Support(h * length, self.point(phi), phi)
-
-    def _moments_on(self, nodes):
-        phi = 2 * np.pi * np.arange(nodes) / nodes
-        x, y = np.moveaxis(self.point(phi), -1, 0)
-        rho = self.radius_of_curvature(phi)
-        dx, dy = rho * np.cos(phi), rho * np.sin(phi)   # dr/dφ = ρ t
-        step = 2 * np.pi / nodes
-        # Green: ∮ x dy = A, ∮ −y²/2 dx = ∫y, ∮ x³/3 dy = ∫x², ∮ −y³/3 dx = ∫y², ∮ x²y/2 dy = ∫xy
-        return step * np.array([np.sum(x * dy), np.sum(-y * y * dx) / 2,
-                                np.sum(x**3 * dy) / 3, np.sum(-y**3 * dx) / 3,
-                                np.sum(x * x * y * dy) / 2])
-
-    @property
-    def moments(self):
-        cached = self.__dict__.get('_moments')
-        if cached is None:
-            nodes = 64
-            old = self._moments_on(nodes)
-            while True:
-                nodes *= 2
-                new = self._moments_on(nodes)
-                scale = self.size ** 4
-                if np.max(np.abs(new - old)) <= MOMENT_RTOL * scale or nodes >= _MAX_MOMENT_NODES:
-                    break
-                old = new
-            area, first_y, xx, yy, xy = (float(v) for v in new)
-            cached = AreaMoments(area, np.array([0.0, first_y / area]), xx, yy, xy)
-            self.__dict__['_moments'] = cached
-        return cached
-
-
-class Egg(SupportLamina):
-    """An egg: the ellipse's support function plus a third harmonic.
-
-    h(φ) = √(a² cos²φ + b² sin²φ) + ε cos 3φ, φ the outward normal's angle from −y. The
-    harmonic keeps the symmetry about the common axis (h even in φ) and breaks the one about
-    the x axis (cos 3(π − φ) = −cos 3φ): for ε > 0 the end at −y is sharper and reaches
-    y = −(a + ε), the end at +y is blunter and reaches a − ε; the half width stays b. Radius of
-    curvature a²b²/h_E³ − 8ε cos 3φ; convex iff |ε| < ε_max(a, b) (:meth:`epsilon_max`), and
-    Egg(a, b, −ε) is the mirror image of Egg(a, b, ε) in the x axis. Area πab − 4πε² (the
-    cross terms integrate to zero); second moments by Green's theorem. The origin is the
-    ellipse's centre, so the centroid lies off it along the common axis.
-
-    Parameters
-    ----------
-    a, b : float
-        Semi-axes of the underlying ellipse along y (common axis) and x (m), finite, > 0.
-    epsilon : float
-        Amplitude of the third harmonic (m), |epsilon| < epsilon_max(a, b).
-    """
-
-    def __init__(self, a, b, epsilon):
-        self.a = check_length('a', a)
-        self.b = check_length('b', b)
-        limit = self.epsilon_max(self.a, self.b)
-        rule = (f'|epsilon| < {limit:.6g} m for a = {self.a:g} m, b = {self.b:g} m '
-                '(radius of curvature h + h\'\' > 0: a strictly convex egg)')
-        if isinstance(epsilon, (str, bytes, bool)) or epsilon is None:
-            raise ValueError(f'epsilon must be a real number with {rule}, got {epsilon!r}')
-        try:
-            eps = float(epsilon)
-        except (TypeError, ValueError):
-            raise ValueError(f'epsilon must be a real number with {rule}, '
-                             f'got {epsilon!r}') from None
-        if not (math.isfinite(eps) and abs(eps) < limit):
-            raise ValueError(f'epsilon must be finite with {rule}, got {epsilon!r}')
-        self.epsilon = eps
-        grid = np.linspace(0.0, np.pi, 4097)
-        if float(np.min(self.radius_of_curvature(grid))) <= 1e-9 * max(self.a, self.b):
-            raise ValueError(f'epsilon must be finite with {rule}, got {epsilon!r}')
-
-    def __repr__(self):
-        return f'Egg(a={self.a!r}, b={self.b!r}, epsilon={self.epsilon!r})'
-
-    @staticmethod
-    def epsilon_max(a, b):
-        """Largest |ε| (m) keeping h + h″ > 0: min over cos 3φ > 0 of (a²b²/h_E³)/(8 cos 3φ)."""
-        from scipy.optimize import minimize_scalar
-        def ratio(phi):
-            he = math.hypot(a * math.cos(phi), b * math.sin(phi))
-            return a * a * b * b / he**3 / (8 * math.cos(3 * phi))
-        best = math.inf
-        for low, high in ((0.0, np.pi / 6), (np.pi / 2, 5 * np.pi / 6)):
-            grid = np.linspace(low, high, 402)[1:-1] if low else np.linspace(low, high, 401)[:-1]
-            values = [ratio(p) for p in grid]
-            j = int(np.argmin(values))
-            step = grid[1] - grid[0]
-            found = minimize_scalar(ratio, bounds=(max(grid[j] - step, low),
-                                                   min(grid[j] + step, high - 1e-12)),
-                                    method='bounded', options={'xatol': 1e-13})
-            best = min(best, values[j], float(found.fun))
-        return best
-
-    def support_jet(self, phi):
-        phi = np.asarray(phi, dtype=float)
-        a, b, eps = self.a, self.b, self.epsilon
-        sin, cos = np.sin(phi), np.cos(phi)
-        he = np.hypot(a * cos, b * sin)
-        he1 = (b * b - a * a) * sin * cos / he
-        he2 = a * a * b * b / he**3 - he
-        c3, s3 = np.cos(3 * phi), np.sin(3 * phi)
-        return he + eps * c3, he1 - 3 * eps * s3, he2 - 9 * eps * c3

@@ -45,9 +45,9 @@ import numpy as np
 
 from ..bodies.contact_solver import GeneralTwoDiskBody
 from .hull import PAIRS, relative_change
-from ..laminae.shapes import AreaMoments, Ellipse, Lamina, Superellipse, Support, SupportLamina
+from ..laminae.shapes import AreaMoments, Lamina, Support
 
-__all__ = ['MirroredLamina', 'general_hull_moments', 'log_curvature', 'rim_speed']
+__all__ = ['MirroredLamina', 'general_hull_moments']
 
 #: Gauss–Legendre nodes per arc: first grid and the last one tried.
 N_START = 16
@@ -85,6 +85,12 @@ class MirroredLamina(Lamina):
     def curvature(self, s):
         return self.original.curvature(np.pi - np.asarray(s, dtype=float))
 
+    def rim_speed(self, s):
+        return self.original.rim_speed(np.pi - np.asarray(s, dtype=float))
+
+    def log_curvature(self, s):
+        return self.original.log_curvature(np.pi - np.asarray(s, dtype=float))
+
     def support(self, direction):
         found = self.original.support(np.asarray(direction, dtype=float) * _FLIP)
         parameter = np.pi - np.asarray(found.parameter, dtype=float)
@@ -101,59 +107,6 @@ class MirroredLamina(Lamina):
 def _det(a, b, c):
     """a·(b × c) row by row."""
     return np.einsum('...i,...i->...', a, np.cross(b, c))
-
-
-def rim_speed(lamina, s):
-    """|dr/ds| (m per rad) of the lamina's boundary parameter s, for the shipped shapes.
-
-    Ellipse: √(b² cos² s + a² sin² s); superellipse: from r = (b sin s, −a cos s)/N(s);
-    support-function laminae (egg, fitted outline): the radius of curvature h + h″ (s = φ);
-    a mirrored lamina: the original's at π − s. Any other lamina: an eighth-order central
-    difference of ``point`` (about 1e-12 relative).
-    """
-    s = np.asarray(s, dtype=float)
-    if isinstance(lamina, MirroredLamina):
-        return rim_speed(lamina.original, np.pi - s)
-    if isinstance(lamina, SupportLamina):
-        return lamina.radius_of_curvature(s)
-    if isinstance(lamina, Ellipse):
-        return np.hypot(lamina.b * np.cos(s), lamina.a * np.sin(s))
-    if isinstance(lamina, Superellipse):
-        n, sin, cos = lamina.n, np.sin(s), np.cos(s)
-        norm = (np.abs(sin) ** n + np.abs(cos) ** n) ** (1.0 / n)
-        dnorm = (np.sign(sin) * np.abs(sin) ** (n - 1) * cos
-                 - np.sign(cos) * np.abs(cos) ** (n - 1) * sin) / norm ** (n - 1)
-        dx = lamina.b * (cos * norm - sin * dnorm) / norm ** 2
-        dy = lamina.a * (sin * norm + cos * dnorm) / norm ** 2
-        return np.hypot(dx, dy)
-    step = 1e-2
-    coefficients = (4 / 5, -1 / 5, 4 / 105, -1 / 280)
-    derivative = sum(c * (lamina.point(s + k * step) - lamina.point(s - k * step))
-                     for k, c in enumerate(coefficients, start=1)) / step
-    return np.linalg.norm(derivative, axis=-1)
-
-
-def log_curvature(lamina, s):
-    """log κ(s) (κ in 1/m), without underflow where a superellipse's curvature vanishes.
-
-    For a superellipse of large n, κ ~ |cos s|^(n−2) near its side vertices underflows to 0
-    within about 1e-3 rad of them (n = 100); the ratio of the two rims' curvatures that B's
-    rate needs is finite there, and is taken as exp(log κ_A − log κ_B).
-    """
-    s = np.asarray(s, dtype=float)
-    if isinstance(lamina, MirroredLamina):
-        return log_curvature(lamina.original, np.pi - s)
-    if not isinstance(lamina, Superellipse):
-        return np.log(lamina.curvature(s))
-    n, a, b = lamina.n, lamina.a, lamina.b
-    with np.errstate(divide='ignore'):
-        log_sin, log_cos = np.log(np.abs(np.sin(s))), np.log(np.abs(np.cos(s)))
-    log_norm = np.logaddexp(n * log_sin, n * log_cos) / n
-    log_gx, log_gy = (n - 1) * log_sin - math.log(b), (n - 1) * log_cos - math.log(a)
-    log_hx = math.log(n - 1) + (n - 2) * log_sin - 2 * math.log(b)
-    log_hy = math.log(n - 1) + (n - 2) * log_cos - 2 * math.log(a)
-    return (log_norm + np.logaddexp(2 * log_gy + log_hx, 2 * log_gx + log_hy)
-            - 1.5 * np.logaddexp(2 * log_gx, 2 * log_gy))
 
 
 def _arc_integrand(body, s, branch):
@@ -185,7 +138,7 @@ def _arc_integrand(body, s, branch):
     e /= np.linalg.norm(e, axis=-1, keepdims=True)
     # disk 1: rate of A per unit s, curvature, m·ν_A = 1/√(1 + τ²)
     t_a = g.tangent_a
-    speed_a = rim_speed(lam, s)
+    speed_a = lam.rim_speed(s)
     cos_a = 1.0 / np.sqrt(1.0 + g.elevation ** 2)
     # disk 2: where B is on its rim (the support in disk 2's in-plane direction of m)
     s_b = lam.support(np.stack([m[..., 2], sigma * m[..., 1]], axis=-1)).parameter
@@ -196,7 +149,7 @@ def _arc_integrand(body, s, branch):
     cos_b = np.einsum('...i,...i->...', m, nu_b)
     e_ta = np.einsum('...i,...i->...', e, t_a)
     e_tb = np.einsum('...i,...i->...', e, t_b)
-    ratio = np.exp(log_curvature(lam, s) - log_curvature(lam, s_b))     # κ_A / κ_B
+    ratio = np.exp(lam.log_curvature(s) - lam.log_curvature(s_b))     # κ_A / κ_B
     speed_b = speed_a * ratio * cos_a * e_tb / (cos_b * e_ta)
     alpha = np.abs(speed_a * _det(m, t_a, w))
     beta = np.abs(speed_b * _det(m, t_b, w))

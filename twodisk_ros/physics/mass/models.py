@@ -394,7 +394,7 @@ def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
         it; inertia about the centre of mass either way).
     """
     props = _properties_of(model, body, mass, principal_moments, rtol)
-    offset = float(getattr(body, 'offset', 0.0))
+    offset = float(body.offset)
     if not offset:
         return props
     return dataclasses.replace(props, center_of_mass=props.center_of_mass

@@ -56,6 +56,11 @@ class PhaseSolution:
         delta, u_dot = self._displace(t.ravel())
         return np.stack([delta, u_dot]).reshape((2,) + t.shape)
 
+    def forget_before(self, t):
+        """Drop what the solution keeps for times before t (s), once they are no longer
+        asked for: nothing here (a solution built piece by piece as time runs on frees its
+        earlier pieces)."""
+
     def _evaluate(self, t):
         raise NotImplementedError
 

@@ -40,10 +40,6 @@ def startup_estimate(body):
     seconds = SECONDS_PER_NODE * resolution
     message = None
     if seconds > NOTICE_SECONDS:
-        if hasattr(body, 'b'):      # the ellipse: its two ratios say what makes it costly
-            what = f'b/a = {body.b / body.a:.6g}, delta/a = {body.delta / body.a:.6g}'
-        else:
-            what = f'{body!r}, feature width {body.feature_width:.3g} rad'
-        message = (f'building tables for an extreme body ({what}: {resolution} nodes per '
-                   f'cycle): about {seconds:.0f} s')
+        message = (f'building tables for an extreme body ({body.resolution_cause()}: '
+                   f'{resolution} nodes per cycle): about {seconds:.0f} s')
     return StartupEstimate(resolution, seconds, message)

@@ -48,7 +48,7 @@ import math
 import numpy as np
 
 from ..motion.simulate import MotionStream
-from .closed import DriftQuadrature, conservative_solution
+from .closed import conservative_solution
 from ..bodies.cycle import TWO_PI
 from .samples import Piece, SceneSamples, samples_from
 from ..motion.solvers import import_integrator
@@ -370,7 +370,7 @@ class ClosedSceneStream:
         Straight from the solution (one read of the narrow energy table at most), without
         the wide table :meth:`samples` reads for ü and the energies."""
         t = np.asarray(t, dtype=float)
-        if isinstance(self.solution, DriftQuadrature) and t.size:
+        if t.size:
             self.solution.forget_before(float(t[0]))
         u, u_dot = self.solution(t)
         return u, u_dot
@@ -386,7 +386,7 @@ class ClosedSceneStream:
     def samples(self, t):
         """:class:`SceneSamples` at times t (s, increasing)."""
         t = np.asarray(t, dtype=float)
-        if isinstance(self.solution, DriftQuadrature) and t.size:
+        if t.size:
             self.solution.forget_before(float(t[0]))
         return self._samples_of(t, *self.state(t))
 

@@ -244,29 +244,10 @@ def flat_vertex_phases(body):
     There z_G − z* ~ |u − u*|^(2q) with the body not turning (|ω_u| = 0), so dz_G/du is flat
     to rounding and bisection of its sign stops up to ~1e-5 rad off; a signed cluster that
     holds one of these phases has its root there (dz_G/du = |ω_u| dz_G/dγ vanishes at it, and
-    changes sign there if anywhere in the cluster). From the body's hook
-    ``flat_vertex_phases()`` (LaminaBody) if it has one; else, for a body with a ``lamina``
-    whose vertex on −y or ±x has an infinite radius of curvature, the phases where A sits on
-    it (``phase_from_theta`` of the vertex's angle θ = 0, ±π/2, both branches; B's flat
-    vertices are then not known); else none.
+    changes sign there if anywhere in the cluster). The body's own
+    :meth:`~twodisk_ros.physics.bodies.protocol.RollingBody.flat_vertex_phases`, in [0, 2π).
     """
-    hook = getattr(body, 'flat_vertex_phases', None)
-    if callable(hook):
-        return np.mod(np.asarray(hook(), dtype=float), TWO_PI)
-    lamina = getattr(body, 'lamina', None)
-    thetas = []
-    for axis, theta in (('-y', (0.0,)), ('+x', (0.5 * math.pi, -0.5 * math.pi))):
-        try:
-            flat = math.isinf(lamina.vertex(axis).radius)
-        except ValueError as error:        # Lamina.vertex: flat, no order of contact given
-            flat = 'flat' in str(error)
-        except AttributeError:              # no lamina, or a lamina without vertices
-            flat = False
-        if flat:
-            thetas.extend(t for t in theta if abs(t) <= body.theta_max)
-    phases = [float(body.phase_from_theta(t, branch)) for t in thetas for branch in (1, -1)]
-    phases = [0.0 if abs(p) < 1e-300 else p for p in phases]   # θ = 0 gives a subnormal
-    return np.unique(np.mod(np.array(phases, dtype=float), TWO_PI))
+    return np.mod(np.asarray(body.flat_vertex_phases(), dtype=float), TWO_PI)
 
 
 def _bisect_sign(body, low, high, positive_low):
