@@ -24,7 +24,7 @@ setup(
     entry_points={
         'console_scripts': [
             'roller = twodisk_ros.roller:main',
-            'twodisk-inspect = twodisk_ros.inspect.cli:main',
+            'twodisk-inspect = twodisk_ros.inspector.cli:main',
             'twodisk-figures = twodisk_ros.plotting.figures:main',
             'twodisk-animate = twodisk_ros.plotting.animate_cli:main',
             'twodisk-sweep = twodisk_ros.sweep.cli:main',

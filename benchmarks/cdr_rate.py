@@ -3,7 +3,7 @@
 For each of the node's fixed-layout types (PoseStamped, PointStamped, WrenchStamped, JointState,
 TFMessage of one transform, Clock, and a Path of ``path_length`` poses), compares:
 
-* ``vectorised``: :mod:`twodisk_ros.io.cdr`, a whole batch from numpy arrays to ``list[bytes]``;
+* ``vectorised``: :mod:`twodisk_ros.recordings.cdr`, a whole batch from numpy arrays to ``list[bytes]``;
 * ``serialize``: ``rclpy.serialization.serialize_message`` of message objects built beforehand;
 * ``build+serialize``: building each object with :mod:`twodisk_ros.node.messages` then serializing
   it, what the node did until now;
@@ -32,7 +32,7 @@ if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
 os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
-from twodisk_ros.io import cdr  # noqa: E402
+from twodisk_ros.recordings import cdr  # noqa: E402
 
 FRAME = 'world'
 NAMES = ['theta', 'psi', 'phase']

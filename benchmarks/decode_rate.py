@@ -2,7 +2,7 @@
 
 ``python benchmarks/decode_rate.py FILE.mcap [--base OTHER_CHECKOUT]`` prints, for each message
 type of the file, the decoding cost per message of mcap-ros2-support's decoder and of the
-generated one (:mod:`twodisk_ros.io.cdr_decode`), best of 3 passes over all its messages with
+generated one (:mod:`twodisk_ros.recordings.cdr_decode`), best of 3 passes over all its messages with
 the garbage collector off (decoding alone); then the wall time of ``inspect_recording`` and
 ``read_recording`` (best of 3, each in a fresh process), and with ``--base`` the same for
 another checkout of the package (e.g. one before a change), the runs interleaved so that both
@@ -19,8 +19,8 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _TIMED = '''
 import sys, time
-from twodisk_ros.inspect.inspection import inspect_recording
-from twodisk_ros.io import read_recording
+from twodisk_ros.inspector.inspection import inspect_recording
+from twodisk_ros.recordings import read_recording
 what, path = sys.argv[1], sys.argv[2]
 start = time.perf_counter()
 (inspect_recording if what == 'inspect' else read_recording)(path)
@@ -32,8 +32,8 @@ def per_message(path):
     """``{type: (messages, mcap_ros2 s per message, generated s per message)}``."""
     sys.path.insert(0, ROOT)
     from mcap_ros2.decoder import DecoderFactory as McapDecoderFactory
-    from twodisk_ros.io.cdr_decode import compile_decoder
-    from twodisk_ros.io.mcap_scan import scan_mcap
+    from twodisk_ros.recordings.cdr_decode import compile_decoder
+    from twodisk_ros.recordings.mcap_scan import scan_mcap
     with open(path, 'rb') as stream:
         scan = scan_mcap(stream.read())
     channels = {**scan.summary_channels, **scan.channels}

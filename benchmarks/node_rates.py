@@ -164,7 +164,7 @@ def batch_rate(rate=1000.0, duration=300.0):
     """Record ``duration`` s at ``rate`` Hz in process; the floors in the same run."""
     import rclpy
     from rclpy.parameter import Parameter
-    from twodisk_ros.io import read_recording
+    from twodisk_ros.recordings import read_recording
     from twodisk_ros.node.roller import Roller
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, 'run.mcap')

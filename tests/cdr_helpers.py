@@ -3,7 +3,7 @@
 from mcap.records import Schema
 from mcap_ros2.decoder import DecoderFactory
 
-from twodisk_ros.io import msgdefs
+from twodisk_ros.recordings import msgdefs
 
 _MCAP_DECODERS = {}
 

@@ -64,7 +64,7 @@ def test_inspector_runs_where_rclpy_cannot_be_imported(tmp_path):
     from batch_recording import record
     out = record(tmp_path / 'run.mcap', domain=int(ENV['ROS_DOMAIN_ID']), duration=0.5)
     code = BLOCK_RCLPY + (
-        'from twodisk_ros.inspect.cli import main\n'
+        'from twodisk_ros.inspector.cli import main\n'
         f'status = main([{str(out)!r}])\n'
         'assert "rclpy" not in sys.modules\n'
         'sys.exit(status)\n')

@@ -1,4 +1,4 @@
-"""Tests of twodisk_ros.io.cdr, byte for byte against independent encoders and decoders.
+"""Tests of twodisk_ros.recordings.cdr, byte for byte against independent encoders and decoders.
 
 References: ``rclpy.serialization.serialize_message`` of the equivalent message object (built
 with the node's own builders in ``twodisk_ros.node.messages``), a scalar CDR writer written here
@@ -32,10 +32,10 @@ typesys = pytest.importorskip('rosbags.typesys')
 from geometry_msgs.msg import Pose, PoseStamped, Quaternion  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
-from twodisk_ros.io import msgdefs  # noqa: E402
+from twodisk_ros.recordings import msgdefs  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 from cdr_helpers import mcap_decode  # noqa: E402
-from twodisk_ros.io import cdr  # noqa: E402
+from twodisk_ros.recordings import cdr  # noqa: E402
 
 serialize_message = rclpy_serialization.serialize_message
 deserialize_message = rclpy_serialization.deserialize_message
@@ -296,7 +296,7 @@ def test_batch_of_one_stamp_and_contiguous_input_not_required():
 
 
 def test_imports_without_rclpy():
-    code = ('import sys; import twodisk_ros.io.cdr; '
+    code = ('import sys; import twodisk_ros.recordings.cdr; '
             'assert not [m for m in sys.modules if m.split(".")[0] == "rclpy"]')
     subprocess.run([sys.executable, '-c', code], cwd=ROOT, check=True)
 

@@ -1,4 +1,4 @@
-"""The generated CDR decoders (twodisk_ros.io.cdr_decode) against mcap-ros2-support's decoder.
+"""The generated CDR decoders (twodisk_ros.recordings.cdr_decode) against mcap-ros2-support's decoder.
 
 The claim checked (the module's equivalence guarantee): on any bytes, the generated function
 either raises or returns what mcap_ros2's own ``DecoderFactory`` decoder returns, field by
@@ -34,9 +34,9 @@ from mcap_ros2._dynamic import serialize_dynamic
 from mcap_ros2.decoder import DecoderFactory as McapDecoderFactory
 import pytest
 
-from twodisk_ros.io import read_recording
-from twodisk_ros.io.cdr_decode import DecoderFactory, compile_decoder
-from twodisk_ros.io.mcap_scan import reason_of, scan_mcap
+from twodisk_ros.recordings import read_recording
+from twodisk_ros.recordings.cdr_decode import DecoderFactory, compile_decoder
+from twodisk_ros.recordings.mcap_scan import reason_of, scan_mcap
 
 pytestmark = pytest.mark.ros
 REPO = Path(__file__).resolve().parents[1]

@@ -1,4 +1,4 @@
-"""Tests of twodisk_ros.io.cdr.serialize, the field-by-field CDR writer for any rclpy message.
+"""Tests of twodisk_ros.recordings.cdr.serialize, the field-by-field CDR writer for any rclpy message.
 
 Each message is checked against: a scalar reference writer written here, which walks the type
 *strings* of ``get_fields_and_field_types()`` (not the ``SLOT_TYPES`` that ``serialize`` walks)
@@ -43,7 +43,7 @@ from unique_identifier_msgs.msg import UUID  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray, MeshFile, UVCoordinate  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
-from twodisk_ros.io import cdr, msgdefs  # noqa: E402
+from twodisk_ros.recordings import cdr, msgdefs  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 
 serialize_message = rclpy_serialization.serialize_message
@@ -386,7 +386,7 @@ def test_duck_typed_message_and_unsupported_types():
 @pytest.mark.parametrize('length', range(10))
 def test_node_markers_encoded_from_arrays_as_the_generic_serializer(length):
     """io/cdr_markers (the node's fast path) against serialize() of the same rclpy markers."""
-    from twodisk_ros.io.cdr_markers import encode_markers
+    from twodisk_ros.recordings.cdr_markers import encode_markers
     frame = 'abcdefghi'[:length]
     s = np.linspace(0.0, 2 * np.pi, 5 + 7 * length)
     disk1 = np.stack([np.sin(s), -0.5 - np.cos(s), 0 * s], -1)

@@ -1,4 +1,4 @@
-"""Tests of twodisk_ros.io.cdr_schema: layouts derived from the .msg definitions.
+"""Tests of twodisk_ros.recordings.cdr_schema: layouts derived from the .msg definitions.
 
 For every message of ``test_cdr_generic`` (markers, diagnostics, and the other types: fixed
 arrays, bounded and unbounded sequences of primitives, strings and messages, bool, octet,
@@ -34,7 +34,7 @@ from visualization_msgs.msg import MarkerArray  # noqa: E402
 
 from test_cdr_generic import (OTHER, SETTINGS, check, headers, markers,  # noqa: E402
                               small_lists, statuses)
-from twodisk_ros.io import cdr_schema, msgdefs  # noqa: E402
+from twodisk_ros.recordings import cdr_schema, msgdefs  # noqa: E402
 
 pytestmark = pytest.mark.ros
 _PRIMITIVE = {'boolean', 'octet', 'char', 'int8', 'uint8', 'int16', 'uint16', 'int32', 'uint32',

@@ -1,4 +1,4 @@
-"""Tests of the /tf and /clock encoders of twodisk_ros.io.cdr, byte for byte.
+"""Tests of the /tf and /clock encoders of twodisk_ros.recordings.cdr, byte for byte.
 
 References: rosbags' Jazzy type store serializer (its own TFMessage and Clock definitions;
 zero padding, exact length), ``rclpy.serialization.serialize_message`` of the equivalent rclpy
@@ -26,7 +26,7 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 
 from cdr_helpers import mcap_decode  # noqa: E402
 from test_cdr import NS_MAX, NS_MIN, SETTINGS, check, frames, rows, stamps  # noqa: E402
-from twodisk_ros.io import cdr, msgdefs  # noqa: E402
+from twodisk_ros.recordings import cdr, msgdefs  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 
 try:

@@ -86,7 +86,7 @@ AS_A_PROCESS = 'oloid'
 @pytest.mark.parametrize('config', CONFIGS)
 def test_every_config_records_a_consistent_run(tmp_path, config, recordings, monkeypatch,
                                                capfd):
-    from twodisk_ros.inspect import inspect_recording
+    from twodisk_ros.inspector import inspect_recording
     params = ('--params-file', str(REPO / 'config' / f'{config}.yaml'), '-p', 'duration:=0.3')
     if config in SHARED:
         out, made = recordings(config, *SHARED[config], run=True)

@@ -59,7 +59,7 @@ def inspect_here(capsys):
     """The entry point's function in this process: (exit status, stdout, stderr). A test
     runs the real entry point (a subprocess) first; its further calls go through the same
     function here, without another interpreter start."""
-    from twodisk_ros.inspect.cli import main
+    from twodisk_ros.inspector.cli import main
 
     def run(*args):
         capsys.readouterr()

@@ -25,12 +25,12 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
-from twodisk_ros.inspect import cli as inspect_cli  # noqa: E402
-from twodisk_ros.inspect import finite_differences, inspect_recording  # noqa: E402
+from twodisk_ros.inspector import cli as inspect_cli  # noqa: E402
+from twodisk_ros.inspector import finite_differences, inspect_recording  # noqa: E402
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
-from twodisk_ros.io import McapRecorder, read_recording  # noqa: E402
+from twodisk_ros.recordings import McapRecorder, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 

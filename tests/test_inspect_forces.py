@@ -24,10 +24,10 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
-from twodisk_ros.inspect import cli as inspect_cli  # noqa: E402
-from twodisk_ros.inspect import inspect_recording  # noqa: E402
-from twodisk_ros.inspect.differences import finite_differences, second_differences  # noqa
-from twodisk_ros.io import McapRecorder  # noqa: E402
+from twodisk_ros.inspector import cli as inspect_cli  # noqa: E402
+from twodisk_ros.inspector import inspect_recording  # noqa: E402
+from twodisk_ros.inspector.differences import finite_differences, second_differences  # noqa
+from twodisk_ros.recordings import McapRecorder  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402

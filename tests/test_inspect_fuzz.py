@@ -32,8 +32,8 @@ from mcap.stream_reader import StreamReader  # noqa: E402
 from mcap.writer import CompressionType, Writer  # noqa: E402
 import pytest  # noqa: E402
 
-from twodisk_ros.inspect import cli as inspect_cli  # noqa: E402
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.inspector import cli as inspect_cli  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -262,7 +262,7 @@ def test_cached_models_give_the_results_of_fresh_ones(tmp_path, original):
     """Inspecting two bodies alternately (the models cached by their parameters) reports
     exactly what inspecting each with nothing cached reports: the shared models are not
     changed by an inspection; and the second inspection of a body reuses its model."""
-    from twodisk_ros.inspect import model as model_module
+    from twodisk_ros.inspector import model as model_module
     other = rewrite(original, metadata={'b': '0.08', 'mass': '2.0'})
     paths = []
     for name, data in (('a.mcap', original), ('b.mcap', other)):

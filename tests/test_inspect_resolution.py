@@ -29,8 +29,8 @@ import pytest
 
 from test_inspect import OLOID, simulate_run as simulate_oloid, write_run as write_oloid
 from test_inspect_forces import write_run
-from twodisk_ros.inspect import inspect_recording
-from twodisk_ros.inspect.resolution import CAP, UNRESOLVED
+from twodisk_ros.inspector import inspect_recording
+from twodisk_ros.inspector.resolution import CAP, UNRESOLVED
 from twodisk_ros.run.parameters import RollerSettings
 from twodisk_ros.run.simulation import Simulation
 
@@ -204,7 +204,7 @@ def test_a_recording_too_short_for_the_stencils_says_so(tmp_path, capsys, sample
     against its first row), energy_balance 3. Fewer: "not evaluated ... too short", a FAIL
     with its reason, never a PASS on one row and never a crash of the report (before: the
     check's detail was None and twodisk-inspect raised AttributeError in its report)."""
-    from twodisk_ros.inspect import cli
+    from twodisk_ros.inspector import cli
     path, _ = record(tmp_path, 'short', (samples - 1) / 200.0, **dict(
         SQUARE, shape='ellipse', exponent=2.0, theta0=0.9, rate=200.0, **scene))
     check = {c.name: c for c in inspect_recording(path).checks}[name]

@@ -72,7 +72,7 @@ def _speed_check(inspection):
 
 
 def test_the_recorded_speed_follows_the_lag_rule(recording):
-    from twodisk_ros.inspect import inspect_recording
+    from twodisk_ros.inspector import inspect_recording
     check = _speed_check(inspect_recording(recording))
     assert check.passed, check.detail
     # the stretches: the start (held), three commands; the time-out's is free motion
@@ -85,7 +85,7 @@ def test_the_recorded_speed_follows_the_lag_rule(recording):
 @pytest.mark.parametrize('lag', [0.25, 0.1])
 def test_a_wrong_drive_lag_fails(recording, monkeypatch, lag):
     """The same poses checked against another T: the rule misses by ~|ΔΩ| (1/T − 1/T') t."""
-    from twodisk_ros.inspect import inspect_recording, inspection
+    from twodisk_ros.inspector import inspect_recording, inspection
     original = inspection.read_recording
 
     def with_lag(*args, **kwargs):

@@ -30,8 +30,8 @@ from rclpy.serialization import deserialize_message  # noqa: E402
 from std_msgs.msg import Header  # noqa: E402
 
 from test_inspect import OLOID, run_main, simulate_run, write_run  # noqa: E402
-from twodisk_ros.inspect import inspect_recording  # noqa: E402
-from twodisk_ros.io import McapRecorder, cdr, read_recording  # noqa: E402
+from twodisk_ros.inspector import inspect_recording  # noqa: E402
+from twodisk_ros.recordings import McapRecorder, cdr, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 TFMessage = tf2_msgs.TFMessage

@@ -61,7 +61,7 @@ def inspect_here(capsys):
     """The entry point's function in this process: (exit status, stdout, stderr). Each test
     runs the real entry point (a subprocess) first; its other readings of the same file go
     through the same function here, without a second interpreter start."""
-    from twodisk_ros.inspect.cli import main
+    from twodisk_ros.inspector.cli import main
 
     def run(path, *extra):
         capsys.readouterr()

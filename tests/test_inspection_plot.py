@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 
 from batch_recording import record
-from twodisk_ros.inspect import inspect_recording
-from twodisk_ros.io.reader import read_recording
+from twodisk_ros.inspector import inspect_recording
+from twodisk_ros.recordings.reader import read_recording
 from twodisk_ros.run.parameters import parse_recorded
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.model import palette
-from twodisk_ros.inspect.figure import align_zeros, inspection_figure, plot_inspection
+from twodisk_ros.inspector.figure import align_zeros, inspection_figure, plot_inspection
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RUNS = {

@@ -28,7 +28,7 @@ from rclpy.parameter import Parameter  # noqa: E402
 
 from rosgraph_msgs.msg import Clock  # noqa: E402
 
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.node.sim_clock import CLOCK_MAX_RATE, clock_step, encode_clock_column  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]

@@ -24,7 +24,7 @@ import time
 import pytest
 
 from roller_here import run_roller_main
-from twodisk_ros.io import read_recording
+from twodisk_ros.recordings import read_recording
 
 pytestmark = pytest.mark.ros
 

@@ -15,7 +15,7 @@ import math  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
 from twodisk_ros.physics.forces.validity import liftoff_speed  # noqa: E402

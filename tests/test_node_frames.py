@@ -346,7 +346,7 @@ def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
     transient local in their offered QoS; read by rosbags and by mcap-ros2-support."""
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
-    from twodisk_ros.io import read_recording
+    from twodisk_ros.recordings import read_recording
     target = tmp_path / 'frames.mcap'
     process = start_roller('-p', 'realtime:=false', '-p', 'duration:=2.0', '-p', 'rate:=100.0',
                            '-p', 'frame_id:=odom', '-p', 'body_frame:=oloid',

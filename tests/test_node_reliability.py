@@ -21,8 +21,8 @@ from hypothesis import given, HealthCheck, settings, strategies as st  # noqa: E
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from twodisk_ros.inspect import inspect_recording  # noqa: E402
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.inspector import inspect_recording  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 
 from roller_here import run_roller_main  # noqa: E402
 

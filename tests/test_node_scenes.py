@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from rounding import ulps  # noqa: E402
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.mass.models import laminae  # noqa: E402
 from twodisk_ros.physics.motion.simulate import MotionStream  # noqa: E402
@@ -366,7 +366,7 @@ def test_driven_from_a_second_node(tmp_path):
     assert [s for s, e in events if e == 'resume'][0] == t_ns[pause]
     assert abs(u[pause] - u[pause - 1] - 0.5 * (u_dot[pause] + u_dot[pause - 1]) * h) < 1e-4
     # the inspector checks each stretch on its own (no stencil across an event)
-    from twodisk_ros.inspect import inspect_recording
+    from twodisk_ros.inspector import inspect_recording
     inspection = inspect_recording(path)
     verdicts = {c.name: c.passed for c in inspection.checks}
     print({c.name: (c.passed, c.value, c.detail[:1]) for c in inspection.checks})

@@ -129,7 +129,7 @@ def test_a_bad_shape_at_run_time_is_refused_in_one_line(tmp_path):
 
 def checks_of(path):
     """{name: Check} of ``twodisk-inspect``'s checks of a recording (in process)."""
-    from twodisk_ros.inspect import inspect_recording
+    from twodisk_ros.inspector import inspect_recording
     return {check.name: check for check in inspect_recording(path).checks}
 
 
@@ -173,7 +173,7 @@ def test_a_recorded_run_of_another_shape_is_consistent(tmp_path, params, words, 
         checked = inspect(tmp_path / 'run.mcap', tmp_path)
         code, out, err = checked.returncode, checked.stdout, checked.stderr
     else:
-        from twodisk_ros.inspect.cli import main
+        from twodisk_ros.inspector.cli import main
         capfd.readouterr()
         code = main([str(tmp_path / 'run.mcap')])
         out, err = capfd.readouterr()

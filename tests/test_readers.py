@@ -24,7 +24,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from twodisk_ros.io import read_recording
+from twodisk_ros.recordings import read_recording
 
 pytestmark = pytest.mark.ros
 REPO = Path(__file__).resolve().parents[1]

@@ -38,8 +38,8 @@ from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import ColorRGBA, Header  # noqa: E402
 from visualization_msgs.msg import Marker, MarkerArray  # noqa: E402
 
-from twodisk_ros.io import msgdefs, rosbag2_metadata, writer  # noqa: E402
-from twodisk_ros.io import McapRecorder, RecordingError, read_recording  # noqa: E402
+from twodisk_ros.recordings import msgdefs, rosbag2_metadata, writer  # noqa: E402
+from twodisk_ros.recordings import McapRecorder, RecordingError, read_recording  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -550,7 +550,7 @@ def test_truncated_files_keep_every_complete_chunk(tmp_path):
 KILLED_WRITER = textwrap.dedent("""
     import sys, time
     from geometry_msgs.msg import PoseStamped
-    from twodisk_ros.io import McapRecorder
+    from twodisk_ros.recordings import McapRecorder
 
     path, count, flush = sys.argv[1], int(sys.argv[2]), sys.argv[3] == 'flush'
     rec = McapRecorder(path, chunk_size=8192, metadata={'run': 'killed'})
@@ -623,7 +623,7 @@ def test_an_interrupt_while_the_recorder_opens_leaves_no_temporary_file(tmp_path
     """A signal's exception (KeyboardInterrupt here, StopNow in the node) that lands right
     after the hidden temporary file is created, or while the header is written, removes it:
     the directory holds only the old recording, byte for byte."""
-    from twodisk_ros.io import writer as writer_module
+    from twodisk_ros.recordings import writer as writer_module
     target = tmp_path / 'run.mcap'
     target.write_bytes(b'old recording')
 

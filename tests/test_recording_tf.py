@@ -36,7 +36,7 @@ from rosbags.highlevel import AnyReader  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
 from foxglove_helpers import foxglove_decode  # noqa: E402
-from twodisk_ros.io import McapRecorder, cdr, msgdefs, read_recording  # noqa: E402
+from twodisk_ros.recordings import McapRecorder, cdr, msgdefs, read_recording  # noqa: E402
 from twodisk_ros.node import messages  # noqa: E402
 
 TFMessage = tf2_msgs.TFMessage

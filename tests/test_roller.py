@@ -34,7 +34,7 @@ from visualization_msgs.msg import MarkerArray  # noqa: E402
 
 from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
 from twodisk_ros.physics.stability.equilibria import equilibria  # noqa: E402
-from twodisk_ros.io import read_recording  # noqa: E402
+from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.node.roller import Roller  # noqa: E402
 
 pytestmark = pytest.mark.ros

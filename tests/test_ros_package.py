@@ -196,7 +196,7 @@ def test_every_console_script_resolves(tmp_path, installed):
 
 
 def test_ros2_run_style_batch_with_params_file(tmp_path, installed):
-    from twodisk_ros.io import read_recording
+    from twodisk_ros.recordings import read_recording
     prefix, share, env = installed
     target = tmp_path / 'run.mcap'
     result = subprocess.run(

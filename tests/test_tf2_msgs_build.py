@@ -77,7 +77,7 @@ def test_type_hash_equals_jazzys():
     """Three hashes agree: rosbags' (its own Jazzy definitions), the installed type
     description (msgdefs.type_hash, what the recorder writes) and rclpy's publisher."""
     from rosbags.typesys import Stores, get_typestore
-    from twodisk_ros.io.msgdefs import type_hash
+    from twodisk_ros.recordings.msgdefs import type_hash
     rosbags_hash = get_typestore(Stores.ROS2_JAZZY).hash_rihs01(TYPE)
     assert rosbags_hash == JAZZY_HASH
     assert type_hash(TYPE) == rosbags_hash

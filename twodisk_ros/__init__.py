@@ -7,10 +7,10 @@ Folders are the architecture, in layers (README "Layout"; enforced by import-lin
 - :mod:`twodisk_ros.node` (the ``roller`` node, the only rclpy layer),
   :mod:`twodisk_ros.view` (``twodisk-view``), :mod:`twodisk_ros.sweep` (``twodisk-sweep``);
 - :mod:`twodisk_ros.plotting`: figures and animations (matplotlib);
-- :mod:`twodisk_ros.inspect`: ``twodisk-inspect``, the offline checks of a recording;
+- :mod:`twodisk_ros.inspector`: ``twodisk-inspect``, the offline checks of a recording;
   :mod:`twodisk_ros.runs`: runs to show;
 - :mod:`twodisk_ros.run`: the parameters, the body they describe and its simulation;
-- :mod:`twodisk_ros.io`: MCAP recordings in rosbag2's layout (writer and tolerant reader);
+- :mod:`twodisk_ros.recordings`: MCAP recordings in rosbag2's layout (writer and tolerant reader);
   :mod:`twodisk_ros.model`: the body as a robot description (frames, meshes, URDF);
 - :mod:`twodisk_ros.physics`: the bodies, their cycles, equilibria, mass models and dynamics
   (numpy/scipy only).

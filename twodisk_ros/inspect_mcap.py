@@ -1,8 +1,8 @@
-"""Entry point ``python -m twodisk_ros.inspect_mcap`` (see :mod:`twodisk_ros.inspect`)."""
+"""Entry point ``python -m twodisk_ros.inspect_mcap`` (see :mod:`twodisk_ros.inspector`)."""
 
 import sys
 
-from .inspect.cli import main
+from .inspector.cli import main
 
 if __name__ == '__main__':
     sys.exit(main())

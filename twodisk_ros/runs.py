@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from .io.errors import one_line
-from .io.reader import read_recording
+from .recordings.errors import one_line
+from .recordings.reader import read_recording
 from .model.frames import disk_rims
 from .model.outline import DEFAULT_TOLERANCE
 from .run.parameters import BY_NAME, DEFAULTS
@@ -262,7 +262,7 @@ def recorded_run(path):
 
     Raises :class:`RunError` (one line) if the file cannot be read or holds no run.
     """
-    from .io.errors import RecordingError
+    from .recordings.errors import RecordingError
     try:
         recording = read_recording(path, decode=lambda topic: _topic_role(topic) in _ROLES)
     except RecordingError as error:

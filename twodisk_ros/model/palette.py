@@ -2,7 +2,7 @@
 
 Contact A and disk 1 are blue, contact B and disk 2 orange, the contact line AB green, the
 centre of mass G near-black, in the PNG figures (:mod:`~twodisk_ros.plotting.figures`,
-:mod:`~twodisk_ros.inspect.figure`), the animations
+:mod:`~twodisk_ros.inspector.figure`), the animations
 (:mod:`~twodisk_ros.plotting.animation`) and the RViz/Foxglove markers
 (:mod:`twodisk_ros.node.messages`, which must not import matplotlib: hence no matplotlib
 here, and :func:`rgb` to turn a colour into the 0..1 floats of ``std_msgs/ColorRGBA``).

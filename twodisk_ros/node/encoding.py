@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..io import cdr
+from ..recordings import cdr
 from . import messages, sim_clock
 from .frames_publisher import TF_TOPIC
 

@@ -30,7 +30,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile
 from std_msgs.msg import String
 from tf2_msgs.msg import TFMessage
 
-from ..io import cdr
+from ..recordings import cdr
 from ..model.frames import disk_frames
 from ..model.urdf import body_description, robot_description
 from ..outputs import OutputError

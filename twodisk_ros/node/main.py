@@ -15,8 +15,8 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.signals import SignalHandlerOptions
 
-from ..io import RecordingError, RecordingExistsError
-from ..io.errors import one_line
+from ..recordings import RecordingError, RecordingExistsError
+from ..recordings.errors import one_line
 from .arguments import ArgumentError, check_arguments, rclpy_type_hint
 from .stop import StopNow, StopRequest
 from .usage import early_exit

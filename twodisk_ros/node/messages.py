@@ -15,7 +15,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA, Header
 from visualization_msgs.msg import Marker, MarkerArray
 
-from ..io.cdr_markers import MarkerSpec
+from ..recordings.cdr_markers import MarkerSpec
 from ..model import palette
 
 JOINT_NAMES = ['theta', 'psi', 'phase']
@@ -65,7 +65,7 @@ def path(frame_id, time_ns, poses):
 
 
 def marker(frame_id, time_ns, spec):
-    """A ``visualization_msgs/Marker`` from a :class:`~twodisk_ros.io.cdr_markers.MarkerSpec`."""
+    """A ``visualization_msgs/Marker`` from a :class:`~twodisk_ros.recordings.cdr_markers.MarkerSpec`."""
     result = Marker(header=header(frame_id, time_ns), ns=spec.ns, id=spec.id, type=spec.type,
                     action=spec.action)
     result.pose.orientation.w = 1.0

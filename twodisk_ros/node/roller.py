@@ -11,7 +11,7 @@ the simulated time on ``/clock`` (:mod:`~twodisk_ros.node.sim_clock`).
 Run: ``ros2 run twodisk_ros roller --ros-args --params-file config/oloid.yaml``.
 
 States are computed in blocks ahead of time and encoded to CDR in one vectorised step
-(:mod:`twodisk_ros.io.cdr`); the per-sample work is handing bytes to DDS and to the recorder.
+(:mod:`twodisk_ros.recordings.cdr`); the per-sample work is handing bytes to DDS and to the recorder.
 """
 
 from collections import deque
@@ -32,8 +32,8 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
 
 from .. import __version__
-from ..io import McapRecorder, cdr
-from ..io.cdr_markers import encode_markers
+from ..recordings import McapRecorder, cdr
+from ..recordings.cdr_markers import encode_markers
 from ..outputs import check_output
 from ..physics.motion.startup import startup_estimate
 from ..run import schedule
@@ -73,7 +73,7 @@ class Roller(Node):
     """Publishes the rolling body; the physics lives in :class:`Simulation`.
 
     Raises ValueError or RuntimeError (one line) if the parameters define no valid run,
-    and :class:`~twodisk_ros.io.RecordingError` if the record file cannot be written.
+    and :class:`~twodisk_ros.recordings.RecordingError` if the record file cannot be written.
     """
 
     def __init__(self, **kwargs):

@@ -32,7 +32,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64, String
 from std_srvs.srv import Empty, SetBool
 
-from ..io import cdr
+from ..recordings import cdr
 from ..run.scene_simulation import SPEED_LIMIT, TORQUE_LIMIT
 from ..physics.scenes.scene import command_error
 

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
-from ..io import cdr
+from ..recordings import cdr
 
 __all__ = ['CLOCK_MAX_RATE', 'CLOCK_QOS', 'CLOCK_TOPIC', 'USE_SIM_TIME', 'check_use_sim_time', 'clock_step',
            'encode_clock_column']

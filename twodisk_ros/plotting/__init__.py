@@ -1,5 +1,5 @@
 """The package's figures and animations (matplotlib), in the colours of
-:mod:`twodisk_ros.model.palette`; the inspector draws its own (:mod:`twodisk_ros.inspect.figure`).
+:mod:`twodisk_ros.model.palette`; the inspector draws its own (:mod:`twodisk_ros.inspector.figure`).
 
 - :mod:`~twodisk_ros.plotting.figures`: the paper's figures, height of G, stability map;
 - :mod:`~twodisk_ros.plotting.contact_forces`: contact forces over a cycle and against speed;

@@ -35,7 +35,7 @@ import sys
 
 from ..limits import LimitError, check_memory, describe_bytes
 from ..outputs import OutputError, check_output, replacing
-from ..io.errors import one_line
+from ..recordings.errors import one_line
 
 __all__ = ['main', 'estimate_memory', 'MAX_FRAMES', 'MAX_SIMULATED_SECONDS']
 

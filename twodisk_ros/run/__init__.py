@@ -1,7 +1,7 @@
 """The run: its parameters, the body they describe, and its simulation, below the node.
 
 ROS-free (no rclpy): the node (:mod:`twodisk_ros.node`), the inspector
-(:mod:`~twodisk_ros.inspect.model`), the viewer, the sweeps and the animation read it, so
+(:mod:`~twodisk_ros.inspector.model`), the viewer, the sweeps and the animation read it, so
 that they all build the same body from the same settings.
 
 - :mod:`~twodisk_ros.run.parameters`: the parameter contract (names, types, units, ranges);

@@ -1,7 +1,7 @@
 """The description of a run: checked settings → lamina, body, mass model, dynamics, motion.
 
 Read by the node (:class:`~twodisk_ros.run.simulation.Simulation`, the start-up estimate),
-the inspector (:func:`~twodisk_ros.inspect.model.build_model`) and the tools that rebuild a
+the inspector (:func:`~twodisk_ros.inspector.model.build_model`) and the tools that rebuild a
 run from its parameters, so that every reader builds the same body:
 
 - ``shape`` ellipse: :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (a, b, delta), the closed

@@ -21,7 +21,7 @@ import signal
 import sys
 import threading
 
-from ..io.errors import one_line
+from ..recordings.errors import one_line
 
 __all__ = ['DEFAULT_PORT', 'EPILOG', 'MAX_RATE', 'MAX_SPEED', 'main']
 

@@ -1,22 +1,22 @@
 """Writing MCAP recordings laid out as rosbag2 (ROS 2 Jazzy, mcap storage plugin) writes them.
 
 No rosbag2 is needed: messages arrive as CDR bytes (``rclpy.serialization`` or
-:mod:`twodisk_ros.io.cdr`) and are written with the ``mcap`` library. What makes the file a
+:mod:`twodisk_ros.recordings.cdr`) and are written with the ``mcap`` library. What makes the file a
 rosbag2 file is copied from the Jazzy sources:
 
 - header profile ``ros2``; one schema per type, named ``pkg/msg/Type``, encoding ``ros2msg``,
-  holding the full definition text (see :mod:`twodisk_ros.io.msgdefs`);
+  holding the full definition text (see :mod:`twodisk_ros.recordings.msgdefs`);
 - one channel per topic, message encoding ``cdr``, metadata ``offered_qos_profiles`` (the QoS
   list as YAML, metadata version 9) and ``topic_type_hash``;
 - a metadata record ``rosbag2`` with key ``serialized_metadata`` (the YAML bag metadata,
-  :mod:`twodisk_ros.io.rosbag2_metadata`), written when the file is opened and again, final,
+  :mod:`twodisk_ros.recordings.rosbag2_metadata`), written when the file is opened and again, final,
   when it is closed;
 - chunked data with chunk and message indexes, statistics and summary offsets.
 
 Times are integer nanoseconds; a message's log time and publish time are both its stamp.
 Each chunk is handed to the operating system as soon as it is complete, so a process that is
 killed leaves every message before its last, unfinished chunk readable by
-:func:`twodisk_ros.io.reader.read_recording`.
+:func:`twodisk_ros.recordings.reader.read_recording`.
 
 The file is written under a hidden temporary name beside it (``.run.1a2b3c4d.partial.mcap``)
 and takes its own name when its first message is on disk (the chunk holding it is ended at

@@ -2,7 +2,7 @@
 
 Summary and checks of a recording, and its states as a table.
 
-Exit status (:mod:`twodisk_ros.inspect.status`): 0 PASS (every check passes and the run is
+Exit status (:mod:`twodisk_ros.inspector.status`): 0 PASS (every check passes and the run is
 all there), 1 FAIL (a check fails), 4 INCOMPLETE (every check passes on the recovered part,
 but the file is cut or damaged), 2 the file cannot be read, an output is refused (an existing
 file without ``--overwrite``, a wrong suffix, a missing directory) or cannot be written (one
@@ -15,7 +15,7 @@ import os
 import sys
 import warnings
 
-from ..io.errors import RecordingError, one_line
+from ..recordings.errors import RecordingError, one_line
 from ..outputs import OutputError, check_output, replacing
 from .status import EXIT_UNUSABLE, PROG
 

@@ -9,13 +9,13 @@ and the message ends after its last field (``serialize_message`` of a JointState
 ``effort`` appends 4 bytes of padding past it, which rosbags rejects as a size mismatch).
 
 All messages of a batch share one frame id, hence one length and one layout
-(:class:`~twodisk_ros.io.cdr_layout.Layout`): a template row holds the constant bytes (header,
+(:class:`~twodisk_ros.recordings.cdr_layout.Layout`): a template row holds the constant bytes (header,
 string lengths, zero padding), and the numeric columns of an ``(n, L)`` ``uint8`` array are
 filled through ``float64``/``int32`` views.  The layouts are derived from the installed
-``.msg`` definitions (:func:`~twodisk_ros.io.cdr_schema.message_layout`, cached), not written
+``.msg`` definitions (:func:`~twodisk_ros.recordings.cdr_schema.message_layout`, cached), not written
 by hand: each encoder only names its batch constants (frame ids, joint names) and columns.
 
-``serialize`` (:mod:`~twodisk_ros.io.cdr_generic`) encodes any other rclpy message object
+``serialize`` (:mod:`~twodisk_ros.recordings.cdr_generic`) encodes any other rclpy message object
 (MarkerArray, DiagnosticArray, ...) one field at a time, with the same guarantees.
 
 Stamps are integer nanoseconds (``int64``), converted exactly as

@@ -2,7 +2,7 @@
 
 Walks the generated class's introspection data (``SLOT_TYPES``, ``rosidl_parser`` definitions
 matched by class name, so rclpy itself is not imported) with the guarantees of
-:mod:`twodisk_ros.io.cdr`: zero padding, nothing after the last field.
+:mod:`twodisk_ros.recordings.cdr`: zero padding, nothing after the last field.
 """
 
 import struct

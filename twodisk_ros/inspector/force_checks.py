@@ -8,8 +8,8 @@ so, and shows the lift-off the poses imply, for information). W = M g is the for
 
 ``contact_forces``
     The ground forces are recomputed from the recorded poses alone (Newton–Euler,
-    :func:`~twodisk_ros.inspect.forces.newton_euler`): a_G and ω̇ by fourth-order central
-    second differences (:func:`~twodisk_ros.inspect.differences.second_differences`),
+    :func:`~twodisk_ros.inspector.forces.newton_euler`): a_G and ω̇ by fourth-order central
+    second differences (:func:`~twodisk_ros.inspector.differences.second_differences`),
     recorded contact points and mass model. Compared with the recorded wrenches at the same
     samples: |ΣF_rec − ΣF|, and the determinate components |ΔN_A|, |ΔN_B|, |ΔT_A|, |ΔT_B|
     (perpendicular to AB; the total along AB is in ΣF), max over samples, / W. The split along

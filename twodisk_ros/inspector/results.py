@@ -1,5 +1,5 @@
 """The results of an inspection: checks with values and tolerances, the verdict
-(:mod:`~twodisk_ros.inspect.status`), the report.
+(:mod:`~twodisk_ros.inspector.status`), the report.
 """
 
 from dataclasses import dataclass, field
@@ -61,14 +61,14 @@ class Inspection:
     ----------
     summary : dict
         JSON-ready: file, truncation, duration, topics, parameters, samples, and ``run``
-        (:func:`~twodisk_ros.inspect.completeness.run_completeness`: the share of the run
+        (:func:`~twodisk_ros.inspector.completeness.run_completeness`: the share of the run
         recovered).
     checks : list of Check
     series : dict of str to numpy.ndarray
-        Time series for :func:`twodisk_ros.inspect.figure.plot_inspection` (times in s
+        Time series for :func:`twodisk_ros.inspector.figure.plot_inspection` (times in s
         from the first stamp).
     samples : Samples or None
-        The joined samples (:func:`~twodisk_ros.inspect.series.join_samples`).
+        The joined samples (:func:`~twodisk_ros.inspector.series.join_samples`).
     sources : dict of str to Series
         The recorded series by role (``'pose'``, ``'wrench_a'``, ...), for the export.
     """

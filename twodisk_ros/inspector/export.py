@@ -1,7 +1,7 @@
 """The recorded states as a table: ``twodisk-inspect run.mcap --csv states.csv --npz states.npz``.
 
 One row per sample: the stamps shared by pose, both contacts and the rolling state (the
-samples the checks use, :func:`~twodisk_ros.inspect.series.join_samples`; at a stamp recorded
+samples the checks use, :func:`~twodisk_ros.inspector.series.join_samples`; at a stamp recorded
 twice the first message counts).  The values are the recorded ones, unchanged (the
 quaternion as recorded, not normalised).  Columns (:data:`COLUMNS`), SI units:
 
@@ -61,7 +61,7 @@ def state_table(inspection):
     Parameters
     ----------
     inspection : Inspection
-        From :func:`~twodisk_ros.inspect.inspect_recording`.
+        From :func:`~twodisk_ros.inspector.inspect_recording`.
 
     Returns
     -------

@@ -2,7 +2,7 @@
 
 ``PASS`` (0)
     every check passes and the run is all there (a run stopped early by a signal, whose file
-    the node closed, is all there: :mod:`~twodisk_ros.inspect.completeness`);
+    the node closed, is all there: :mod:`~twodisk_ros.inspector.completeness`);
 ``FAIL`` (1)
     a check fails (whatever else: it takes precedence);
 ``INCOMPLETE`` (4)

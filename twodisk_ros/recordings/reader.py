@@ -1,8 +1,8 @@
 """Reading MCAP recordings (rosbag2 layout), tolerant of cut and damaged files.
 
-The records are found by :func:`twodisk_ros.io.mcap_scan.scan_mcap` (its docstring states the
+The records are found by :func:`twodisk_ros.recordings.mcap_scan.scan_mcap` (its docstring states the
 recovery rule); here they become decoded messages, channels and metadata.  Messages are
-decoded by :mod:`twodisk_ros.io.cdr_decode`: what ``mcap_ros2`` returns, faster.
+decoded by :mod:`twodisk_ros.recordings.cdr_decode`: what ``mcap_ros2`` returns, faster.
 
 Needs only ``mcap`` and ``mcap-ros2-support``: no rclpy, so recordings are read and checked
 offline on any machine.
@@ -86,7 +86,7 @@ class Recording:
     damage : list of str
         One line per damaged part of the file that was skipped (a chunk that does not
         decompress or fails its CRC, a record whose fields do not fit, lost framing, CRC
-        mismatches of the data section or summary; see :mod:`twodisk_ros.io.mcap_scan` for
+        mismatches of the data section or summary; see :mod:`twodisk_ros.recordings.mcap_scan` for
         the recovery rule).  Empty for an intact (possibly truncated) file.
     undecodable : dict of str to tuple of (int, str)
         Messages that could not be decoded, by topic: their count and the first reason.
@@ -147,7 +147,7 @@ def read_recording(path, *, decode=None) -> Recording:
         Messages decoded with ``mcap_ros2``, metadata records and channels.  A file without
         footer (writer killed) gives ``truncated=True`` and every message of its complete
         chunks; damaged parts are skipped and listed in ``damage`` (the recovery rule is
-        that of :mod:`twodisk_ros.io.mcap_scan`); messages that do not decode are counted in
+        that of :mod:`twodisk_ros.recordings.mcap_scan`); messages that do not decode are counted in
         ``undecodable``.  The file is read into memory, which suits recordings of simulation
         runs.
 
@@ -196,7 +196,7 @@ def collector_paused():
     of the 2.9 s that decoding a 15 s, 1 kHz recording took (Python 3.11).  Paused, it walks
     the messages that outlive the pause a few times once it runs again (a read of that
     recording followed by a pass over its messages: 30 % less time than without the pause),
-    and never those freed before (:func:`~twodisk_ros.inspect.inspection.inspect_recording`
+    and never those freed before (:func:`~twodisk_ros.inspector.inspection.inspect_recording`
     keeps it paused until it has dropped them).  Nested and concurrent pauses share one; the
     collector is enabled again, if it was, when the last one ends.
     """

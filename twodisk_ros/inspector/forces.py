@@ -131,7 +131,7 @@ def exact_components(model, phase, phase_rate, phase_acceleration=None):
     Dynamic mode: the free motion through (u, u̇); kinematic mode: the drive holding
     |ω| = |omega0|; with ``phase_acceleration`` ü (rad/s², a scene's), the forces on flat
     ground that this ü needs (in the frame of the model's poses: for the FD error).
-    ``model`` is a :class:`~twodisk_ros.inspect.model.RecordedModel`.
+    ``model`` is a :class:`~twodisk_ros.inspector.model.RecordedModel`.
     """
     forces_model = model.forces
     if phase_acceleration is not None:

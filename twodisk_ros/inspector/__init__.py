@@ -1,16 +1,16 @@
 """``twodisk-inspect``: offline checks of a ``roller`` recording (no rclpy needed).
 
-- :mod:`~twodisk_ros.inspect.series`: messages → time series and joined samples;
-- :mod:`~twodisk_ros.inspect.model`: the body the recorded parameters describe;
-- :mod:`~twodisk_ros.inspect.differences`: velocities and accelerations of the recorded poses;
-- :mod:`~twodisk_ros.inspect.checks`: the checks and their tolerances;
-- :mod:`~twodisk_ros.inspect.forces`, :mod:`~twodisk_ros.inspect.force_checks`: contact forces
+- :mod:`~twodisk_ros.inspector.series`: messages → time series and joined samples;
+- :mod:`~twodisk_ros.inspector.model`: the body the recorded parameters describe;
+- :mod:`~twodisk_ros.inspector.differences`: velocities and accelerations of the recorded poses;
+- :mod:`~twodisk_ros.inspector.checks`: the checks and their tolerances;
+- :mod:`~twodisk_ros.inspector.forces`, :mod:`~twodisk_ros.inspector.force_checks`: contact forces
   from the poses (Newton–Euler) against the recorded wrenches, and the model's validity;
-- :mod:`~twodisk_ros.inspect.tf_check`: the body frame on /tf against the poses, bit for bit;
-- :mod:`~twodisk_ros.inspect.inspection`: :func:`inspect_recording`;
-- :mod:`~twodisk_ros.inspect.status`: the verdicts and the exit status of each;
-- :mod:`~twodisk_ros.inspect.report`, :mod:`~twodisk_ros.inspect.figure`,
-  :mod:`~twodisk_ros.inspect.export`, :mod:`~twodisk_ros.inspect.cli`: the report, the figure
+- :mod:`~twodisk_ros.inspector.tf_check`: the body frame on /tf against the poses, bit for bit;
+- :mod:`~twodisk_ros.inspector.inspection`: :func:`inspect_recording`;
+- :mod:`~twodisk_ros.inspector.status`: the verdicts and the exit status of each;
+- :mod:`~twodisk_ros.inspector.report`, :mod:`~twodisk_ros.inspector.figure`,
+  :mod:`~twodisk_ros.inspector.export`, :mod:`~twodisk_ros.inspector.cli`: the report, the figure
   (``--plot``, matplotlib), the exported states, the command line.
 """
 

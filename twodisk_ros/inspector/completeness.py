@@ -52,7 +52,7 @@ def run_completeness(recording, parameters, sample_t, diagnostics_count):
 
     Parameters
     ----------
-    recording : twodisk_ros.io.Recording
+    recording : twodisk_ros.recordings.Recording
         The file read (``truncated``, ``damage``).
     parameters : dict of str to str
         The ``twodisk_ros`` metadata (``duration`` s, ``rate`` Hz).

@@ -3,9 +3,9 @@
 The node's markers (disk outlines and fills, the contact line, force arrows) are plain
 geometry: a few hundred points each. Building them as rclpy objects costs a Python object
 per point; here the array is laid out from its message definitions
-(:func:`~twodisk_ros.io.cdr_schema.message_layout`: zero padding, exact length) and each
+(:func:`~twodisk_ros.recordings.cdr_schema.message_layout`: zero padding, exact length) and each
 marker's points are written as one float64 block. The result is checked byte for byte against
-:func:`twodisk_ros.io.cdr_generic.serialize` of the same markers in the tests. Only numpy and
+:func:`twodisk_ros.recordings.cdr_generic.serialize` of the same markers in the tests. Only numpy and
 the standard library are imported.
 """
 

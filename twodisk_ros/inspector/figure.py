@@ -2,7 +2,7 @@
 drift of the motion's invariant and, for recordings with contact forces, N_A, N_B and
 μ_required, with the stretches outside the rolling model shaded.
 
-Kept apart from :mod:`twodisk_ros.inspect` so that the checks never import matplotlib.
+Kept apart from :mod:`twodisk_ros.inspector` so that the checks never import matplotlib.
 """
 
 import math
@@ -259,7 +259,7 @@ def _recorded_state(inspection):
     from the file (only that topic is decoded); any failure gives None (no drift drawn).
     """
     from .series import select_topics, extract_series, topic_role
-    from ..io.reader import read_recording
+    from ..recordings.reader import read_recording
     try:
         recording = read_recording(inspection.summary['file'],
                                    decode=lambda topic: topic_role(topic) == 'rolling_state')
@@ -367,7 +367,7 @@ def _shade(axes, stretches, data):
     """Shade the samples outside the rolling model, half a sample step around each run.
 
     Lift-off (N_A < 0 or N_B < 0) in one colour, slip with both contacts down (μ_required >
-    μ) in another, as :func:`~twodisk_ros.inspect.forces.invalid_stretches` classifies the
+    μ) in another, as :func:`~twodisk_ros.inspector.forces.invalid_stretches` classifies the
     samples. Returns one patch per kind drawn (for a legend).
     """
     if not stretches:

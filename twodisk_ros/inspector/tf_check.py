@@ -166,7 +166,7 @@ def tf_check(recording, series, parameters, t0_ns=0):
 
     Parameters
     ----------
-    recording : twodisk_ros.io.Recording
+    recording : twodisk_ros.recordings.Recording
         Read with /tf and /tf_static decoded (:func:`reads_topic`).
     series : dict of str to Series
         The pose series (role ``'pose'``): stamps, ``position``, ``quaternion``.

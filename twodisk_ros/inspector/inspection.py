@@ -1,25 +1,25 @@
 """``inspect_recording``: read a recording, join its samples, run the checks, summarise.
 
 ``twodisk-inspect FILE.mcap [--json] [--plot PNG]`` (or ``python -m twodisk_ros.inspect_mcap``)
-reads an MCAP file written by the node (:mod:`twodisk_ros.io`), summarises it (topics,
+reads an MCAP file written by the node (:mod:`twodisk_ros.recordings`), summarises it (topics,
 types, counts, duration, rates, recorded parameters) and runs the checks of
-:mod:`twodisk_ros.inspect.checks`. A truncated file (writer killed, no footer) is checked
+:mod:`twodisk_ros.inspector.checks`. A truncated file (writer killed, no footer) is checked
 on the part that was recovered; the report says how many messages and bytes that is.  A
 damaged file (corrupt chunks, CRC mismatches, lost framing: see
-:mod:`twodisk_ros.io.mcap_scan` for what is skipped) is checked on what could be read, and
+:mod:`twodisk_ros.recordings.mcap_scan` for what is skipped) is checked on what could be read, and
 the damage, with messages that do not decode, are problems of the ``inputs`` check.  A file
 from which no channel, message or metadata can be read is not a recording
 (:class:`RecordingError`).  How much of the *run* was recovered (samples against ``duration``
-× ``rate``) is ``summary['run']`` (:mod:`twodisk_ros.inspect.completeness`); with it the
-checks give the verdict PASS, FAIL or INCOMPLETE (:mod:`twodisk_ros.inspect.results`).
-The body frame on ``/tf`` is checked against the poses by :mod:`twodisk_ros.inspect.tf_check`
+× ``rate``) is ``summary['run']`` (:mod:`twodisk_ros.inspector.completeness`); with it the
+checks give the verdict PASS, FAIL or INCOMPLETE (:mod:`twodisk_ros.inspector.results`).
+The body frame on ``/tf`` is checked against the poses by :mod:`twodisk_ros.inspector.tf_check`
 (not applicable to recordings without /tf).
 """
 
 import numpy as np
 
-from ..io import RecordingError, read_recording
-from ..io.reader import collector_paused
+from ..recordings import RecordingError, read_recording
+from ..recordings.reader import collector_paused
 from .checks import run_checks
 from .completeness import run_completeness
 from .differences import kinetic_energy
@@ -126,7 +126,7 @@ def inspect_recording(path):
         If the file cannot be read at all (missing, a directory, not MCAP, damaged).
 
     The cyclic garbage collector is paused meanwhile
-    (:func:`~twodisk_ros.io.reader.collector_paused`): the messages make no cycles, they are
+    (:func:`~twodisk_ros.recordings.reader.collector_paused`): the messages make no cycles, they are
     freed when this returns, and with the collector on its full collections walked them all
     repeatedly (2 of 6 s for a 15 s, 1 kHz recording).
     """

@@ -2,8 +2,8 @@
 
 :func:`message_layout` reads a type's ``.msg`` file (and, recursively, those of its field
 types) from the share directories of the installed ROS packages
-(:func:`~twodisk_ros.io.msgdefs.definition_text`), and lays the message out in CDR (XCDR1,
-little endian, the rules of :mod:`~twodisk_ros.io.cdr_layout`) with:
+(:func:`~twodisk_ros.recordings.msgdefs.definition_text`), and lays the message out in CDR (XCDR1,
+little endian, the rules of :mod:`~twodisk_ros.recordings.cdr_layout`) with:
 
 - ``constants``: fields whose value is the same for a whole batch, by dotted path
   (``'header.frame_id'``, ``'name'`` for JointState's joint names,
@@ -216,7 +216,7 @@ def _frozen(table):
 
 
 def message_layout(type_name, constants=None, counts=None, start=None):
-    """The :class:`~twodisk_ros.io.cdr_layout.Layout` of a message type (cached).
+    """The :class:`~twodisk_ros.recordings.cdr_layout.Layout` of a message type (cached).
 
     Parameters
     ----------

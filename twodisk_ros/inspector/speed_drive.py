@@ -7,7 +7,7 @@ by the documented first-order lag (README "Scenes", node/scene_control.py)
 
 from any time t_r of a stretch on which the command does not change (the law is the same
 from any of its points). The stretches are those of the node's events
-(:func:`~twodisk_ros.inspect.balance.scene_timeline`): a stretch under the speed drive with
+(:func:`~twodisk_ros.inspector.balance.scene_timeline`): a stretch under the speed drive with
 a command (``command speed <value>``) follows that value; before the first command (and
 after a reset or a change of drive) the drive holds the speed it starts from, Ω_cmd = Ω(t_r);
 mode kinematic holds it throughout. T is ``drive_lag`` of the recorded parameters, with the
