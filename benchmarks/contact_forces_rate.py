@@ -11,7 +11,7 @@ import time
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics import RollingDynamics, simulate
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.physics.forces.contact import ContactForceModel
@@ -30,7 +30,7 @@ def best_of(function):
 
 
 def main():
-    body = TwoDiskBody.oloid(0.1)
+    body = EllipseBody.oloid(0.1)
     dynamics = RollingDynamics(body, mass_properties('laminae', 0.1, 0.1, 0.05, 1.0))
     start = time.perf_counter()
     model = ContactForceModel(dynamics)

@@ -9,7 +9,7 @@ side by side in one run, for the shapes of ``SHAPES``:
 * **poses**: ``RollingCycle.positions`` on 1e6 phases over three cycles, samples/s, best of
   ``REPEATS``; target ≥ 1e6/s;
 * **error** of those poses (fraction of the body's size): for the ellipse through the general
-  path, G against TwoDiskBody's closed-form cycle at the same pose (the closed body's phase of
+  path, G against EllipseBody's closed-form cycle at the same pose (the closed body's phase of
   the general body's θ and branch; phases within 0.05 rad of a turning point are left out,
   where θ ↦ u amplifies rounding as √), an independent construction of the same body; for the
   other shapes, A's ground trace against DOP853 integration of the trace equations (rtol 1e-13)
@@ -18,7 +18,7 @@ side by side in one run, for the shapes of ``SHAPES``:
 * **equilibria**: ``RollingDynamics(body, laminae 1 kg).equilibria_with_periods()`` (the
   certified search, stability, order and periods; the node's start and the sweep per body) in
   seconds, best of ``REPEATS`` on fresh dynamics objects (it is cached); target ≤ 1 s;
-* the same build and pose rate for TwoDiskBody itself (the closed forms), as the ratio.
+* the same build and pose rate for EllipseBody itself (the closed forms), as the ratio.
 
 Run: ``python benchmarks/general_shapes.py [--quick]``.
 """
@@ -36,7 +36,7 @@ if ROOT not in sys.path:
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace  # noqa: E402
 from twodisk_ros.physics.motion.dynamics import RollingDynamics  # noqa: E402
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse  # noqa: E402
@@ -115,7 +115,7 @@ def measure(quick=False, log=print):
         row = dict(name=name, text=text, build=build, resolution=cycle.resolution,
                    rate=samples / rate_wall, size=body.size, equilibria=equilibria_wall)
         if isinstance(lamina, Ellipse):
-            closed = TwoDiskBody(lamina.a, lamina.b, delta)
+            closed = EllipseBody(lamina.a, lamina.b, delta)
             closed_build, closed_cycle = _best(lambda: RollingCycle(closed), repeats)
             closed_wall, _ = _best(lambda: closed_cycle.positions(u), repeats)
             row.update(error=_matched_error(cycle, closed_cycle, u[::97], body.size),

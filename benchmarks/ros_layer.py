@@ -28,7 +28,7 @@ import setup_cost
 from targets import poses_throughput
 import view_rate
 
-from twodisk_ros.physics import RollingDynamics, TwoDiskBody, simulate
+from twodisk_ros.physics import RollingDynamics, EllipseBody, simulate
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.mass.models import clear_hull_cache, mass_properties, solid_hull
 
@@ -46,7 +46,7 @@ def _best(function, repeats=3):
 
 def contact_force_rate(states=10**6):
     """States per second of ContactForceModel.dynamic along a motion of the oloid (0.1 m)."""
-    body = TwoDiskBody.oloid(0.1)
+    body = EllipseBody.oloid(0.1)
     dynamics = RollingDynamics(body, mass_properties('laminae', 0.1, 0.1, 0.05, 1.0))
     build = _best(lambda: ContactForceModel(dynamics), repeats=2)
     model = ContactForceModel(dynamics)

@@ -53,7 +53,7 @@ from plot import work_precision_figure  # noqa: E402
 from report import write_report, TARGET_RATE, TARGET_POS_ERROR, TARGET_RATIO  # noqa: E402
 from reference import ReferenceBody  # noqa: E402
 
-from twodisk_ros import TwoDiskBody  # noqa: E402
+from twodisk_ros import EllipseBody  # noqa: E402
 from twodisk_ros.outputs import OutputError, check_output  # noqa: E402
 from twodisk_ros.physics.motion.simulate import CLOSED_FORM_SOLVERS  # noqa: E402
 import ros_layer  # noqa: E402
@@ -176,12 +176,12 @@ def findings(results, hours, builds, fd_errors, ratios, throughput):
                    'this machine, more than the ~0.5 ms the issue assumed; spans are short '
                    'accordingly.')
     # 4. body.size for b > a
-    tb = TwoDiskBody(1.0, 2.0, 0.5)
+    tb = EllipseBody(1.0, 2.0, 0.5)
     true_size = ReferenceBody(1.0, 2.0, 0.5).size
     if abs(tb.size - true_size) > 1e-9 * true_size:
-        out.append(f'Minor: `TwoDiskBody.size` is documented as "the largest distance of a '
+        out.append(f'Minor: `EllipseBody.size` is documented as "the largest distance of a '
                    f'disk point from G", but for b > a it returns hypot(b, Δ), which is smaller '
-                   f'when aΔ < b² − a²: TwoDiskBody(1, 2, 0.5).size = {tb.size:.6f} m, the '
+                   f'when aΔ < b² − a²: EllipseBody(1, 2, 0.5).size = {tb.size:.6f} m, the '
                    f'largest distance is {true_size:.6f} m (√(b² + Δ² + a²Δ²/(b² − a²))). '
                    'None of the benchmark bodies has b > a, so the numbers here are unaffected.')
     # 5. energy_drift in kinematic mode

@@ -34,7 +34,7 @@ if ROOT not in sys.path:
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody  # noqa: E402
+from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.physics.scenes.scene import Scene  # noqa: E402
 from twodisk_ros.physics.scenes.motion import SceneStream, scene_stream  # noqa: E402
@@ -72,7 +72,7 @@ def measure(quick=False, log=print):
     """The measurements (a dict): samples/s of every scene of :data:`SCENES` and the flat case."""
     repeats = 1 if quick else REPEATS
     duration = DURATION / 10 if quick else DURATION
-    dynamics = RollingDynamics(TwoDiskBody(*SHAPE), mass_properties('laminae', *SHAPE, 1.0))
+    dynamics = RollingDynamics(EllipseBody(*SHAPE), mass_properties('laminae', *SHAPE, 1.0))
     u0 = float(dynamics.body.phase_from_theta(0.3, 1))
     u_dot0 = dynamics.initial_phase_rate(u0, 3.0)
     t = np.arange(0.0, duration, 1.0 / RATE)

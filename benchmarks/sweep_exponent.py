@@ -8,7 +8,7 @@ work; the Dask overheads are sweep_rate.py's and sweep_scaling.py's), on the sam
 the representative map (b/a in [0.2, 3], Δ/a in [0.05, 0.95]), in tasks of the default chunk
 sizes (:data:`~twodisk_ros.sweep.request.DEFAULT_CHUNK_SIZE` bodies for n = 2,
 :data:`~twodisk_ros.sweep.request.GENERAL_CHUNK_SIZE` for n ≠ 2), with the general path's cost
-split by stage; beside them the per-body path on the ellipse's closed forms (TwoDiskBody, the
+split by stage; beside them the per-body path on the ellipse's closed forms (EllipseBody, the
 same stages as the general path without the lamina's contact solve). A body that fails is
 reported with its one line (e.g. while LaminaBody is not implemented); the rate counts only
 the bodies computed.
@@ -33,7 +33,7 @@ if __name__ == '__main__':
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.sweep.chunks import chunk_quantities  # noqa: E402
 from twodisk_ros.sweep.quantities import STAGES  # noqa: E402
@@ -54,7 +54,7 @@ def _grid(shape):
 
 def _ellipse_body(b, d, n):
     """The general path's body factory on the ellipse's closed forms (whatever n)."""
-    return TwoDiskBody(1.0, b, d)
+    return EllipseBody(1.0, b, d)
 
 
 def _ellipse_mass(model, body):
@@ -111,7 +111,7 @@ def report_lines(m):
     estimates = {'ellipse': CORE_SECONDS_PER_BODY, 'scalar': CORE_SECONDS_PER_BODY,
                  'general': GENERAL_CORE_SECONDS_PER_BODY}
     for key, label in (('ellipse', 'batched closed forms'),
-                       ('scalar', 'per body, TwoDiskBody (general path, closed forms)'),
+                       ('scalar', 'per body, EllipseBody (general path, closed forms)'),
                        ('general', 'per body, LaminaBody')):
         row = m[key]
         per_body = (f'{1e3 * row["per_body"]:.1f} ms' if row['computed'] else 'n/a')

@@ -10,7 +10,7 @@ import numpy as np
 from reference import ReferenceBody, ReferenceSolution
 from scenarios import BODIES, GRAVITY, MASS
 
-from twodisk_ros import RollingCycle, RollingDynamics, TwoDiskBody, simulate
+from twodisk_ros import RollingCycle, RollingDynamics, EllipseBody, simulate
 from twodisk_ros.physics.mass.models import laminae
 
 METHODS = ('direct', 'table')
@@ -25,7 +25,7 @@ class Built:
     """A body with its tables, and what building them cost."""
 
     name: str
-    body: TwoDiskBody
+    body: EllipseBody
     dynamics: RollingDynamics
     ref_body: ReferenceBody
     cycle_build: float      #: s, RollingCycle(body)
@@ -35,7 +35,7 @@ class Built:
 
 def build(name):
     a, b, d, _ = BODIES[name]
-    body = TwoDiskBody(a, b, d)
+    body = EllipseBody(a, b, d)
     mass = laminae(a, b, d, MASS)
     t0 = time.perf_counter()
     cycle = RollingCycle(body)

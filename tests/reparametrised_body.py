@@ -1,4 +1,4 @@
-"""A test double of the RollingBody protocol: a TwoDiskBody seen through another phase.
+"""A test double of the RollingBody protocol: a EllipseBody seen through another phase.
 
 ``ReparametrisedBody(body, kind)`` is the ellipse body ``body`` with its phase u replaced by
 u = g(v) (v the double's phase):
@@ -27,7 +27,7 @@ __all__ = ['ReparametrisedBody']
 
 
 class ReparametrisedBody(RollingBody):
-    """``base`` (a TwoDiskBody) with phase u = g(v); see the module docstring."""
+    """``base`` (a EllipseBody) with phase u = g(v); see the module docstring."""
 
     def __init__(self, base, kind='smooth', epsilon=0.3):
         if kind not in ('smooth', 'degenerate'):

@@ -182,15 +182,15 @@ SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'candidate'}
 #: The switches still in the package, each (module, what): the aim is none. Removing one
 #: shrinks this list; adding one fails the test.
 KNOWN_SWITCHES = sorted([
-    ('model/mesh.py', "isinstance ['TwoDiskBody']"),       # an ellipse's plates: closed-form rims
-    ('model/mesh.py', "isinstance ['TwoDiskBody']"),       # an ellipse's hull: its contact traces
+    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's plates: closed-form rims
+    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's hull: its contact traces
     ('physics/mass/models.py', "type() ['Ellipse']"),      # the ellipse's closed-form mass models
     ('physics/mass/models.py', 'hasattr(body, about)'),    # only a LaminaBody moves onto its mass
-    ('physics/motion/dynamics.py', "isinstance ['TwoDiskBody']"),   # (u, u̇) or (u, w)
+    ('physics/motion/dynamics.py', "isinstance ['EllipseBody']"),   # (u, u̇) or (u, w)
     ('physics/scenes/events.py', 'hasattr(stream, samples_at)'),    # a dense-output stream
     ('physics/scenes/motion.py', 'hasattr(solution, energy)'),
     ('physics/scenes/motion.py', 'hasattr(solution, state)'),
-    ('physics/stability/equilibria.py', "isinstance ['TwoDiskBody']"),  # closed-form roots
+    ('physics/stability/equilibria.py', "isinstance ['EllipseBody']"),  # closed-form roots
     ('run/scene_simulation.py', 'hasattr(stream, samples)'),       # MotionStream or a scene's
 ])
 
@@ -243,5 +243,5 @@ def test_type_switches_only_shrink():
     by type or by the attributes they happen to have: each kind answers for itself through
     its methods. The count is going to 0 (issue 29); those left are listed in
     KNOWN_SWITCHES, and a new one fails here."""
-    assert 'TwoDiskBody' in _kind_classes() and 'Ellipse' in _kind_classes()
+    assert 'EllipseBody' in _kind_classes() and 'Ellipse' in _kind_classes()
     assert type_switches() == KNOWN_SWITCHES

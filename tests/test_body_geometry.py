@@ -29,7 +29,7 @@ from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 
 # -- tolerances (all measured with the reference below; the margin is ~100x) ----------------
 #: ψ (rad) and unit vectors, interior points |η| ≤ 0.99 η_max of the hypothesis range
@@ -224,7 +224,7 @@ def _compare_geometry(body, ref, thetas, angle_atol, length_rtol):
 # -- closed forms against the construction ---------------------------------------------------
 @pytest.mark.parametrize('shape', NAMED)
 def test_closed_forms_named_bodies(shape):
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     assert_allclose(body.theta_max, ref.theta_max, rtol=0, atol=ANGLE_ATOL)
     _compare_geometry(body, ref, ref.sample_thetas(), ANGLE_ATOL, LENGTH_RTOL)
 
@@ -233,14 +233,14 @@ def test_closed_forms_named_bodies(shape):
 @given(SHAPES)
 def test_closed_forms_across_shapes(drawn):
     shape = _shape(drawn)
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     assert_allclose(body.theta_max, ref.theta_max, rtol=0, atol=ANGLE_ATOL)
     assert_allclose(body.psi_max, ref.theta_max, rtol=0, atol=ANGLE_ATOL)
     _compare_geometry(body, ref, ref.sample_thetas(count=13), ANGLE_ATOL, LENGTH_RTOL)
 
 
 def _check_derivatives(shape):
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     thetas = ref.sample_thetas(fraction=0.9, count=9)
     fd = np.array([ref.height_derivatives(t) for t in thetas])
     slope, curvature = body.height_derivative(thetas), body.height_second_derivative(thetas)
@@ -276,7 +276,7 @@ def test_heights_at_the_equilibria(drawn):
     """V(0) = b(a+Δ)/√(b²+4aΔ+4Δ²), V(π/2) = b/√2 and V(θ_max) = V(0) (disk swap), M g = 1."""
     shape = _shape(drawn)
     a, b, delta = shape
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     v0 = height_at_theta0(*shape)
     tol = LENGTH_RTOL * ref.size
     assert_allclose(ref.height(0.0), v0, rtol=0, atol=tol)
@@ -305,12 +305,12 @@ def test_theta_max_matches_q_root_named():
         expected = math.acos(-a * a / math.sqrt(a**4 + 4 * a * delta * b * b
                                                 + 4 * delta**2 * b * b))
         assert_allclose(Reference(*shape).theta_max, expected, rtol=0, atol=1e-12)
-        assert_allclose(TwoDiskBody(*shape).theta_max, expected, rtol=0, atol=1e-12)
+        assert_allclose(EllipseBody(*shape).theta_max, expected, rtol=0, atol=1e-12)
 
 
 def test_theta_max_full_precision():
     for a, b, delta in [(1.0, 0.01, 1e-3), (1.0, 0.05, 0.01), (1.0, 0.01, 1e-5)]:
-        body = TwoDiskBody(a, b, delta)
+        body = EllipseBody(a, b, delta)
         exact = math.atan2(2 * b * math.sqrt(delta * (a + delta)), -a * a)
         # to rounding (16 ulps; arccos of ≈ −1 was 2.5e-9 off)
         assert_allclose(body.theta_max, exact, rtol=ulps(16))
@@ -321,7 +321,7 @@ def test_theta_max_full_precision():
 @given(SHAPES)
 def test_phase_form_matches_theta_form(drawn):
     shape = _shape(drawn)
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     thetas = ref.sample_thetas(count=11)
     for branch in (1, -1):
         u = body.phase_from_theta(thetas, branch)
@@ -355,7 +355,7 @@ def test_phase_form_matches_theta_form(drawn):
 @pytest.mark.parametrize('shape', NAMED)
 def test_phase_form_is_continuous_through_turning_points(shape):
     """σ√Q changes sign at u = ±π/2 while every vector stays continuous."""
-    body = TwoDiskBody(*shape)
+    body = EllipseBody(*shape)
     for center in (math.pi / 2, -math.pi / 2):
         eps = 1e-7
         geo = body.phase_geometry(np.array([center - eps, center, center + eps]))
@@ -373,7 +373,7 @@ def test_phase_form_is_continuous_through_turning_points(shape):
 def test_branches_mirror_each_other(drawn):
     """geometry(θ, −1) is geometry(θ, +1) reflected in the plane of disk 1 (x3 → −x3)."""
     shape = _shape(drawn)
-    body = TwoDiskBody(*shape)
+    body = EllipseBody(*shape)
     thetas = np.linspace(-1, 1, 21) * body.theta_max
     plus, minus = body.geometry(thetas, 1), body.geometry(thetas, -1)
     mirror = np.array([1.0, 1.0, -1.0])
@@ -395,7 +395,7 @@ def test_branches_mirror_each_other(drawn):
 @pytest.mark.parametrize('shape', NAMED)
 def test_arc_length_rate_and_curvature(shape):
     """Eq. (1) is |dr1/dθ|; k is the ellipse's curvature ab/(a² sin²η + b² cos²η)^{3/2}."""
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     a, b, _ = shape
     thetas = ref.sample_thetas()
     speed = [np.linalg.norm(ref.r1_prime(t)) for t in thetas]
@@ -409,7 +409,7 @@ def test_arc_length_rate_and_curvature(shape):
 @pytest.mark.parametrize('shape', EXTREMES)
 def test_extreme_shapes(shape):
     a, b, delta = shape
-    body, ref = TwoDiskBody(*shape), Reference(*shape)
+    body, ref = EllipseBody(*shape), Reference(*shape)
     thetas = np.array([ref.theta(e) for e in
                        np.concatenate([np.linspace(-0.999, 0.999, 21), [1 - 1e-5, -1 + 1e-5]])
                        * ref.eta_max] + [0.0, math.pi / 2])
@@ -435,7 +435,7 @@ def test_size_is_largest_distance():
         a, b, delta = shape
         eta = np.linspace(0, 2 * math.pi, 200001)
         dist = np.hypot(b * np.sin(eta), delta + a * np.cos(eta)).max()
-        assert_allclose(TwoDiskBody(*shape).size, dist, rtol=1e-9)
+        assert_allclose(EllipseBody(*shape).size, dist, rtol=1e-9)
 
 
 # -- input validation -------------------------------------------------------------------------
@@ -453,7 +453,7 @@ BAD_INPUTS = [
 @pytest.mark.parametrize('name, args', BAD_INPUTS)
 def test_invalid_parameters(name, args):
     with pytest.raises(ValueError) as info:
-        TwoDiskBody(*args)
+        EllipseBody(*args)
     message = str(info.value)
     assert '\n' not in message
     assert message.startswith(f'{name} ')
@@ -464,11 +464,11 @@ def test_invalid_parameters(name, args):
 
 def test_numeric_strings_are_rejected():
     with pytest.raises(ValueError, match='^a '):
-        TwoDiskBody('1.0', 1.0, 0.5)
+        EllipseBody('1.0', 1.0, 0.5)
 
 
 def test_theta_outside_range_is_rejected():
-    body = TwoDiskBody(1.0, 1.0, 0.5)
+    body = EllipseBody(1.0, 1.0, 0.5)
     for bad in (body.theta_max * 1.001, -3.0, math.nan):
         with pytest.raises(ValueError, match='theta'):
             body.geometry(bad)
@@ -488,7 +488,7 @@ def test_reference_is_self_consistent():
     # the arc of disk 1 between ±θ_max from eq. (1) equals the one from |dr1/dθ|
     arc = quad(lambda t: np.linalg.norm(ref.r1_prime(t)), -ref.theta_max, ref.theta_max,
                epsabs=1e-13, epsrel=1e-13)[0]
-    body = TwoDiskBody(2.0, 0.7, 0.4)
+    body = EllipseBody(2.0, 0.7, 0.4)
     arc1 = quad(lambda t: float(body.arc_length_rate(t)), -ref.theta_max, ref.theta_max,
                 epsabs=1e-13, epsrel=1e-13)[0]
     assert_allclose(arc1, arc, rtol=1e-12)

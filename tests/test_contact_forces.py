@@ -34,7 +34,7 @@ from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics import RollingDynamics, simulate
 from twodisk_ros.physics.stability.equilibria import STABLE, equilibria
 from twodisk_ros.physics.mass.models import mass_properties
@@ -91,7 +91,7 @@ def world_atol(*forces):
 
 
 def make(shape, model='laminae', gravity=GRAVITY):
-    body = TwoDiskBody(*shape)
+    body = EllipseBody(*shape)
     dynamics = RollingDynamics(body, mass_properties(model, *shape, MASS), gravity=gravity)
     return ContactForceModel(dynamics)
 

@@ -1,4 +1,4 @@
-"""Contact forces of bodies other than TwoDiskBody, against independent references.
+"""Contact forces of bodies other than EllipseBody, against independent references.
 
 * Newton–Euler with finite differences in time of the simulated poses (G's position, the
   orientation), solved for (N_A, N_B, T_A, T_B, S, τ): ``newton_euler_forces`` of
@@ -6,7 +6,7 @@
 * the test double (tests/reparametrised_body.py): the ellipse seen through u = g(v), also
   the degenerate g′ = 0 where the body stops turning in v: the same physical states must
   have the ellipse's forces;
-* LaminaBody(Ellipse) against TwoDiskBody at the same contact angle θ;
+* LaminaBody(Ellipse) against EllipseBody at the same contact angle θ;
 * at a superellipse's flat vertex (n = 4) the growth N − N(Ω = 0) ∝ |γ − γ0|^(q − 2),
   q = n/(n − 1), of docs/physics.md#contact-forces, γ the body's turn integrated here from
   |ω_u| by scipy's quad.
@@ -22,7 +22,7 @@ from scipy.integrate import quad
 
 from reparametrised_body import ReparametrisedBody
 from test_contact_forces import GRAVITY, MASS, newton_euler_forces
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import (
     check_validity, liftoff_speed, mu_required_dynamic, mu_required_kinematic)
@@ -42,7 +42,7 @@ DOUBLE_ATOL = 1e-12
 #: the egg and the ellipse LaminaBody, 3.4e-9 on the superellipse n = 4 (its tables' tail
 #: 2.9e-10, and poses up to 20 M g near its flat vertices)
 FD_ATOL = 1e-8
-#: LaminaBody(Ellipse) against TwoDiskBody at equal θ: LaminaBody's tables (its tail
+#: LaminaBody(Ellipse) against EllipseBody at equal θ: LaminaBody's tables (its tail
 #: 1.2e-13) and the matching of θ; measured ≤ 9.3e-14 M g
 LAMINA_ATOL = 5e-13
 
@@ -50,7 +50,7 @@ _MODELS = {}
 
 
 def ellipse_model():
-    return model_of(TwoDiskBody(*FIGURE3), laminae(*FIGURE3, MASS))
+    return model_of(EllipseBody(*FIGURE3), laminae(*FIGURE3, MASS))
 
 
 def model_of(body, mass):
@@ -61,7 +61,7 @@ def model_of(body, mass):
 
 
 def double(kind):
-    base = TwoDiskBody(*FIGURE3)
+    base = EllipseBody(*FIGURE3)
     return model_of(ReparametrisedBody(base, kind), laminae(*FIGURE3, MASS))
 
 

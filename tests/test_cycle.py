@@ -30,7 +30,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace
 
 TWO_PI = 2 * math.pi
@@ -107,7 +107,7 @@ _CYCLES = {}
 def _cycle(shape):
     """RollingCycle of a shape, built once per session (tables take up to ~1.5 s)."""
     if shape not in _CYCLES:
-        _CYCLES[shape] = RollingCycle(TwoDiskBody(*shape))
+        _CYCLES[shape] = RollingCycle(EllipseBody(*shape))
     return _CYCLES[shape]
 
 
@@ -249,7 +249,7 @@ def test_whole_cycles_named(name):
 @given(SHAPES)
 def test_whole_cycles_across_shapes(drawn):
     shape = _shape(drawn)
-    _check_whole_cycles(shape, NO_SLIP_RTOL, RollingCycle(TwoDiskBody(*shape)))
+    _check_whole_cycles(shape, NO_SLIP_RTOL, RollingCycle(EllipseBody(*shape)))
 
 
 @pytest.mark.parametrize('shape', EXTREMES)
@@ -365,7 +365,7 @@ def test_oloid_cycle_displacement():
 @given(SHAPES)
 def test_cycle_turn_and_symmetry(drawn):
     shape = _shape(drawn)
-    cycle = RollingCycle(TwoDiskBody(*shape))
+    cycle = RollingCycle(EllipseBody(*shape))
     size = _size(*shape)
     # Gauss–Bonnet (module doc): the heading turns by 2π per cycle
     assert_allclose(cycle.displacement.turn, TWO_PI, rtol=0, atol=TURN_ATOL['range'])
@@ -469,7 +469,7 @@ def test_direct_integration_named(name):
 @given(SHAPES)
 def test_direct_integration_across_shapes(drawn):
     shape = _shape(drawn)
-    _check_direct_integration(shape, INTEGRATION_RTOL, RollingCycle(TwoDiskBody(*shape)))
+    _check_direct_integration(shape, INTEGRATION_RTOL, RollingCycle(EllipseBody(*shape)))
 
 
 @pytest.mark.parametrize('shape', [(1.0, 1.0, 1e-3), (1.0, 0.01, 0.5)])

@@ -4,7 +4,7 @@ References: the laminae's own definitions (the superellipse's implicit equation,
 support function h of lamina.py) and the placement of the laminae in general_body.py's
 docstring, written out here; the lamina's area (lamina.moments: closed forms for the
 superellipse) against the shoelace area of what is drawn. The drawers get a
-GeneralTwoDiskBody (any lamina) as a body: LaminaBody has the same attributes.
+ContactSolver (any lamina) as a body: LaminaBody has the same attributes.
 """
 
 import numpy as np
@@ -16,14 +16,14 @@ from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.frames import disk_rims
 from twodisk_ros.model.outline import DEFAULT_TOLERANCE
-from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.laminae.shapes import Superellipse
 from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.plotting.animation import still
 from twodisk_ros.runs import Run, RunError
 
-SQUIRCLE = GeneralTwoDiskBody(Superellipse(0.2, 0.15, 6), 0.1)
-EGG = GeneralTwoDiskBody(Egg(0.2, 0.16, 0.012), 0.08, 'swapped')
+SQUIRCLE = ContactSolver(Superellipse(0.2, 0.15, 6), 0.1)
+EGG = ContactSolver(Egg(0.2, 0.16, 0.012), 0.08, 'swapped')
 
 
 def _superellipse_residual(lamina, x, y):

@@ -32,7 +32,7 @@ from scipy.interpolate import CubicSpline
 
 from paper_forms import curvature_at_half_pi
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle, integrate_contact_trace
 from twodisk_ros.physics import MotionStream, RollingDynamics, simulate, simulate_phase
 from twodisk_ros.physics.stability.equilibria import STABLE, UNSTABLE, equilibria
@@ -92,7 +92,7 @@ SECOND = np.array([-1.0, 16.0, -30.0, 16.0, -1.0]) / 12.0     # × 1/h²
 @functools.lru_cache(maxsize=None)
 def model(abd, mass_model='laminae', gravity=GRAVITY):
     """(body, cycle, mass properties, dynamics) for a shape (a, b, Δ) in m."""
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     cycle = RollingCycle(body)
     if mass_model == 'laminae':
         mass = laminae(*abd, MASS)
@@ -505,7 +505,7 @@ def test_small_oscillation_period_scaling():
     _, _, _, dyn = model(OLOID)
     reference = dyn.small_oscillation_periods()[0][1]
     small = (0.25, 0.25, 0.125)
-    body = TwoDiskBody(*small)
+    body = EllipseBody(*small)
     scaled = RollingDynamics(body, laminae(*small, 7.0), gravity=4 * GRAVITY)
     periods = [p for _, p in scaled.small_oscillation_periods()]
     # docs/physics.md: periods × √(g/a) equal the unit body's to ≤ 3e-13; measured 1.5e-14

@@ -20,7 +20,7 @@ from scipy.optimize import brentq
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0, height_at_theta0, height_slope
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.stability.equilibria import (NEUTRAL, STABLE, UNSTABLE, equilibria,
                                                      stability_map)
@@ -140,7 +140,7 @@ def _turning_phase_curvatures(shape, ref):
 
 def _check_equilibria(shape):
     a, b, delta = shape
-    body, ref = TwoDiskBody(*shape), PolarReference(*shape)
+    body, ref = EllipseBody(*shape), PolarReference(*shape)
     found = equilibria(body)
     assert len(found) == 8
     phases = np.array([e.phase for e in found])
@@ -205,7 +205,7 @@ def test_equilibria_across_shapes(drawn):
 @pytest.mark.parametrize('shape', [(1.0, 0.01, 1e-3), (1.0, 100.0, 1e-3), (1.0, 0.01, 1 - 1e-6),
                                    (1.0, 100.0, 1 - 1e-6)])
 def test_equilibria_extremes(shape):
-    found = equilibria(TwoDiskBody(*shape))
+    found = equilibria(EllipseBody(*shape))
     assert len(found) == 8
     for e in found:
         for name in ('phase', 'theta', 'psi', 'height', 'curvature', 'phase_curvature'):
@@ -236,7 +236,7 @@ def test_neutral_shapes(scale, b_over_a):
     delta = math.sqrt(a * a - b * b / 2)
     if not 0 < delta < a:
         return
-    body, ref = TwoDiskBody(a, b, delta), PolarReference(a, b, delta)
+    body, ref = EllipseBody(a, b, delta), PolarReference(a, b, delta)
     found = equilibria(body)
     assert [e.stability for e in found] == [NEUTRAL] * 8
     assert stability_map(b_over_a, delta / a) == 0
@@ -250,7 +250,7 @@ def test_neutral_shapes(scale, b_over_a):
 
 def test_neutral_cycle_keeps_g_level():
     """The TCR through RollingCycle: G at b/√2 at every phase, also at the turning points."""
-    cycle = RollingCycle(TwoDiskBody.two_circle_roller(0.3))
+    cycle = RollingCycle(EllipseBody.two_circle_roller(0.3))
     u = np.concatenate([np.linspace(0, 2 * math.pi, 721), np.arange(4) * math.pi / 2])
     assert_allclose(cycle.state(u).position_g[:, 2], 0.3 / SQRT2, rtol=0,
                     atol=NEUTRAL_RTOL * cycle.body.size)
@@ -262,7 +262,7 @@ def test_near_neutral_is_not_neutral():
     a, b = 1.0, 1.0
     delta = math.sqrt(a * a - b * b / 2)
     for offset, zero_family in ((1e-6, STABLE), (-1e-6, UNSTABLE)):
-        found = equilibria(TwoDiskBody(a, b, delta + offset))
+        found = equilibria(EllipseBody(a, b, delta + offset))
         assert [e.stability for e in found][:3] == [
             zero_family, UNSTABLE if zero_family == STABLE else STABLE, zero_family]
 
@@ -284,7 +284,7 @@ def test_stability_map_matches_numerical_curvature():
             assert abs(v2) > 100 * 1e-15 * ref.height(0.0) / h**2, (ba, da, v2)
             assert grid[i, j] == int(np.sign(v2)), (ba, da, v2)
             # and the map is the stability of θ = 0 reported by equilibria()
-            first = equilibria(TwoDiskBody(1.0, ba, da))[0]
+            first = equilibria(EllipseBody(1.0, ba, da))[0]
             assert first.stability == (STABLE if grid[i, j] > 0 else UNSTABLE)
             checked += 1
     assert checked == 63

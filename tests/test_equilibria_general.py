@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.stability.equilibria import STABLE, UNSTABLE, equilibria
 from twodisk_ros.physics.stability.certified import certified_roots
 from twodisk_ros.physics.stability.symmetric import symmetric_equilibria
@@ -41,7 +41,7 @@ def _gamma_curvature(body, eq):
 def test_general_search_finds_the_ellipse_equilibria(shape, kind):
     """Claim: the general search finds exactly the ellipse's eight equilibria, with their
     θ, ψ, height, stability and d²z_G/dγ² (docs/physics.md#equilibria-of-any-body)."""
-    base = TwoDiskBody(*shape)
+    base = EllipseBody(*shape)
     double = ReparametrisedBody(base, kind)
     found, proof = equilibria(double, certificate=True)
     reference = equilibria(base)
@@ -63,7 +63,7 @@ def test_degenerate_phase_is_classified_in_the_turn():
     """Claim: at a phase where the body does not turn (|ω_u| = 0, m = 0) the equilibrium is
     still found and classified, in γ: d²z_G/dγ² equals symmetric_stability's closed form for
     θ = 0 (an independent derivation from the lamina's radius of curvature at its tip)."""
-    base = TwoDiskBody(1.0, 1.6, 0.4)
+    base = EllipseBody(1.0, 1.6, 0.4)
     double = ReparametrisedBody(base, 'degenerate')
     found = equilibria(double)
     at_zero = [eq for eq in found if abs(math.remainder(eq.phase, math.pi)) < 1e-6]
@@ -93,7 +93,7 @@ def test_certificate_sees_close_roots():
     search finds all ten (as many as the sign changes of the analytic slope on 2e5 points:
     spacing 3.1e-5 rad, ~900 points between the closest pair, 0.028 rad apart; 0, π/2, π,
     3π/2 on the grid as before) and the certificate covers the rest of the cycle."""
-    base = TwoDiskBody(1.0, 1.6, 0.4)
+    base = EllipseBody(1.0, 1.6, 0.4)
     double = _Bumpy(base, 'smooth')
     roots, proof = certified_roots(double)
     assert proof.complete

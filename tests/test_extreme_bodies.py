@@ -21,7 +21,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.integrate import IntegrationWarning, quad
 
 from rounding import ulps
-from twodisk_ros.physics import RollingCycle, RollingDynamics, TwoDiskBody, equilibria
+from twodisk_ros.physics import RollingCycle, RollingDynamics, EllipseBody, equilibria
 from twodisk_ros.physics.bodies.ellipse import LENGTH_RANGE
 from twodisk_ros.physics.mass.models import laminae
 from twodisk_ros.physics.motion.simulate import MotionStream, simulate_phase
@@ -32,7 +32,7 @@ GRAVITY = 9.81
 
 
 def _dynamics(abd):
-    return RollingDynamics(TwoDiskBody(*abd), laminae(*abd, 1.0), GRAVITY)
+    return RollingDynamics(EllipseBody(*abd), laminae(*abd, 1.0), GRAVITY)
 
 
 def _start(dyn, theta0=0.3, omega0=3.0):
@@ -190,20 +190,20 @@ def test_thin_body_at_rest_near_the_barrier_starts_without_a_10_s_chunk():
 
 
 def test_startup_estimate_names_the_costly_bodies():
-    costly = startup_estimate(TwoDiskBody(1.0, 0.01, 0.001))
+    costly = startup_estimate(EllipseBody(1.0, 0.01, 0.001))
     assert costly.resolution == 65536
     assert costly.seconds > NOTICE_SECONDS
     assert costly.message.startswith('building tables for an extreme body (b/a = 0.01')
     assert f'about {costly.seconds:.0f} s' in costly.message
-    assert startup_estimate(TwoDiskBody.oloid(0.1)).message is None
+    assert startup_estimate(EllipseBody.oloid(0.1)).message is None
     # the estimate is the grid the cycle then uses
-    assert RollingCycle(TwoDiskBody(1.0, 0.05, 0.02)).resolution == startup_estimate(
-        TwoDiskBody(1.0, 0.05, 0.02)).resolution
+    assert RollingCycle(EllipseBody(1.0, 0.05, 0.02)).resolution == startup_estimate(
+        EllipseBody(1.0, 0.05, 0.02)).resolution
 
 
 # ------------------------------------------------------------------------- scale invariance
 def _dimensionless(a, b_over_a, delta_over_a):
-    body = TwoDiskBody(a, b_over_a * a, delta_over_a * a)
+    body = EllipseBody(a, b_over_a * a, delta_over_a * a)
     found = equilibria(body)
     cycle = RollingCycle(body)
     return np.array([body.theta_max] + [eq.height / a for eq in found]
@@ -233,7 +233,7 @@ def test_scale_invariance_at_the_ends_of_the_range(a):
     ((1.0, 1e31, 0.5), 'b'), ((1.0, 1e-31, 0.5), 'b'), ((1e-29, 1e-29, 1e-31), 'delta')])
 def test_lengths_outside_the_range_are_refused(args, name):
     with pytest.raises(ValueError, match=rf'^{name} must be in \[1e-30, 1e\+30\] m'):
-        TwoDiskBody(*args)
+        EllipseBody(*args)
 
 
 @pytest.mark.parametrize('args', [
@@ -241,7 +241,7 @@ def test_lengths_outside_the_range_are_refused(args, name):
     (-1.0, 1.0, 0.5), (0.0, 1.0, 0.5), ('1', 1.0, 0.5), (None, 1.0, 0.5), (1.0, 1.0, [0.5])])
 def test_bad_parameters_are_value_errors(args):
     with pytest.raises(ValueError, match=r'^(a|b|delta) must be '):
-        TwoDiskBody(*args)
+        EllipseBody(*args)
 
 
 @pytest.mark.ros

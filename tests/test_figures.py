@@ -18,7 +18,7 @@ from numpy.testing import assert_allclose  # noqa: E402
 
 from rounding import ulps  # noqa: E402
 from twodisk_ros.plotting import figures  # noqa: E402
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 
 EXPECTED = ['figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stability_map.png',
             'laminae_traces.png']
@@ -73,10 +73,10 @@ def test_oloid_trace_data():
     """The plotted trace of A ends 2 cycles × 8√3π/9 m along X (elementary oloid trace)."""
     fig, ax = plt.subplots()
     try:
-        figures.plot_traces(TwoDiskBody.oloid(), 2, ax)
+        figures.plot_traces(EllipseBody.oloid(), 2, ax)
         x, y = _line(ax, 'trace A').get_data()
         # A at the origin at u = 0, to the tables' rounding (16 ulps of the size)
-        assert_allclose([x[0], y[0]], [0.0, 0.0], atol=ulps(16, TwoDiskBody.oloid().size))
+        assert_allclose([x[0], y[0]], [0.0, 0.0], atol=ulps(16, EllipseBody.oloid().size))
         assert_allclose([x[-1], y[-1]], [2 * 8 * math.sqrt(3) * math.pi / 9, 0.0], atol=1e-12)
         assert y.min() >= -1e-12
         # the trace of B stays above the trace of A, as in the paper's figures
@@ -92,8 +92,8 @@ def test_height_data():
     """TCR at b/√2 throughout; oloid between 1/√2 and 3/4 (Mg = 1: z_G in m)."""
     fig, ax = plt.subplots()
     try:
-        figures.plot_height([('Oloid', TwoDiskBody.oloid()),
-                             ('TCR', TwoDiskBody.two_circle_roller(2.0))], ax)
+        figures.plot_height([('Oloid', EllipseBody.oloid()),
+                             ('TCR', EllipseBody.two_circle_roller(2.0))], ax)
         _, tcr = _line(ax, 'height TCR').get_data()
         assert_allclose(tcr, 2.0 / math.sqrt(2.0), rtol=0, atol=1e-12)
         u, oloid = _line(ax, 'height Oloid').get_data()
@@ -129,7 +129,7 @@ def test_core_does_not_import_matplotlib():
 def test_plot_functions_return_their_axes():
     fig, axes = plt.subplots(1, 3)
     try:
-        body = TwoDiskBody(*figures.FIGURE4)
+        body = EllipseBody(*figures.FIGURE4)
         assert figures.plot_traces(body, 1, axes[0], samples_per_cycle=200) is axes[0]
         assert figures.plot_height([('Fig. 4', body)], axes[1], samples=101) is axes[1]
         assert figures.plot_stability_map(axes[2], resolution=20) is axes[2]

@@ -1,6 +1,6 @@
 """physics/bodies/contact_solver.py (issue 20, step 2) against independent references.
 
-References: TwoDiskBody's closed forms (the paper's, a different derivation: Q(θ), its exact
+References: EllipseBody's closed forms (the paper's, a different derivation: Q(θ), its exact
 factorisation and the eccentric-anomaly phase) for ellipses; the oloid's literature values;
 for other shapes, constructions written here from the boundary points alone: a dense sampling
 of both rims (is anything below the ground?), central-difference rim tangents (is the ground
@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
-from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
+from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
 from twodisk_ros.physics.laminae.support import Egg
 
@@ -46,8 +46,8 @@ def _phase_grid():
 @pytest.mark.parametrize('arrangement', ['parallel', 'swapped'])
 @pytest.mark.parametrize('a, b, delta', ELLIPSE_BODIES)
 def test_ellipse_agrees_with_closed_forms(a, b, delta, arrangement):
-    ref = TwoDiskBody(a, b, delta)
-    body = GeneralTwoDiskBody(Ellipse(a, b), delta, arrangement)
+    ref = EllipseBody(a, b, delta)
+    body = ContactSolver(Ellipse(a, b), delta, arrangement)
     size = ref.size
     assert body.theta_max == pytest.approx(ref.theta_max, abs=ELLIPSE_TOL)
     assert body.psi_max == pytest.approx(ref.psi_max, abs=ELLIPSE_TOL)
@@ -87,7 +87,7 @@ def test_ellipse_agrees_with_closed_forms(a, b, delta, arrangement):
 @pytest.mark.parametrize('radius', [1.0, 2.5])
 def test_oloid_height_range_literature(radius):
     """Circles, Δ = r/2: z_G runs over [r/√2, 3r/4] (the oloid's literature values)."""
-    body = GeneralTwoDiskBody(Ellipse(radius, radius), radius / 2)
+    body = ContactSolver(Ellipse(radius, radius), radius / 2)
     # claim: the extremes are attained at θ = π/2 and θ = 0, to rounding of the size
     assert float(body.height(np.pi / 2)) == pytest.approx(radius / math.sqrt(2),
                                                           abs=1e-14 * radius)
@@ -126,7 +126,7 @@ def _parameter_of(lamina, point):
 @pytest.mark.parametrize('arrangement', ['parallel', 'swapped'])
 @pytest.mark.parametrize('lamina, delta', OTHER_SHAPES, ids=OTHER_IDS)
 def test_ground_supports_and_touches_both_laminae(lamina, delta, arrangement):
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     size = body.size
     theta = body.theta_max * np.concatenate([np.linspace(-1, 1, 13), [0.999999]])
     _, rim1, rim2 = _rim_points(body)
@@ -172,7 +172,7 @@ def test_ground_supports_and_touches_both_laminae(lamina, delta, arrangement):
 def test_theta_max_is_the_tangent_from_the_far_tip(lamina, delta, arrangement):
     """At θ_max disk 1 stands vertical and the ground passes through disk 2's far tip: the
     tangent from that tip T to disk 1 in its plane (root of (r − T) × r′ by brentq, 1e-12)."""
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     _, y_min, y_max = lamina.extents
     tip = 2 * delta + (y_max if arrangement == 'parallel' else -y_min)
 
@@ -200,7 +200,7 @@ def test_symmetries(lamina, delta):
     is invariant under the disk swap (x1, x2, x3) ↦ (x3, −x2, x1): (θ, ψ) ↦ (−ψ, −θ)."""
     theta = np.linspace(-0.98, 0.98, 25)
     for arrangement in ('parallel', 'swapped'):
-        body = GeneralTwoDiskBody(lamina, delta, arrangement)
+        body = ContactSolver(lamina, delta, arrangement)
         th = theta * body.theta_max
         up, down, left = body.geometry(th, 1), body.geometry(th, -1), body.geometry(-th, 1)
         flip1, flip3 = np.array([-1.0, 1, 1]), np.array([1.0, 1, -1])
@@ -226,8 +226,8 @@ def test_symmetries(lamina, delta):
 def test_egg_parallel_bodies_of_opposite_eggs_are_one_body_turned():
     """Egg(ε) and Egg(−ε) in the parallel arrangement are the same body turned by the disk
     swap, so (θ, ψ) ↦ (−ψ, −θ) maps one's poses to the other's; G is off the centres."""
-    one = GeneralTwoDiskBody(Egg(1.3, 1.0, 0.08), 0.5)
-    other = GeneralTwoDiskBody(Egg(1.3, 1.0, -0.08), 0.5)
+    one = ContactSolver(Egg(1.3, 1.0, 0.08), 0.5)
+    other = ContactSolver(Egg(1.3, 1.0, -0.08), 0.5)
     assert one.centroid[1] > 0 > other.centroid[1]   # G towards the blunt ends
     geo = one.geometry(one.theta_max * AWAY_FROM_ZERO)
     assert one.psi_max == pytest.approx(other.theta_max, abs=1e-12)
@@ -239,10 +239,10 @@ def test_egg_parallel_bodies_of_opposite_eggs_are_one_body_turned():
 def test_superellipse_converges_to_the_ellipse():
     """Superellipse n → 2: pose differences shrink like n − 2; n = 2 is the ellipse (1e-13)."""
     theta = np.linspace(-0.95, 0.95, 21)
-    ref = GeneralTwoDiskBody(Ellipse(1.0, 0.7), 0.4)
+    ref = ContactSolver(Ellipse(1.0, 0.7), 0.4)
     errors = []
     for excess in (0.0, 1e-2, 1e-3, 1e-4):
-        body = GeneralTwoDiskBody(Superellipse(1.0, 0.7, 2.0 + excess), 0.4)
+        body = ContactSolver(Superellipse(1.0, 0.7, 2.0 + excess), 0.4)
         th = theta * min(body.theta_max, ref.theta_max)
         got, want = body.geometry(th, 1), ref.geometry(th, 1)
         errors.append(max(np.max(np.abs(got.height - want.height)),
@@ -263,7 +263,7 @@ def test_superellipse_converges_to_the_ellipse():
 ])
 def test_refusals_are_one_line(args, match):
     with pytest.raises(ValueError, match=match) as info:
-        GeneralTwoDiskBody(*args)
+        ContactSolver(*args)
     assert '\n' not in str(info.value)
 
 

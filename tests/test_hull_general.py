@@ -23,8 +23,8 @@ from numpy.testing import assert_allclose
 from scipy.spatial import ConvexHull
 from scipy.special import ellipe, ellipk
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
-from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
+from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.mass.hull import unit_hull_moments
 from twodisk_ros.physics.mass.hull_laminae import SWAP, MirroredLamina, general_hull_moments
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
@@ -103,8 +103,8 @@ def test_oloid_volume_on_the_general_path():
 def test_two_disk_body_takes_the_closed_forms_exactly(model):
     moments = (0.3, 0.2, 0.3) if model == 'custom' else None
     expected = mass_properties(model, 1.0, 0.7, 0.3, 2.0, principal_moments=moments)
-    assert mass_properties_of(model, TwoDiskBody(1.0, 0.7, 0.3), 2.0, moments) == expected
-    general = GeneralTwoDiskBody(Ellipse(1.0, 0.7), 0.3, 'swapped')
+    assert mass_properties_of(model, EllipseBody(1.0, 0.7, 0.3), 2.0, moments) == expected
+    general = ContactSolver(Ellipse(1.0, 0.7), 0.3, 'swapped')
     assert mass_properties_of(model, general, 2.0, moments) == expected
 
 
@@ -114,13 +114,13 @@ def test_two_disk_body_takes_the_closed_forms_exactly(model):
 def ruling_ends(lamina, delta, arrangement, n):
     """Points on both rims at the ends of the hull's rulings, from O (m).
 
-    GeneralTwoDiskBody's poses at n + 1 equal steps of A's lamina parameter over |s| ≤ s_c
+    ContactSolver's poses at n + 1 equal steps of A's lamina parameter over |s| ≤ s_c
     (both branches; s_c halfway between the side vertex and the turning point) and, around the
     turning points, the dual body's poses (disk 2 seen as disk 1) at n/2 + 1 steps of B's.
     """
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     mirrored = MirroredLamina(lamina) if arrangement == 'parallel' else lamina
-    dual = GeneralTwoDiskBody(mirrored, delta, arrangement)
+    dual = ContactSolver(mirrored, delta, arrangement)
     side = float(lamina.support(np.array([1.0, 0.0])).parameter)
     cut = 0.5 * (side + body.s_max)
     s = np.linspace(-cut, cut, n + 1)
@@ -165,10 +165,10 @@ def polytope_reference(lamina, delta, arrangement, levels=(64, 128, 256, 512, 10
     if not (isinstance(shape[0], Outline) and arrangement == 'swapped')])   # 12 s each
 def test_solid_matches_extrapolated_inscribed_polytopes(lamina, delta, arrangement):
     reference = polytope_reference(lamina, delta, arrangement)
-    props = mass_properties_of('solid', GeneralTwoDiskBody(lamina, delta, arrangement), 1.5,
+    props = mass_properties_of('solid', ContactSolver(lamina, delta, arrangement), 1.5,
                                rtol=1e-12)
     assert props.relative_error <= 1e-12
-    g = GeneralTwoDiskBody(lamina, delta, arrangement).centroid
+    g = ContactSolver(lamina, delta, arrangement).centroid
     com = props.center_of_mass + g                                    # from O
     size = lamina.size + delta
     assert abs(props.volume / reference[0] - 1) <= POLYTOPE_RTOL
@@ -180,7 +180,7 @@ def test_solid_matches_extrapolated_inscribed_polytopes(lamina, delta, arrangeme
 @pytest.mark.parametrize('arrangement', ['parallel', 'swapped'])
 @pytest.mark.parametrize('lamina, delta', SHAPES, ids=IDS)
 def test_solid_symmetries(lamina, delta, arrangement):
-    props = mass_properties_of('solid', GeneralTwoDiskBody(lamina, delta, arrangement), 1.0)
+    props = mass_properties_of('solid', ContactSolver(lamina, delta, arrangement), 1.0)
     inertia, size = props.inertia, lamina.size + delta
     largest = np.max(np.diag(inertia))
     assert_allclose(inertia - np.diag(np.diag(inertia)), 0.0, atol=SYMMETRY_ATOL * largest)
@@ -245,7 +245,7 @@ def plates_reference(lamina, delta, sigma, mass, levels=(256, 512, 1024, 2048)):
 @pytest.mark.parametrize('lamina, delta', SHAPES, ids=IDS)
 def test_laminae_match_plates_integrated_on_their_rims(lamina, delta, arrangement):
     sigma = 1.0 if arrangement == 'parallel' else -1.0
-    props = mass_properties_of('laminae', GeneralTwoDiskBody(lamina, delta, arrangement), 2.0)
+    props = mass_properties_of('laminae', ContactSolver(lamina, delta, arrangement), 2.0)
     expected = plates_reference(lamina, delta, sigma, 2.0)
     assert_allclose(np.diag(props.inertia), np.diag(expected), rtol=PLATES_RTOL)
     assert_allclose(props.center_of_mass, 0.0, atol=0.0)
@@ -256,13 +256,13 @@ def test_laminae_match_plates_integrated_on_their_rims(lamina, delta, arrangemen
 
 
 @pytest.mark.parametrize('call, words', [
-    (lambda: mass_properties_of('oloid', TwoDiskBody(1, 1, 0.5), 1.0), ['model must be one of']),
+    (lambda: mass_properties_of('oloid', EllipseBody(1, 1, 0.5), 1.0), ['model must be one of']),
     (lambda: mass_properties_of('solid', object(), 1.0), ['body must be a rolling body']),
-    (lambda: mass_properties_of('solid', GeneralTwoDiskBody(Egg(1, 0.8, 0.05), 0.4), -1.0),
+    (lambda: mass_properties_of('solid', ContactSolver(Egg(1, 0.8, 0.05), 0.4), -1.0),
      ['mass must be finite and > 0 kg']),
-    (lambda: mass_properties_of('custom', GeneralTwoDiskBody(Egg(1, 0.8, 0.05), 0.4), 1.0),
+    (lambda: mass_properties_of('custom', ContactSolver(Egg(1, 0.8, 0.05), 0.4), 1.0),
      ['principal_moments must be given']),
-    (lambda: mass_properties_of('solid', GeneralTwoDiskBody(Egg(1, 0.8, 0.05), 0.4), 1.0,
+    (lambda: mass_properties_of('solid', ContactSolver(Egg(1, 0.8, 0.05), 0.4), 1.0,
                                 rtol=0.0), ['rtol must be']),
 ])
 def test_bad_input_gives_one_line_value_error(call, words):

@@ -27,7 +27,7 @@ from std_msgs.msg import Header  # noqa: E402
 
 from twodisk_ros.inspector import cli as inspect_cli  # noqa: E402
 from twodisk_ros.inspector import finite_differences, inspect_recording  # noqa: E402
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.recordings import McapRecorder, read_recording  # noqa: E402
@@ -51,7 +51,7 @@ OLOID = {
 
 def simulate_run(params):
     """Sample the motion the parameters describe: stamps, poses, contacts, angles, energy."""
-    body = TwoDiskBody(float(params['a']), float(params['b']), float(params['delta']))
+    body = EllipseBody(float(params['a']), float(params['b']), float(params['delta']))
     mass = mass_properties(params['mass_model'], body.a, body.b, body.delta,
                            float(params['mass']))
     dynamics = RollingDynamics(body, mass, float(params['gravity']))

@@ -29,7 +29,7 @@ from twodisk_ros.inspector import inspect_recording  # noqa: E402
 from twodisk_ros.inspector.differences import finite_differences, second_differences  # noqa
 from twodisk_ros.recordings import McapRecorder  # noqa: E402
 from twodisk_ros.physics import RollingDynamics, simulate  # noqa: E402
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
 from twodisk_ros.physics.forces.validity import check_validity, liftoff_speed  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
@@ -50,7 +50,7 @@ NEW = ('contact_forces', 'force_split', 'rolling_validity')
 
 
 def dynamics_of(params):
-    body = TwoDiskBody(float(params['a']), float(params['b']), float(params['delta']))
+    body = EllipseBody(float(params['a']), float(params['b']), float(params['delta']))
     mass = mass_properties(params['mass_model'], body.a, body.b, body.delta,
                            float(params['mass']))
     return RollingDynamics(body, mass, float(params['gravity']))

@@ -16,7 +16,7 @@ from batch_recording import record
 from twodisk_ros.inspector import inspect_recording
 from twodisk_ros.recordings.reader import read_recording
 from twodisk_ros.run.parameters import parse_recorded
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.model import palette
 from twodisk_ros.inspector.figure import align_zeros, inspection_figure, plot_inspection
@@ -72,7 +72,7 @@ def zero_height(axes):
 def test_drift_panel_shows_the_recorded_energy_drift_not_the_fd_error(recordings, figures):
     inspection, figure = figures['tcr']
     settings, phase, rate = recorded_state(recordings['tcr'])
-    dynamics = RollingDynamics(TwoDiskBody(settings.a, settings.b, settings.delta),
+    dynamics = RollingDynamics(EllipseBody(settings.a, settings.b, settings.delta),
                                settings.ellipse_mass_properties(), settings.gravity)
     energy = dynamics.energy(phase, rate)
     reference = np.max(np.abs(energy - energy[0])) / dynamics.energy_scale
@@ -89,7 +89,7 @@ def test_drift_panel_shows_the_recorded_energy_drift_not_the_fd_error(recordings
 def test_kinematic_drift_panel_shows_the_drift_of_omega(recordings, figures):
     _, figure = figures['kinematic']
     settings, phase, rate = recorded_state(recordings['kinematic'])
-    body = TwoDiskBody(settings.a, settings.b, settings.delta)
+    body = EllipseBody(settings.a, settings.b, settings.delta)
     speed = np.abs(rate) * np.linalg.norm(body.phase_angular_velocity(phase), axis=-1)
     reference = np.max(np.abs(speed - 5.0)) / 5.0
     drift = axes_named(figure, 'drift')

@@ -1,7 +1,7 @@
 """physics/bodies/lamina_body.py (LaminaBody: the regular phase of any two laminae) against
 independent references.
 
-References: TwoDiskBody's closed forms (eccentric-anomaly phase, complex step) for ellipses,
+References: EllipseBody's closed forms (eccentric-anomaly phase, complex step) for ellipses,
 matched pose by pose through (θ, branch) since the two phases differ; RollingCycle of the
 closed forms; the oloid's literature values; for other shapes, checks written here from the
 lamina alone: its support function (lamina.py) at the ground normal, central-difference rim
@@ -19,7 +19,7 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
 from twodisk_ros.physics.laminae.support import Egg
@@ -66,7 +66,7 @@ def _ellipse_pair(shape):
     key = ('ellipse',) + shape
     if key not in _BODIES:
         a, b, delta = shape
-        _BODIES[key] = (LaminaBody(Ellipse(a, b), delta), TwoDiskBody(a, b, delta))
+        _BODIES[key] = (LaminaBody(Ellipse(a, b), delta), EllipseBody(a, b, delta))
     return _BODIES[key]
 
 
@@ -137,7 +137,7 @@ def test_ellipse_cycle_displacement_matches_closed_forms(shape):
 def test_swapped_ellipse_is_the_same_body():
     a, b, delta = ELLIPSES[2]
     body = LaminaBody(Ellipse(a, b), delta, 'swapped')
-    ref = TwoDiskBody(a, b, delta)
+    ref = EllipseBody(a, b, delta)
     u = np.linspace(0.0, TWO_PI, 64, endpoint=False)
     theta = body.phase_geometry(u).theta
     branch = np.where(np.cos(u) < 0, -1, 1)
@@ -168,7 +168,7 @@ def test_oloid_literature_values(radius):
 def test_superellipse_converges_to_ellipse():
     """The differences to the ellipse shrink ~ linearly in n − 2 (the superellipse differs
     from the ellipse by (n − 2) s² ln|s| to first order)."""
-    ref = TwoDiskBody(1.0, 0.8, 0.4)
+    ref = EllipseBody(1.0, 0.8, 0.4)
     exact = RollingCycle(ref).displacement
     u = np.array([0.0, 0.5 * math.pi])        # θ = 0 and θ_max: the same poses in both phases
     differences = []
@@ -451,7 +451,7 @@ def test_random_shapes_give_a_body_or_one_line(kind, b, n, eps_fraction, delta_f
 # -- what each body answers for itself (issue 29: no switches on the body's class) -----------
 
 def test_bodies_describe_themselves_and_what_their_tables_cost():
-    oloid = TwoDiskBody(0.1, 0.1, 0.05)
+    oloid = EllipseBody(0.1, 0.1, 0.05)
     assert oloid.describe() == 'a = 0.1 m, b = 0.1 m, Δ = 0.05 m'
     assert oloid.resolution_cause() == 'b/a = 1, delta/a = 0.5'
     square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
@@ -463,7 +463,7 @@ def test_contact_solver_and_origin_of_every_body():
     """The drawings' exact contact geometry: the ellipse's solver is that of its lamina (same
     θ_max as the closed form to 1e-15 relative), its origin the midpoint of the centres; a
     lamina body's solver is its own, its origin the centroid (G)."""
-    body = TwoDiskBody(0.1, 0.07, 0.04)
+    body = EllipseBody(0.1, 0.07, 0.04)
     solver = body.contact_solver
     assert solver is body.contact_solver and solver.contact_solver is solver
     assert abs(solver.theta_max / body.theta_max - 1) < 1e-15
@@ -484,5 +484,5 @@ def test_flat_vertex_phases_from_the_vertices_are_the_bodys_own():
     assert generic.size == 6 and own.size == 8
     gaps = np.abs(np.remainder(generic[:, None] - own[None, :] + math.pi, 2 * math.pi) - math.pi)
     assert np.max(np.min(gaps, axis=1)) < 1e-12
-    assert TwoDiskBody(0.1, 0.07, 0.04).flat_vertex_phases().size == 0
+    assert EllipseBody(0.1, 0.07, 0.04).flat_vertex_phases().size == 0
     assert LaminaBody(Egg(0.1, 0.08, 0.004), 0.04).flat_vertex_phases().size == 0

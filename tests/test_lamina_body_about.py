@@ -15,7 +15,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.laminae.shapes import Superellipse
@@ -122,7 +122,7 @@ def test_centred_on_mass_moves_the_egg_and_leaves_symmetric_bodies():
     """The parallel egg's solid has its centre of mass off G along e2 (here 2.1e-4 m, 0.2 % of
     the size): the centred body is moved there and reports it at its origin. A body with
     the disk-swap symmetry (square superellipse) moves by rounding only; the ellipse's
-    TwoDiskBody is returned as it is."""
+    EllipseBody is returned as it is."""
     body = _egg()
     solid = mass_properties_of('solid', body, 1.0)
     assert abs(solid.center_of_mass[1]) > 1e-3 * body.size
@@ -132,7 +132,7 @@ def test_centred_on_mass_moves_the_egg_and_leaves_symmetric_bodies():
     assert np.array_equal(props.inertia, solid.inertia)
     square, _ = centred_on_mass('solid', _square(), 1.0)
     assert abs(square.offset) <= ulps(16, square.size)     # the quadrature's rounding
-    ellipse = TwoDiskBody(0.1, 0.08, 0.04)
+    ellipse = EllipseBody(0.1, 0.08, 0.04)
     same, props = centred_on_mass('solid', ellipse, 1.0)
     assert same is ellipse
     with pytest.raises(ValueError, match='center_of_mass must be G'):

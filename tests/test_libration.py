@@ -34,7 +34,7 @@ from numpy.polynomial import chebyshev
 from scipy.integrate import solve_ivp
 
 from rounding import ulps
-from twodisk_ros.physics import TwoDiskBody, RollingDynamics, simulate, simulate_phase
+from twodisk_ros.physics import EllipseBody, RollingDynamics, simulate, simulate_phase
 from twodisk_ros.physics.mass.models import laminae
 
 MASS, GRAVITY = 1.0, 9.81
@@ -56,7 +56,7 @@ N_PERIODS, N_SAMPLES = 3, 61
 @functools.lru_cache(maxsize=None)
 def _dynamics(name):
     abd = BODIES[name]
-    return RollingDynamics(TwoDiskBody(*abd), laminae(*abd, MASS), GRAVITY)
+    return RollingDynamics(EllipseBody(*abd), laminae(*abd, MASS), GRAVITY)
 
 
 # ----------------------------------------------------------------- the test's own closed forms
@@ -295,7 +295,7 @@ def test_issue_9_nudged_oloid(method, start):
 @pytest.mark.parametrize('omega0', [1e-12, 1e-6, 2.0])
 def test_two_circle_roller_rolls_on_at_any_speed(method, omega0):
     abd = (0.1, 0.1, 0.1 / math.sqrt(2.0))
-    dyn = RollingDynamics(TwoDiskBody(*abd), laminae(*abd, MASS), GRAVITY)
+    dyn = RollingDynamics(EllipseBody(*abd), laminae(*abd, MASS), GRAVITY)
     # 4 s: at 2 rad/s the phase advances 6.5 rad, one whole turn of m(u) (a cycle of the body)
     t = np.linspace(0.0, 4.0, 41)
     motion = simulate(dyn, t, omega0=omega0, method=method)

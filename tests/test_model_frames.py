@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from rounding import ulps
 from twodisk_ros.model.frames import check_frame_id, disk_frames
-from twodisk_ros.physics import TwoDiskBody
+from twodisk_ros.physics import EllipseBody
 
 # (a, b, Δ) in m: Oloid, Two-Circle-Roller, Figures 3 and 4, b > a, thin, small and large Δ
 BODIES = [(1.0, 1.0, 0.5), (1.0, 1.0, 1 / math.sqrt(2)), (2.0, 1.0, 1.0),
@@ -24,7 +24,7 @@ PHASES = np.linspace(-np.pi, np.pi, 401)
 
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_contact_points_lie_on_each_disk_rim_in_its_frame(abd):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     a, b = body.a, body.b
     frame_a, frame_b = disk_frames(body, 'rover')
     geometry = body.phase_geometry(PHASES)
@@ -46,7 +46,7 @@ def test_contact_points_lie_on_each_disk_rim_in_its_frame(abd):
 def test_frames_of_the_oloid_exactly():
     # disk 1: centre −Δ e2, x = −e2, y = e1, z = e3; disk 2: centre +Δ e2, x = e2, y = −e3,
     # z = −e1 (docs/physics.md's placement, axes chosen by frames.py's docstring)
-    frame_a, frame_b = disk_frames(TwoDiskBody.oloid(2.0))
+    frame_a, frame_b = disk_frames(EllipseBody.oloid(2.0))
     assert frame_a.child_frame_id == 'twodisk_body_disk_a'
     assert frame_b.child_frame_id == 'twodisk_body_disk_b'
     assert frame_a.parent_frame_id == frame_b.parent_frame_id == 'twodisk_body'
@@ -73,7 +73,7 @@ def test_bad_frame_names_are_refused_in_one_line(name):
         check_frame_id(name)
     assert '\n' not in str(error.value) and 'body_frame' in str(error.value)
     with pytest.raises(ValueError):
-        disk_frames(TwoDiskBody.oloid(), name)
+        disk_frames(EllipseBody.oloid(), name)
 
 
 def test_model_package_imports_without_ros_or_matplotlib():

@@ -26,7 +26,7 @@ from twodisk_ros.model.mesh import (DEFAULT_THICKNESS, Mesh, body_mesh, hull_mes
                                     laminae_mesh, mesh_parts)
 from twodisk_ros.model.stl import cache_directory, cached_stl, stl_bytes
 from twodisk_ros.outputs import OutputError
-from twodisk_ros.physics import TwoDiskBody
+from twodisk_ros.physics import EllipseBody
 from twodisk_ros.physics.mass.models import laminae, mass_properties, solid_hull
 
 # Oloid volume / r³ = (2/3)(2E(3/4) + K(3/4)) = 3.0524184684...
@@ -59,7 +59,7 @@ def _rim_residuals(body, points, disk=None):
 @pytest.mark.parametrize('model', ['laminae', 'solid'])
 @pytest.mark.parametrize('abd', BODIES + EXTREMES, ids=str)
 def test_meshes_are_closed_and_wound_outward(abd, model):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     for part in mesh_parts(body, model, 64).values():
         mesh = _trimesh(part)
         assert mesh.is_watertight and mesh.is_winding_consistent
@@ -77,7 +77,7 @@ def test_meshes_are_closed_and_wound_outward(abd, model):
 
 @pytest.mark.parametrize('abd', BODIES + EXTREMES, ids=str)
 def test_hull_vertices_lie_on_the_rims_and_cover_both(abd):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     mesh = hull_mesh(body, 128)
     plane, rim, on_1 = _rim_residuals(body, mesh.vertices)
     # the closed forms' accuracy (body.py): lengths to 2e-14 of the size, 2e-13 at extremes;
@@ -94,7 +94,7 @@ def test_hull_vertices_lie_on_the_rims_and_cover_both(abd):
 
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_plate_vertices_project_onto_the_rims(abd):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     half = DEFAULT_THICKNESS * body.size / 2
     disk_a, disk_b = mesh_parts(body, 'custom', 64).values()
     for index, part in enumerate((disk_a, disk_b)):
@@ -120,7 +120,7 @@ def _solid_errors(body, resolution, reference):
 
 def test_oloid_hull_volume_converges_to_the_closed_form_at_second_order():
     radius = 0.3
-    body = TwoDiskBody.oloid(radius)
+    body = EllipseBody.oloid(radius)
     errors = []
     for n in (64, 128, 256, 512):
         volume = _trimesh(body_mesh(body, 'solid', n)).volume
@@ -137,7 +137,7 @@ def test_oloid_hull_volume_converges_to_the_closed_form_at_second_order():
 
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_hull_volume_and_inertia_match_the_solid_model_within_resolution(abd):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     reference = solid_hull(*abd, 2.5, rtol=1e-12)
     volume, inertia = np.array([_solid_errors(body, n, reference) for n in (128, 256, 512)]).T
     n2 = np.array([128, 256, 512]) ** 2
@@ -149,7 +149,7 @@ def test_hull_volume_and_inertia_match_the_solid_model_within_resolution(abd):
 
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_plate_inertia_matches_the_laminae_model_thickened(abd):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     mass = 1.7
     thickness = DEFAULT_THICKNESS * body.size
     # two plates of mass M/2, each thickened by h: + (M/2) h²/12 about both in-plane axes;
@@ -175,7 +175,7 @@ def test_plate_inertia_matches_the_laminae_model_thickened(abd):
 
 
 def test_model_choice_and_defaults():
-    body = TwoDiskBody(2.0, 1.0, 1.0)
+    body = EllipseBody(2.0, 1.0, 1.0)
     solid = mass_properties('solid', 2.0, 1.0, 1.0, 1.0)
     assert list(mesh_parts(body, solid)) == ['hull']
     assert list(mesh_parts(body, 'laminae')) == ['disk_a', 'disk_b']
@@ -192,7 +192,7 @@ def test_model_choice_and_defaults():
                                     dict(thickness=5.0), dict(thickness='thin')])
 def test_bad_mesh_arguments_are_refused_in_one_line(kwargs):
     with pytest.raises(ValueError) as error:
-        body_mesh(TwoDiskBody.oloid(), **{'mass_model': 'laminae', **kwargs})
+        body_mesh(EllipseBody.oloid(), **{'mass_model': 'laminae', **kwargs})
     assert '\n' not in str(error.value)
     assert next(iter(kwargs)) in str(error.value)
 
@@ -206,7 +206,7 @@ def test_mesh_validates_its_arrays():
 
 @pytest.mark.parametrize('model', ['laminae', 'solid'])
 def test_stl_read_back_by_trimesh_is_the_mesh(model):
-    mesh = body_mesh(TwoDiskBody(0.8, 2.0, 0.3), model, 32)
+    mesh = body_mesh(EllipseBody(0.8, 2.0, 0.3), model, 32)
     data = stl_bytes(mesh)
     assert len(data) == 84 + 50 * len(mesh.faces)
     loaded = trimesh.load(io.BytesIO(data), file_type='stl', process=False)
@@ -221,7 +221,7 @@ def test_stl_read_back_by_trimesh_is_the_mesh(model):
 def test_cache_is_content_addressed_and_atomic(tmp_path, monkeypatch):
     monkeypatch.setenv('XDG_CACHE_HOME', str(tmp_path / 'xdg'))
     assert cache_directory() == tmp_path / 'xdg' / 'twodisk_ros' / 'meshes'
-    oloid = body_mesh(TwoDiskBody.oloid(), 'solid', 32)
+    oloid = body_mesh(EllipseBody.oloid(), 'solid', 32)
     path = cached_stl(oloid)
     assert path.parent == cache_directory() and path.is_absolute()
     assert path.read_bytes() == stl_bytes(oloid)
@@ -229,10 +229,10 @@ def test_cache_is_content_addressed_and_atomic(tmp_path, monkeypatch):
     assert path.stem == hashlib.sha256(path.read_bytes()).hexdigest()
     # the same mesh again: the same file, not rewritten
     inode, mtime = path.stat().st_ino, path.stat().st_mtime_ns
-    assert cached_stl(body_mesh(TwoDiskBody.oloid(), 'solid', 32)) == path
+    assert cached_stl(body_mesh(EllipseBody.oloid(), 'solid', 32)) == path
     assert (path.stat().st_ino, path.stat().st_mtime_ns) == (inode, mtime)
     # another body: another file; nothing else (no temporary file) left in the directory
-    other = cached_stl(body_mesh(TwoDiskBody.oloid(1.5), 'solid', 32))
+    other = cached_stl(body_mesh(EllipseBody.oloid(1.5), 'solid', 32))
     assert other != path
     assert sorted(os.listdir(path.parent)) == sorted([path.name, other.name])
     # XDG_CACHE_HOME relative or empty: ~/.cache, as the XDG rules say
@@ -246,6 +246,6 @@ def test_cache_that_cannot_be_written_says_so_in_one_line(tmp_path):
     blocker = tmp_path / 'a_file'
     blocker.write_text('not a directory')
     with pytest.raises(OutputError) as error:
-        cached_stl(body_mesh(TwoDiskBody.oloid(), 'solid', 16), blocker / 'meshes')
+        cached_stl(body_mesh(EllipseBody.oloid(), 'solid', 16), blocker / 'meshes')
     assert '\n' not in str(error.value) and 'XDG_CACHE_HOME' in str(error.value)
     assert blocker.read_text() == 'not a directory'

@@ -25,8 +25,8 @@ from twodisk_ros.model.frames import disk_frames, disk_rims
 from twodisk_ros.model.mesh import body_mesh, mesh_parts
 from twodisk_ros.model.outline import frame_rims, lamina_outline
 from twodisk_ros.model.stl import cached_stl
-from twodisk_ros.physics import TwoDiskBody
-from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics import EllipseBody
+from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
 from twodisk_ros.physics.laminae.support import Egg
 
@@ -106,7 +106,7 @@ def test_outline_refuses_a_bad_tolerance_in_one_line():
 @pytest.mark.parametrize('body', BODIES, ids=_ids)
 def test_rims_sit_where_general_body_puts_the_laminae(body):
     lamina, delta, arrangement = body
-    general = GeneralTwoDiskBody(lamina, delta, arrangement)
+    general = ContactSolver(lamina, delta, arrangement)
     rim_1, rim_2 = disk_rims(general, 1e-4, closed=False)
     sigma = 1.0 if arrangement == 'parallel' else -1.0
     g = general.centroid
@@ -147,7 +147,7 @@ def _dense_hull_volume(lamina, delta, arrangement, centroid):
 @pytest.mark.parametrize('body', BODIES, ids=_ids)
 def test_ruled_hull_is_closed_outward_and_converges_to_the_convex_hull(body):
     lamina, delta, arrangement = body
-    general = GeneralTwoDiskBody(lamina, delta, arrangement)
+    general = ContactSolver(lamina, delta, arrangement)
     reference = _dense_hull_volume(lamina, delta, arrangement, general.centroid)
     errors = []
     for n in (128, 256, 512):
@@ -170,7 +170,7 @@ def test_ruled_hull_is_closed_outward_and_converges_to_the_convex_hull(body):
 @pytest.mark.parametrize('body', BODIES, ids=_ids)
 def test_plates_are_closed_prisms_over_the_outline(body):
     lamina, delta, arrangement = body
-    general = GeneralTwoDiskBody(lamina, delta, arrangement)
+    general = ContactSolver(lamina, delta, arrangement)
     thickness = 0.01 * general.size
     for part in mesh_parts(general, 'laminae', 256, thickness).values():
         mesh = trimesh.Trimesh(part.vertices, part.faces, process=False)
@@ -183,34 +183,34 @@ def test_plates_are_closed_prisms_over_the_outline(body):
 
 
 def test_ellipse_bodies_keep_their_closed_form_meshes():
-    # the general path is used only for other bodies: a TwoDiskBody's plates keep the
+    # the general path is used only for other bodies: a EllipseBody's plates keep the
     # eccentric-anomaly rim and its hull the closed-form rulings (tests/test_model_mesh.py)
-    body = TwoDiskBody(1.0, 1.0, 0.5)
+    body = EllipseBody(1.0, 1.0, 0.5)
     assert len(body_mesh(body, 'laminae', 64).vertices) == 2 * (2 * 64 + 2)
     assert len(body_mesh(body, 'solid', 64).vertices) == 2 * 33
 
 
 def test_mesh_cache_key_distinguishes_shapes(tmp_path):
     # the same a, b, Δ, three shapes: three files; the same shape again: the same file
-    bodies = [TwoDiskBody(1.0, 1.0, 0.5),
-              GeneralTwoDiskBody(Superellipse(1.0, 1.0, 4), 0.5),
-              GeneralTwoDiskBody(Superellipse(1.0, 1.0, 6), 0.5)]
+    bodies = [EllipseBody(1.0, 1.0, 0.5),
+              ContactSolver(Superellipse(1.0, 1.0, 4), 0.5),
+              ContactSolver(Superellipse(1.0, 1.0, 6), 0.5)]
     for model in ('laminae', 'solid'):
         paths = [cached_stl(body_mesh(body, model, 64), tmp_path) for body in bodies]
         assert len(set(paths)) == 3
-        again = cached_stl(body_mesh(GeneralTwoDiskBody(Superellipse(1.0, 1.0, 6), 0.5),
+        again = cached_stl(body_mesh(ContactSolver(Superellipse(1.0, 1.0, 6), 0.5),
                                      model, 64), tmp_path)
         assert again == paths[-1]
 
 
 def test_disk_frames_follow_the_centroid_of_an_egg():
-    general = GeneralTwoDiskBody(Egg(1.0, 0.8, 0.06), 0.4)
+    general = ContactSolver(Egg(1.0, 0.8, 0.06), 0.4)
     g = general.centroid[1]
     assert abs(g) > 1e-3                        # the egg's centroid is off its centre
     frame_a, frame_b = disk_frames(general)
     assert np.array_equal(frame_a.translation, [0.0, -0.4 - g, 0.0])
     assert np.array_equal(frame_b.translation, [0.0, 0.4 - g, 0.0])
     # for an ellipse body the frames are exactly the old ones, (0, ∓Δ, 0)
-    frame_a, frame_b = disk_frames(TwoDiskBody(2.0, 1.0, 1.0))
+    frame_a, frame_b = disk_frames(EllipseBody(2.0, 1.0, 1.0))
     assert np.array_equal(frame_a.translation, [0.0, -1.0, 0.0])
     assert np.array_equal(frame_b.translation, [0.0, 1.0, 0.0])

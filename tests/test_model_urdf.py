@@ -25,7 +25,7 @@ from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.stl import stl_bytes
 from twodisk_ros.model.urdf import body_description, robot_description
-from twodisk_ros.physics import TwoDiskBody, mass_properties
+from twodisk_ros.physics import EllipseBody, mass_properties
 from twodisk_ros.model import palette
 
 # yourdfpy 0.0.60 calls a trimesh method that trimesh 5 deprecates (not ours to fix)
@@ -59,7 +59,7 @@ def _check_urdf(path):
 @pytest.mark.parametrize('model', MODELS)
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_urdf_read_back_by_urdfdom_and_yourdfpy(abd, model, tmp_path):
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     mass = _mass(model, abd)
     text = body_description(body, mass, 'rover', directory=tmp_path / 'cache')
     path, urdf = _load(text, tmp_path)
@@ -111,7 +111,7 @@ def test_urdf_read_back_by_urdfdom_and_yourdfpy(abd, model, tmp_path):
 @pytest.mark.parametrize('abd', BODIES, ids=str)
 def test_urdf_disk_frames_put_the_contact_points_on_the_rims(abd, tmp_path):
     # the joint origins as the parser reads them, applied to the closed forms' A and B
-    body = TwoDiskBody(*abd)
+    body = EllipseBody(*abd)
     _, urdf = _load(robot_description(body, _mass('laminae', abd)), tmp_path)
     geometry = body.phase_geometry(np.linspace(0, 2 * np.pi, 257))
     for child, points in (('twodisk_body_disk_a', geometry.contact_a),
@@ -127,7 +127,7 @@ def test_urdf_disk_frames_put_the_contact_points_on_the_rims(abd, tmp_path):
 def test_inertial_block_holds_the_closed_forms(tmp_path):
     # laminae: I11 = I33 = M(2a² + b²)/8 + MΔ², I22 = M b²/4 (docs/physics.md), written out
     a, b, d, m = 0.3, 0.2, 0.1, 2.0
-    root = ElementTree.fromstring(robot_description(TwoDiskBody(a, b, d),
+    root = ElementTree.fromstring(robot_description(EllipseBody(a, b, d),
                                                     _mass('laminae', (a, b, d), m)))
     inertia = root.find("link[@name='twodisk_body']/inertial/inertia").attrib
     # the closed forms to rounding (16 ulps; the code may group the terms otherwise)
@@ -145,7 +145,7 @@ def test_inertial_block_holds_the_closed_forms(tmp_path):
 
 
 def test_single_uri_and_unknown_part(tmp_path):
-    body = TwoDiskBody.oloid(0.1)
+    body = EllipseBody.oloid(0.1)
     text = robot_description(body, _mass('solid', (0.1, 0.1, 0.05)), 'b',
                              'file:///tmp/x%20y.stl')
     root = ElementTree.fromstring(text)
@@ -157,7 +157,7 @@ def test_single_uri_and_unknown_part(tmp_path):
 
 def test_check_urdf_is_a_real_check(tmp_path):
     # the reference parser refuses a joint without its child link: it does check
-    body = TwoDiskBody.oloid()
+    body = EllipseBody.oloid()
     broken = robot_description(body, _mass('laminae', (1.0, 1.0, 0.5))).replace(
         '<link name="twodisk_body_disk_b" />', '')
     path = tmp_path / 'broken.urdf'
@@ -168,12 +168,12 @@ def test_check_urdf_is_a_real_check(tmp_path):
 @pytest.mark.parametrize('name', ['', 'two words', '/world'])
 def test_bad_body_frame_in_one_line(name):
     with pytest.raises(ValueError) as error:
-        robot_description(TwoDiskBody.oloid(), _mass('laminae', (1.0, 1.0, 0.5)), name)
+        robot_description(EllipseBody.oloid(), _mass('laminae', (1.0, 1.0, 0.5)), name)
     assert '\n' not in str(error.value)
 
 
 def test_a_server_can_name_the_mesh_files_its_own_way(tmp_path):
-    body = TwoDiskBody.oloid(0.1)
+    body = EllipseBody.oloid(0.1)
     text = body_description(body, _mass('laminae', (0.1, 0.1, 0.05)), directory=tmp_path,
                             uri=lambda path: f'package://twodisk_ros/meshes/{path.name}')
     names = [m.get('filename') for m in ElementTree.fromstring(text).iter('mesh')]
@@ -186,11 +186,11 @@ def test_a_server_can_name_the_mesh_files_its_own_way(tmp_path):
 def test_urdf_of_a_non_elliptic_body(model, arrangement, tmp_path):
     # an egg (not symmetric along the common axis, so G is off the centres' midpoint): the
     # parsers read its meshes, and its joint origins put the exact contact points A and B of
-    # GeneralTwoDiskBody on the egg, mapped into the disk frames as frames.py documents
-    from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+    # ContactSolver on the egg, mapped into the disk frames as frames.py documents
+    from twodisk_ros.physics.bodies.contact_solver import ContactSolver
     from twodisk_ros.physics.laminae.support import Egg
     lamina = Egg(0.2, 0.16, 0.012)
-    body = GeneralTwoDiskBody(lamina, 0.08, arrangement)
+    body = ContactSolver(lamina, 0.08, arrangement)
     # the URDF only carries the mass model's numbers: an ellipse's stand in for the egg's
     mass = _mass(model, (0.2, 0.16, 0.08))
     text = body_description(body, mass, 'rover', directory=tmp_path / 'cache')

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.mass.models import laminae
 from twodisk_ros.physics.motion.simulate import simulate
@@ -27,7 +27,7 @@ STARTS = [(0.3, 0.0), (0.0, 1.0), (0.2, 6.0)]
 
 @pytest.fixture(scope='module')
 def bodies():
-    base = TwoDiskBody(*BASE)
+    base = EllipseBody(*BASE)
     mass = laminae(*BASE, 2.0)
     return RollingDynamics(base, mass), {kind: RollingDynamics(ReparametrisedBody(base, kind),
                                                                mass)

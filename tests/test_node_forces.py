@@ -16,7 +16,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 from twodisk_ros.recordings import read_recording  # noqa: E402
-from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
+from twodisk_ros.physics import RollingDynamics, EllipseBody  # noqa: E402
 from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
 from twodisk_ros.physics.forces.validity import liftoff_speed  # noqa: E402
 from twodisk_ros.physics.mass.models import laminae  # noqa: E402
@@ -63,7 +63,7 @@ def diagnostics_values(msg):
 
 
 def model():
-    dynamics = RollingDynamics(TwoDiskBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
+    dynamics = RollingDynamics(EllipseBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
     return ContactForceModel(dynamics)
 
 

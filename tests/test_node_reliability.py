@@ -365,9 +365,9 @@ def test_direct_method_in_real_time_runs_past_its_integration_chunks(ros_context
     finally:
         node.close()
         node.destroy_node()
-    from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
+    from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
     from twodisk_ros.physics.mass.models import laminae
-    dynamics = RollingDynamics(TwoDiskBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
+    dynamics = RollingDynamics(EllipseBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
     stream = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=0.5, tolerance=1e-8)
     reference = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=100.0, tolerance=1e-8)
     times = np.arange(0.0, 1.6, 0.05)

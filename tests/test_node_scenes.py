@@ -1,7 +1,7 @@
 """The roller in scenes: slope, drive, dissipation, commands, reset and pause.
 
 References are independent of the node's scene code: today's MotionStream (flat, free),
-the closed-form body geometry (|ω| = |ω_u(u)| u̇ and the contact points of TwoDiskBody), the
+the closed-form body geometry (|ω| = |ω_u(u)| u̇ and the contact points of EllipseBody), the
 rigid-body kinematics of the recorded poses (finite differences) and the documented rules
 (first-order lag of the speed drive, dE/dt = τ|ω| of the torque drive). Batch runs in process
 in ROS domain 68; the realtime integration test drives the node from a second rclpy node in
@@ -20,13 +20,13 @@ import pytest  # noqa: E402
 
 from rounding import ulps  # noqa: E402
 from twodisk_ros.recordings import read_recording  # noqa: E402
-from twodisk_ros.physics import RollingDynamics, TwoDiskBody  # noqa: E402
+from twodisk_ros.physics import RollingDynamics, EllipseBody  # noqa: E402
 from twodisk_ros.physics.mass.models import laminae  # noqa: E402
 from twodisk_ros.physics.motion.simulate import MotionStream  # noqa: E402
 
 pytestmark = pytest.mark.ros
 BATCH_DOMAIN, LIVE_DOMAIN = 68, 67
-BODY = TwoDiskBody(0.1, 0.1, 0.05)
+BODY = EllipseBody(0.1, 0.1, 0.05)
 DYNAMICS = RollingDynamics(BODY, laminae(0.1, 0.1, 0.05, 1.0))
 
 

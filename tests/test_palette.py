@@ -64,11 +64,11 @@ def test_figures_and_animation_take_their_colours_from_the_palette():
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+    from twodisk_ros.physics.bodies.ellipse import EllipseBody
     from twodisk_ros.plotting import animation, figures
     fig, ax = plt.subplots()
     try:
-        figures.plot_traces(TwoDiskBody.oloid(), 1, ax, samples_per_cycle=50)
+        figures.plot_traces(EllipseBody.oloid(), 1, ax, samples_per_cycle=50)
         colours = {line.get_gid(): line.get_color() for line in ax.lines if line.get_gid()}
         assert colours == {'trace A': palette.A, 'trace B': palette.B}
     finally:

@@ -24,7 +24,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.bodies.orientation import quaternion_from_matrix
 from twodisk_ros.physics.numerics.tables import HermiteTable
@@ -74,7 +74,7 @@ _CYCLES = {}
 def _cycle(shape):
     """RollingCycle of a shape, built once per session (≤ 0.5 s each here)."""
     if shape not in _CYCLES:
-        _CYCLES[shape] = RollingCycle(TwoDiskBody(*shape))
+        _CYCLES[shape] = RollingCycle(EllipseBody(*shape))
     return _CYCLES[shape]
 
 
@@ -124,7 +124,7 @@ def test_quaternion_matches_closed_form_rotation(name):
 def test_quaternion_across_shapes(drawn, start):
     scale, log_ba, da = drawn
     shape = (scale, scale * math.exp(log_ba), scale * da)
-    cycle = RollingCycle(TwoDiskBody(*shape))
+    cycle = RollingCycle(EllipseBody(*shape))
     u = _phases(start, cycles=3, count=1500)
     _check_against_closed_forms(cycle, u)
     _check_continuous(cycle, np.linspace(start, start + 3 * TWO_PI, 6000))

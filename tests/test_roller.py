@@ -32,7 +32,7 @@ from nav_msgs.msg import Path as PathMsg  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from visualization_msgs.msg import MarkerArray  # noqa: E402
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.stability.equilibria import equilibria  # noqa: E402
 from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.node.roller import Roller  # noqa: E402
@@ -187,7 +187,7 @@ def test_samples_received_at_rate(oloid_run):
 
 
 def test_pose_contacts_and_state_match_body(oloid_run):
-    check_geometry(oloid_run, TwoDiskBody(0.1, 0.1, 0.05))
+    check_geometry(oloid_run, EllipseBody(0.1, 0.1, 0.05))
 
 
 def test_diagnostics_report_the_eight_equilibria(oloid_run):
@@ -195,7 +195,7 @@ def test_diagnostics_report_the_eight_equilibria(oloid_run):
     for diag in oloid_run['/diagnostics']:
         (status,) = diag.status
         assert status.name == 'twodisk_ros: roller'
-        assert_equilibria_match(diag, TwoDiskBody(0.1, 0.1, 0.05))
+        assert_equilibria_match(diag, EllipseBody(0.1, 0.1, 0.05))
 
 
 def _plane_and_polygon(outline):
@@ -217,7 +217,7 @@ def _inside_convex(points, polygon, tol):
 def test_markers(oloid_run):
     from visualization_msgs.msg import Marker
     assert oloid_run['markers']
-    size = TwoDiskBody(0.1, 0.1, 0.05).size
+    size = EllipseBody(0.1, 0.1, 0.05).size
     for array in oloid_run['markers']:
         arrows = [m for m in array.markers if m.ns == 'twodisk_forces']
         assert [m.id for m in arrows] == [100, 101]          # the contact forces
@@ -315,7 +315,7 @@ def test_parameter_changes():
         harness.clear()
         harness.spin(0.5)
         assert harness.node.simulation is simulation and harness.node.settings is settings
-        check_geometry(harness.got, TwoDiskBody(0.1, 0.1, 0.05))
+        check_geometry(harness.got, EllipseBody(0.1, 0.1, 0.05))
         stamps = [stamp_ns(m.header) for m in harness.got['pose']]
         assert np.all(np.diff(stamps) == 20_000_000)   # motion not restarted
 
@@ -323,7 +323,7 @@ def test_parameter_changes():
         assert result.successful is True
         assert harness.node.get_parameter('delta').value == 0.06
         harness.clear()
-        new_body = TwoDiskBody(0.1, 0.1, 0.06)
+        new_body = EllipseBody(0.1, 0.1, 0.06)
 
         def new_diagnostics():
             return any(abs(parse_equilibria(d)[0][3] - equilibria(new_body)[0].height) < 1e-9

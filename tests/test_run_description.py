@@ -1,6 +1,6 @@
 """The shape parameters and the run description (issue 20, "The node, the files and the tools").
 
-References are independent of the code under test: the ellipse's closed forms (TwoDiskBody's
+References are independent of the code under test: the ellipse's closed forms (EllipseBody's
 θ_max, the superellipse at n = 2 is the ellipse), the egg's closed forms (ε_max = r/8 for a
 circle, its ends at −(a + ε) and a − ε), points sampled from a known ellipse, and the energy
 integral of a free motion (tests/energy_integral.py).
@@ -17,7 +17,7 @@ from twodisk_ros.node import arguments
 from twodisk_ros.run.params_yaml import params_file_values
 from twodisk_ros.run.parameters import BY_NAME, DEFAULTS, PARAMETERS, parse_recorded
 from twodisk_ros.run.simulation import Simulation
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.run import shape as shapes
 from twodisk_ros.run.description import RunDescription
@@ -69,7 +69,7 @@ def test_an_ellipse_run_starts_where_its_parameters_say_and_is_the_energy_integr
     for the table method). The poses are the closed-form cycle at the recorded phases."""
     s = DEFAULTS.with_values(realtime=False, duration=1.0, mass_model='solid', theta0=0.7)
     simulation = Simulation(s)
-    assert isinstance(simulation.body, TwoDiskBody)
+    assert isinstance(simulation.body, EllipseBody)
     t = np.linspace(0.0, 1.0, 101)
     sample = simulation.sample(t)
     dynamics = simulation.dynamics
@@ -90,7 +90,7 @@ def test_an_ellipse_run_starts_where_its_parameters_say_and_is_the_energy_integr
 def test_superellipse_at_exponent_2_has_the_ellipse_theta_max():
     # θ_max of the general contact geometry against the closed form (agree to ~2e-16 rel.)
     for a, b, delta in ((0.1, 0.1, 0.05), (0.1, 0.03, 0.02), (0.1, 0.5, 0.09)):
-        limit = TwoDiskBody(a, b, delta).theta_max
+        limit = EllipseBody(a, b, delta).theta_max
         base = DEFAULTS.with_values(shape='superellipse', exponent=2.0, a=a, b=b, delta=delta)
         base.with_values(theta0=limit * (1 - 1e-12)).checked()
         with pytest.raises(ValueError, match='theta_max') as error:
@@ -121,7 +121,7 @@ def test_points_take_a_and_b_from_the_outline(tmp_path):
     outline = shapes.lamina_of(s)
     assert outline.fit_error < 1e-12                 # an exact ellipse is fitted to rounding
     assert shapes.axes_of(outline) == pytest.approx((A, B), rel=1e-12)
-    limit = TwoDiskBody(A, B, 0.03).theta_max
+    limit = EllipseBody(A, B, 0.03).theta_max
     with pytest.raises(ValueError, match='theta_max'):
         s.with_values(theta0=limit * (1 + 1e-9)).checked()
     s.with_values(theta0=limit * (1 - 1e-9)).checked()
@@ -323,7 +323,7 @@ def test_a_points_outline_round_trips_through_the_metadata_exactly(tmp_path):
     assert np.array_equal(outline.coefficients, fitted.coefficients)
     assert (outline.fit_error, outline.point_count) == (fitted.fit_error, 200)
     # the rebuilt outline gives the recorded body: θ_max of the ellipse it was sampled from
-    limit = TwoDiskBody(A, B, 0.03).theta_max
+    limit = EllipseBody(A, B, 0.03).theta_max
     assert shapes.theta_max_of(parsed, outline) == pytest.approx(limit, rel=1e-12)
 
 
@@ -348,6 +348,6 @@ def test_recordings_without_the_shape_parameters_are_ellipse_runs():
     old.update(a='1.0', b='0.6', delta='0.5')
     run, problems = RunDescription.from_recorded(old)
     assert problems == [] and run.settings.shape == 'ellipse'
-    assert isinstance(run.body, TwoDiskBody)
-    assert run.body.theta_max == TwoDiskBody(1.0, 0.6, 0.5).theta_max
+    assert isinstance(run.body, EllipseBody)
+    assert run.body.theta_max == EllipseBody(1.0, 0.6, 0.5).theta_max
     assert 'ellipse a = 1 m, b = 0.6 m, delta = 0.5 m' == run.shape_line

@@ -24,7 +24,7 @@ import pytest
 from scipy.integrate import cumulative_simpson
 from scipy.spatial.transform import Rotation
 
-from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
+from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.physics.scenes.scene import Scene, quaternion_product
 from twodisk_ros.physics.scenes.events import first_failure, settle
@@ -55,7 +55,7 @@ _DYNAMICS = {}
 
 def dynamics_of(shape):
     if shape not in _DYNAMICS:
-        _DYNAMICS[shape] = RollingDynamics(TwoDiskBody(*shape),
+        _DYNAMICS[shape] = RollingDynamics(EllipseBody(*shape),
                                            mass_properties('laminae', *shape, MASS), GRAVITY)
     return _DYNAMICS[shape]
 

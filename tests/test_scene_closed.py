@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
-from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
+from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.physics.scenes.scene import Scene, command_error
 from twodisk_ros.physics.scenes.closed import (DriftQuadrature, OscillationSolution,
@@ -40,7 +40,7 @@ _DYNAMICS = {}
 
 def dynamics_of(shape=OLOID):
     if shape not in _DYNAMICS:
-        _DYNAMICS[shape] = RollingDynamics(TwoDiskBody(*shape),
+        _DYNAMICS[shape] = RollingDynamics(EllipseBody(*shape),
                                            mass_properties('laminae', *shape, 1.0))
     return _DYNAMICS[shape]
 
@@ -212,7 +212,7 @@ def test_good_commands_are_accepted():
 @pytest.mark.parametrize('scene', [Scene(slope=0.05), Scene(damping=0.01)])
 def test_scenes_use_only_the_rolling_body_protocol(scene):
     """The ellipse through another phase v (u = v + 0.3 sin 2v) moves the same in time."""
-    base = TwoDiskBody(*OLOID)
+    base = EllipseBody(*OLOID)
     mass = mass_properties('laminae', *OLOID, 1.0)
     double = ReparametrisedBody(base, 'smooth')
     results = []

@@ -25,7 +25,7 @@ import pytest
 from reparametrised_body import ReparametrisedBody
 from test_scene import d5, kinematics, stencil
 import test_scene
-from twodisk_ros.physics import MotionStream, RollingDynamics, TwoDiskBody
+from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.laminae.shapes import Superellipse
 from twodisk_ros.physics.laminae.support import Egg
@@ -53,7 +53,7 @@ def dynamics_of(name):
             body, mass = LaminaBody(lamina, delta), laminae_of(lamina, delta, 'parallel', MASS)
         else:
             shape = (0.1, 0.1, 0.05)
-            base = TwoDiskBody(*shape)
+            base = EllipseBody(*shape)
             body = base if name == 'ellipse' else ReparametrisedBody(base, 'degenerate')
             mass = mass_properties('laminae', *shape, MASS)
         _DYNAMICS[name] = RollingDynamics(body, mass, GRAVITY)

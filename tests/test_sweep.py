@@ -19,7 +19,7 @@ import pytest
 from dask_helpers import free_port
 from harsh_start import harshly
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import liftoff_speed, mu_required_kinematic
 from twodisk_ros.physics.bodies.cycle import RollingCycle
@@ -97,7 +97,7 @@ def _library(b, d, reference_speed=0.5):
     are checked against other library calls in :func:`_check_derived`, never by the sweep's
     own formulas.
     """
-    body = TwoDiskBody(1.0, b, d)
+    body = EllipseBody(1.0, b, d)
     cycle = RollingCycle(body)
     dyn = RollingDynamics(body, mass_properties('laminae', 1.0, b, d, 1.0), 1.0, cycle=cycle)
     heights = [eq.height for eq in equilibria(body)]

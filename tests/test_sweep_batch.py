@@ -16,7 +16,7 @@ import pytest
 
 from paper_forms import curvature_at_half_pi, curvature_at_theta0
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.mass.models import mass_properties
@@ -67,7 +67,7 @@ def _paper_period(b, d, mass_model):
     forms and dθ/du from the phase's definition (tan θ = (b/a) tan(η_max sin u)): dθ/du =
     (b/a) η_max at θ* = 0 (u* = 0), (a/b) η_max cos u* at θ* = π/2; m(u*) is the library's
     closed form (RollingDynamics.effective_mass; the cycle's tables are not used)."""
-    body = TwoDiskBody(1.0, b, d)
+    body = EllipseBody(1.0, b, d)
     dyn = RollingDynamics(body, mass_properties(mass_model, 1.0, b, d, 1.0), 1.0,
                           cycle=RollingCycle(body, resolution=512))
     if body.stability_margin > 0:
@@ -227,18 +227,18 @@ def test_a_block_that_raises_goes_through_the_scalar_path(monkeypatch):
 
 
 def test_cycle_samples_are_the_scalar_bodys_closed_forms():
-    # TwoDiskBodies.cycle_samples against TwoDiskBody body by body: values are the same
+    # EllipseBodies.cycle_samples against EllipseBody body by body: values are the same
     # closed forms (measured ≤ 3.5e-16 of the largest; bitwise at the edges), and ω_u, whose
     # u-derivatives of n and t1 are closed forms in the batch, against the scalar body's
     # complex step (measured ≤ 3.1e-13 of max |ω_u| at b/a = 0.01, ≤ 3e-15 elsewhere)
-    from twodisk_ros.physics.bodies.ellipse_batch import TwoDiskBodies
+    from twodisk_ros.physics.bodies.ellipse_batch import EllipseBodies
     b = np.array([0.01, 0.01, 100.0, 100.0, 1.0, 0.3])
     d = np.array([1e-3, 1 - 1e-6, 1e-3, 1 - 1e-6, 0.5, 0.2])
     n = 4096
-    samples = TwoDiskBodies(1.0, b, d).cycle_samples(n)
+    samples = EllipseBodies(1.0, b, d).cycle_samples(n)
     u = 2 * math.pi * np.arange(n) / n
     for k in range(b.size):
-        body = TwoDiskBody(1.0, b[k], d[k])
+        body = EllipseBody(1.0, b[k], d[k])
         geo = body.phase_geometry(u)
         for got, want in ((samples.contact_a[:, :, k].T, geo.contact_a),
                           (samples.contact_b[:, :, k].T, geo.contact_b),

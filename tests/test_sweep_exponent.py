@@ -4,7 +4,7 @@ References, none of them the code under test:
 
 - n = 2 is today's sweep: its plane equals, bit for bit, the batched path called directly on
   the same blocks (what a task computed before the axis existed) and a sweep of n = 2 alone;
-- the per-body general path is exercised with a fake body factory (the ellipse TwoDiskBody
+- the per-body general path is exercised with a fake body factory (the ellipse EllipseBody
   and its closed-form mass model for every n): its values must then be the ellipse's, which
   the batched closed forms compute by other code (arrays, fixed-angle equilibria, the
   roll-over speed from m(u*) and ω_u instead of I_AB);
@@ -21,7 +21,7 @@ import re
 import numpy as np
 import pytest
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.sweep import general
 from twodisk_ros.sweep.batch import batch_quantities
@@ -42,7 +42,7 @@ OWN_MEANING = {'stability_margin'}
 
 def fake_body(b, d, n):
     """The ellipse (a, b, Δ) = (1, b, d) whatever n: a RollingBody with closed forms."""
-    return TwoDiskBody(1.0, b, d)
+    return EllipseBody(1.0, b, d)
 
 
 def fake_mass(model, body):

@@ -3,7 +3,7 @@ equilibria against independent references.
 
 References, sharing no code with the module under test:
 
-* the height of G along the rolling motion from GeneralTwoDiskBody's contact geometry (the
+* the height of G along the rolling motion from ContactSolver's contact geometry (the
   support-function solve of general_body.py), differentiated numerically here: z_G is sampled
   at six poses whose rolling angle γ (the signed angle between the ground normal n and its
   value at the equilibrium, both in the body frame) is about ±h, ±h/2, ±h/4, and
@@ -14,7 +14,7 @@ References, sharing no code with the module under test:
 * at flat vertices (superellipse, n > 2), the height at |p| = 1e-3 and 1e-4, p the component
   of n named by the equilibrium, found by brentq on the charts, against the two-term
   expansion A|p|^q + B p², whose remainder is O(|p|^2q) (measured ≤ 0.45 L|p|^2q, L below);
-* for ellipses, TwoDiskBody's closed forms (the paper's margin s = b² − 2a² + 2Δ², its
+* for ellipses, EllipseBody's closed forms (the paper's margin s = b² − 2a² + 2Δ², its
   d²z_G/dθ² with dγ/dθ from central differences of its ground normal), and the small-
   oscillation period of RollingDynamics (effective mass and V″ in the phase u).
 """
@@ -28,9 +28,9 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from scipy.optimize import brentq
 
 from rounding import ulps
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
-from twodisk_ros.physics.bodies.contact_solver import GeneralTwoDiskBody
+from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
 from twodisk_ros.physics.laminae.support import Egg, SupportLamina
 from twodisk_ros.physics.laminae.fit import Outline
@@ -158,7 +158,7 @@ def _agrees(value, reference, tolerance):
 # -- ellipses: the paper's margin and curvatures ---------------------------------------------
 @pytest.mark.parametrize('a, b, delta', ELLIPSES)
 def test_ellipse_reduces_to_the_paper_margin(a, b, delta):
-    ref = TwoDiskBody(a, b, delta)
+    ref = EllipseBody(a, b, delta)
     s, w2 = ref.stability_margin, b * b + 4 * a * delta + 4 * delta * delta
     first, turning, side = symmetric_equilibria(Ellipse(a, b), delta)
     # claim: the criteria are b²(a + Δ)/(aW)·s at the tips and −s at the sides, exactly (the
@@ -187,7 +187,7 @@ def test_ellipse_reduces_to_the_paper_margin(a, b, delta):
 def test_period_is_that_of_a_rotation_about_the_contact_line(a, b, delta):
     """T = 2π √(I_AB / (M g d²z_G/dγ²)) against RollingDynamics' 2π √(m(u)/V″(u))."""
     mass, gravity = 1.0, 9.81
-    ref = TwoDiskBody(a, b, delta)
+    ref = EllipseBody(a, b, delta)
     dynamics = RollingDynamics(ref, mass_properties('laminae', a, b, delta, mass),
                                gravity=gravity)
     periods = {eq.name: period for eq, period in dynamics.equilibria_with_periods()}
@@ -221,7 +221,7 @@ def _mutants(eq):
 
 @pytest.mark.parametrize('lamina, delta, arrangement', SMOOTH, ids=SMOOTH_IDS)
 def test_curvature_against_finite_differences(lamina, delta, arrangement):
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     size = body.size
     for eq in symmetric_equilibria(lamina, delta, arrangement):
         slope, curvature, estimate, centre = _height_jet(body, eq)
@@ -262,7 +262,7 @@ FLAT = [(n, b) for n in (2.05, 2.5, 4.0, 10.0, 100.0) for b in (1.0, 0.4)]
 def _flat_body(n, b):
     """The superellipse body of FLAT at Δ = 0.5, built once (its tilt chart's steepest pose
     costs ~1 s): shared by the leading-term and tiny-well tests."""
-    return GeneralTwoDiskBody(Superellipse(1.0, b, n), 0.5)
+    return ContactSolver(Superellipse(1.0, b, n), 0.5)
 
 
 @pytest.mark.parametrize('n, b', FLAT)
@@ -303,7 +303,7 @@ def test_nearly_elliptic_flat_tip_has_a_tiny_well():
 # -- neutral cases -----------------------------------------------------------------------------
 @pytest.mark.parametrize('a, b, delta', [(1.0, 1.0, 1 / math.sqrt(2)), (math.sqrt(1.5), 1, 1)])
 def test_neutral_ellipses(a, b, delta):
-    body = GeneralTwoDiskBody(Ellipse(a, b), delta)
+    body = ContactSolver(Ellipse(a, b), delta)
     for eq in symmetric_equilibria(Ellipse(a, b), delta):
         assert eq.stability == 'neutral' and 'higher orders decide' in eq.verdict
         _, curvature, estimate, _ = _height_jet(body, eq)
@@ -322,7 +322,7 @@ def test_neutral_delta_is_where_the_numerical_curvature_changes_sign(lamina, arr
     assert symmetric_equilibria(lamina, neutral, arrangement)[which].stability == 'neutral'
     curvatures = []
     for delta in (neutral - 0.05, neutral, neutral + 0.05):
-        body = GeneralTwoDiskBody(lamina, delta, arrangement)
+        body = ContactSolver(lamina, delta, arrangement)
         eq = symmetric_equilibria(lamina, delta, arrangement)[which]
         _, curvature, estimate, _ = _height_jet(body, eq)
         curvatures.append((curvature, estimate + FD_FLOOR * body.size))
@@ -353,7 +353,7 @@ def test_the_tip_criterion_is_not_a_function_of_vertex_data():
             v = lamina.vertex(axis)
             assert (v.extent == pytest.approx(1.0, abs=ulps(16))
                     and v.radius == pytest.approx(1.0))
-        body = GeneralTwoDiskBody(lamina, delta)
+        body = ContactSolver(lamina, delta)
         first, _, side = symmetric_equilibria(lamina, delta)
         _, curvature, estimate, _ = _height_jet(body, first)
         assert _agrees(first.curvature, curvature, estimate + FD_FLOOR * body.size)
@@ -366,7 +366,7 @@ def test_the_tip_criterion_is_not_a_function_of_vertex_data():
 # 12 examples: each checks every equilibrium of its body (tips, turning point, sides) against
 # the finite differences; 4 kinds × 2 arrangements are drawn ~1.5 times each per run, and the
 # named shapes above (SMOOTH, FLAT) cover every kind and arrangement deterministically. An
-# example costs ~1.5 s (the turning point's tilt chart needs GeneralTwoDiskBody.steepest).
+# example costs ~1.5 s (the turning point's tilt chart needs ContactSolver.steepest).
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(kind=st.sampled_from(['ellipse', 'superellipse', 'egg', 'outline']),
        a=st.floats(0.3, 3.0), b=st.floats(0.3, 3.0), n=st.floats(2.0, 100.0),
@@ -388,7 +388,7 @@ def test_any_shape_gives_an_answer_that_numerics_confirm_or_one_line(
     except ValueError as error:
         assert str(error) and '\n' not in str(error)
         return
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     for eq in found:
         if eq.order == 2.0:
             slope, curvature, estimate, _ = _height_jet(body, eq)

@@ -32,7 +32,7 @@ from batch_recording import record
 from foxglove_client import SUBPROTOCOL, collect, refused, stamp_ns
 from view_process import ENV, RUNNER, View, wait_for_handlers
 from twodisk_ros.model.mesh import mesh_parts
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.mass.models import mass_properties
@@ -53,7 +53,7 @@ def _oloid_parameters():
 def _library(p, t):
     """Poses, contacts and ground forces of the parameters ``p`` at times ``t`` (s): the
     physics library, called here independently of the command."""
-    body = TwoDiskBody(p['a'], p['b'], p['delta'])
+    body = EllipseBody(p['a'], p['b'], p['delta'])
     mass = mass_properties(p['mass_model'], p['a'], p['b'], p['delta'], p['mass'])
     dynamics = RollingDynamics(body, mass, p['gravity'])
     motion = simulate(dynamics, t, mode=p['mode'], theta0=p['theta0'], branch=p['branch'],
@@ -268,7 +268,7 @@ def _check_body(update, p, parts):
 def test_live_body_mesh_and_parameters(live):
     received, *_ = live
     p = _oloid_parameters()
-    parts = mesh_parts(TwoDiskBody(p['a'], p['b'], p['delta']), p['mass_model'])
+    parts = mesh_parts(EllipseBody(p['a'], p['b'], p['delta']), p['mass_model'])
     assert set(parts) == {'disk_a', 'disk_b'}
     _check_body(received.messages['/body'][0][1], p, parts)
     shown = received.messages['/parameters'][0][1]['parameters']
@@ -283,7 +283,7 @@ def test_solid_body_is_the_grey_hull(sparse_solid):
     _, received, status, stderr, _ = sparse_solid
     assert status == 0, stderr
     p = dict(_oloid_parameters(), mass_model='solid')
-    parts = mesh_parts(TwoDiskBody(p['a'], p['b'], p['delta']), 'solid')
+    parts = mesh_parts(EllipseBody(p['a'], p['b'], p['delta']), 'solid')
     assert set(parts) == {'hull'}
     _check_body(received.messages['/body'][0][1], p, parts)
 

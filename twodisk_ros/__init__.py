@@ -16,14 +16,16 @@ Folders are the architecture, in layers (README "Layout"; enforced by import-lin
   (numpy/scipy only).
 
 The physics is re-exported here (imported on first use):
-``from twodisk_ros import TwoDiskBody, simulate``.
+``from twodisk_ros import EllipseBody, simulate`` (``TwoDiskBody``, the ellipse body's former
+name, is the same class).
 """
 
 import importlib
 
-_PHYSICS = ('CycleDisplacement', 'Equilibrium', 'MassProperties', 'PhaseGeometry', 'RollingCycle',
-            'RollingDynamics', 'RollingMotion', 'RollingState', 'TwoDiskBody', 'equilibria',
-            'integrate_contact_trace', 'mass_properties', 'simulate', 'stability_map')
+_PHYSICS = ('CycleDisplacement', 'EllipseBody', 'Equilibrium', 'MassProperties', 'PhaseGeometry',
+            'RollingCycle', 'RollingDynamics', 'RollingMotion', 'RollingState', 'TwoDiskBody',
+            'equilibria', 'integrate_contact_trace', 'mass_properties', 'simulate',
+            'stability_map')
 
 
 def __getattr__(name):
@@ -37,7 +39,7 @@ def __getattr__(name):
 __version__ = '0.1.0'
 
 __all__ = [
-    'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState', 'CycleDisplacement',
-    'integrate_contact_trace', 'Equilibrium', 'equilibria', 'stability_map', 'MassProperties',
+    'EllipseBody', 'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState',
+    'CycleDisplacement', 'integrate_contact_trace', 'Equilibrium', 'equilibria', 'stability_map', 'MassProperties',
     'mass_properties', 'RollingDynamics', 'RollingMotion', 'simulate', '__version__',
 ]

@@ -46,7 +46,7 @@ class Run:
     ``quaternion`` holds the orientations as sampled or recorded (x, y, z, w, body → world),
     ``stamp_ns`` the recorded header stamps (ns; None for a library run), ``settings`` the
     node's settings the run was made with (for a recording: the last recorded). ``body`` is
-    any body with a ``lamina`` (TwoDiskBody, LaminaBody, GeneralTwoDiskBody).
+    any body with a ``lamina`` (EllipseBody, LaminaBody, ContactSolver).
     """
 
     body: object

@@ -2,7 +2,7 @@
 
 Everything is recomputed from the recorded messages and the recorded parameters alone.
 
-The checks (L is the body size, :attr:`TwoDiskBody.size`; X = max(L, max |G|) the coordinate
+The checks (L is the body size, :attr:`EllipseBody.size`; X = max(L, max |G|) the coordinate
 scale, so that round-off far from the origin is allowed for):
 
 ``inputs``
@@ -14,7 +14,7 @@ scale, so that round-off far from the origin is allowed for):
     (sin β, 0, cos β), the ground through the origin).
 ``contact_points``
     A and B where the body puts them: |A − (G + R r1(u))| and |B − (G + R r2(u))| ≤ 1e-8 X,
-    r1, r2 from :meth:`TwoDiskBody.phase_geometry` at the recorded phase u.  The recorded
+    r1, r2 from :meth:`EllipseBody.phase_geometry` at the recorded phase u.  The recorded
     values are float64 from closed forms and tables accurate to ~1e-13 L, so anything above
     the tolerance is an inconsistency, not round-off.
 ``tangent_plane``

@@ -1,6 +1,6 @@
 """The body as a robot description: disk frames, meshes and a URDF (no ROS, no matplotlib).
 
-Any body: a TwoDiskBody (ellipses), a LaminaBody or a GeneralTwoDiskBody (any lamina).
+Any body: a EllipseBody (ellipses), a LaminaBody or a ContactSolver (any lamina).
 
 - :mod:`~twodisk_ros.model.outline`: the laminae's outlines as polygons of a stated error,
   where every drawer (meshes, markers, Foxglove, animation) takes its rims;

@@ -21,7 +21,7 @@ and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
     centre C2 = +Δ e2 − G; x = +e2, y = −e3, z = −e1.
 
 G is the laminae's centroid seen from the midpoint of the centres
-(:attr:`GeneralTwoDiskBody.centroid <twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody>`,
+(:attr:`ContactSolver.centroid <twodisk_ros.physics.bodies.contact_solver.ContactSolver>`,
 along e2): zero for laminae symmetric along the common axis (ellipses, superellipses), not
 for an egg in the 'parallel' arrangement. A body moved by
 :meth:`LaminaBody.about <twodisk_ros.physics.bodies.lamina_body.LaminaBody.about>` (the solid egg,
@@ -98,11 +98,11 @@ class DiskFrame:
 
 
 def disk_frames(body, body_frame='twodisk_body'):
-    """The two disk frames of ``body`` (a TwoDiskBody), relative to ``body_frame``.
+    """The two disk frames of ``body`` (a EllipseBody), relative to ``body_frame``.
 
     Parameters
     ----------
-    body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
+    body : EllipseBody, LaminaBody or ContactSolver
         Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.model.outline.body_shape`).
     body_frame : str
         The parent frame's name (see :func:`check_frame_id`).

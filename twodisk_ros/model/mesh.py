@@ -2,8 +2,8 @@
 
 Body frame ``G e1 e2 e3`` as in docs/physics.md (metres). Every mesh is closed (each edge is
 shared by exactly two faces) and its faces are wound counter-clockwise seen from outside, so
-their right-hand normals point out. Any body: a TwoDiskBody (ellipses, closed forms), a
-LaminaBody or a GeneralTwoDiskBody (any lamina, ``body.lamina``).
+their right-hand normals point out. Any body: a EllipseBody (ellipses, closed forms), a
+LaminaBody or a ContactSolver (any lamina, ``body.lamina``).
 
 ``'laminae'`` (and ``'custom'``, whose geometry is the same two disks)
     Each disk as a thin plate: a closed prism over its rim, ``thickness`` thick, centred on
@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody
+from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.mass.models import MODELS
 
 from .frames import disk_frames
@@ -54,7 +54,7 @@ __all__ = ['Mesh', 'body_mesh', 'mesh_parts', 'laminae_mesh', 'hull_mesh', 'merg
 
 #: Rim vertices per disk (laminae) and phase steps per cycle (solid hull).
 DEFAULT_RESOLUTION = 256
-#: Thickness of the laminae's plates, as a fraction of the body's size L (TwoDiskBody.size).
+#: Thickness of the laminae's plates, as a fraction of the body's size L (EllipseBody.size).
 DEFAULT_THICKNESS = 0.02
 
 
@@ -134,7 +134,7 @@ def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickne
 
     Parameters
     ----------
-    body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
+    body : EllipseBody, LaminaBody or ContactSolver
     mass_model : str or twodisk_ros.physics.mass.models.MassProperties
         ``'solid'`` gives the convex hull (:func:`hull_mesh`); ``'laminae'`` and ``'custom'``
         the two plates (:func:`laminae_mesh`).
@@ -181,7 +181,7 @@ def _plates(body, resolution, thickness):
         raise ValueError(f'thickness must be a number of metres in (0, size = {body.size!r}), '
                          f'got {thickness!r}')
     half = 0.5 * float(thickness)
-    if isinstance(body, TwoDiskBody):
+    if isinstance(body, EllipseBody):
         angle = 2 * np.pi * np.arange(n) / n
         rim = np.stack([body.a * np.cos(angle), body.b * np.sin(angle)], axis=-1)
         # exact values where the rim meets the axes (cos, sin of multiples of π/2)
@@ -218,7 +218,7 @@ def hull_mesh(body, resolution=DEFAULT_RESOLUTION):
     """The convex hull of the two rims (see the module docstring), body frame (m)."""
     from scipy.spatial import ConvexHull
     n = _resolution(resolution)
-    if not isinstance(body, TwoDiskBody):
+    if not isinstance(body, EllipseBody):
         return Mesh(*ruled_hull(body, n))
     u = 2 * np.pi * np.arange(n) / n
     geometry_a = body.phase_geometry(u[(u <= np.pi / 2) | (u >= 3 * np.pi / 2)])

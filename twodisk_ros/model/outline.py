@@ -19,7 +19,7 @@ the lamina (``lamina.point``). :func:`resolution_tolerance` converts a mesh reso
 
 **In the body.** Body frame G e1 e2 e3 (m). With general_body.py's placement, disk 1's
 lamina point (x, y) sits at (x, y − Δ, 0) − G and disk 2's at (0, Δ + σy, x) − G, σ = ±1 the
-arrangement ('parallel', 'swapped'); G = GeneralTwoDiskBody(lamina, Δ, arrangement).centroid,
+arrangement ('parallel', 'swapped'); G = ContactSolver(lamina, Δ, arrangement).centroid,
 the midpoint of the centres for laminae symmetric along y (ellipses, superellipses). A body
 moved by :meth:`LaminaBody.about <twodisk_ros.physics.bodies.lamina_body.LaminaBody.about>` (its
 origin P = ``body.origin``, the centre of mass of a solid egg) is drawn about P: every
@@ -125,7 +125,7 @@ class BodyShape:
 
 
 def body_shape(body):
-    """:class:`BodyShape` of a TwoDiskBody, a LaminaBody or a GeneralTwoDiskBody."""
+    """:class:`BodyShape` of a EllipseBody, a LaminaBody or a ContactSolver."""
     arrangement = body.arrangement
     if arrangement not in ARRANGEMENTS:
         raise ValueError(f'arrangement must be one of {sorted(ARRANGEMENTS)}, '

@@ -5,7 +5,7 @@ segments AB between the two contact points of the resting poses (docs/physics.md
 models): each resting pose's ground plane touches the hull along its AB. So the hull's
 surface is sampled by rulings and triangulated as strips between consecutive ones.
 
-**Sampling.** :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody` gives the
+**Sampling.** :class:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver` gives the
 resting poses exactly (bisection to the last bit) in two charts: the contact angle θ of A
 (:meth:`geometry`) from θ = 0 to θ_mid, and the tilt of disk 1 (:meth:`geometry_at_tilt`)
 from there to the turning point θ_max, where ψ(θ) ~ √(θ_max − θ) and the θ chart is

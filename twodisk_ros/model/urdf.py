@@ -77,7 +77,7 @@ def robot_description(body, mass, body_frame='twodisk_body', mesh_uris=None, *,
 
     Parameters
     ----------
-    body : twodisk_ros.physics.bodies.ellipse.TwoDiskBody
+    body : twodisk_ros.physics.bodies.ellipse.EllipseBody
     mass : twodisk_ros.physics.mass.models.MassProperties
         Mass (kg), centre of mass (m) and inertia about G (kg m²), body frame.
     body_frame : str

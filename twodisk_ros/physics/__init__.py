@@ -16,14 +16,17 @@ The names below are the library's public API (also importable from :mod:`twodisk
 """
 
 from .bodies.cycle import CycleDisplacement, RollingCycle, RollingState, integrate_contact_trace
-from .bodies.ellipse import PhaseGeometry, TwoDiskBody
+from .bodies.ellipse import EllipseBody, PhaseGeometry
 from .mass.models import MassProperties, mass_properties
 from .motion.dynamics import RollingDynamics
 from .motion.simulate import MotionStream, RollingMotion, simulate, simulate_phase
 from .stability.equilibria import Equilibrium, equilibria, stability_map
 
+#: The ellipse body's former name (the same class), so that existing scripts run.
+TwoDiskBody = EllipseBody
+
 __all__ = [
-    'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState', 'CycleDisplacement',
+    'EllipseBody', 'TwoDiskBody', 'PhaseGeometry', 'RollingCycle', 'RollingState', 'CycleDisplacement',
     'integrate_contact_trace', 'Equilibrium', 'equilibria', 'stability_map', 'MassProperties',
     'mass_properties', 'RollingDynamics', 'RollingMotion', 'MotionStream', 'simulate',
     'simulate_phase',

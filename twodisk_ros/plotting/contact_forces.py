@@ -13,7 +13,7 @@ import sys
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.motion.dynamics import RollingDynamics  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
 from twodisk_ros.physics.forces.contact import ContactForceModel  # noqa: E402
@@ -48,7 +48,7 @@ def _pyplot():
 
 def force_model(shape, mass=1.0, model='laminae', gravity=9.81):
     """A :class:`ContactForceModel` for (a, b, Δ) in m."""
-    body = TwoDiskBody(*shape)
+    body = EllipseBody(*shape)
     return ContactForceModel(RollingDynamics(body, mass_properties(model, *shape, mass),
                                              gravity=gravity))
 

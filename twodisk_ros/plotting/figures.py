@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np  # noqa: E402
 
-from ..physics.bodies.ellipse import TwoDiskBody  # noqa: E402
+from ..physics.bodies.ellipse import EllipseBody  # noqa: E402
 from ..physics.laminae.shapes import Superellipse  # noqa: E402
 from ..physics.laminae.support import Egg  # noqa: E402
 from ..physics.bodies.lamina_body import LaminaBody  # noqa: E402
@@ -111,7 +111,7 @@ def plot_traces(body, cycles, ax, samples_per_cycle=2000, rulings_per_cycle=12, 
 
     Parameters
     ----------
-    body : TwoDiskBody
+    body : EllipseBody
     cycles : int
         Number of whole cycles, from phase u = 0 (A at the origin, θ = 0).
     ax : matplotlib.axes.Axes
@@ -182,7 +182,7 @@ def plot_height(bodies, ax, samples=1441, annotate=0):
 
     Parameters
     ----------
-    bodies : sequence of (label, TwoDiskBody)
+    bodies : sequence of (label, EllipseBody)
     ax : matplotlib.axes.Axes
     samples : int
         Phases over [0, 2π].
@@ -327,11 +327,11 @@ def write_figures(out_dir):
                                    ('figure4.png', 'Paper, Figure 4', FIGURE4),
                                    ('oloid_traces.png', 'Oloid', (1.0, 1.0, 0.5))]:
         fig, ax = plt.subplots(figsize=(8.0, 3.6))
-        plot_traces(TwoDiskBody(*shape), 3, ax, name=title)
+        plot_traces(EllipseBody(*shape), 3, ax, name=title)
         written.append(_save(fig, out / filename))
     fig, ax = plt.subplots(figsize=(7.5, 3.6))
-    plot_height([('Oloid', TwoDiskBody.oloid()), ('Fig. 3 body', TwoDiskBody(*FIGURE3)),
-                 ('Two-Circle-Roller', TwoDiskBody.two_circle_roller())], ax, annotate=1)
+    plot_height([('Oloid', EllipseBody.oloid()), ('Fig. 3 body', EllipseBody(*FIGURE3)),
+                 ('Two-Circle-Roller', EllipseBody.two_circle_roller())], ax, annotate=1)
     written.append(_save(fig, out / 'height.png'))
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     plot_stability_map(ax)

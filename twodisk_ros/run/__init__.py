@@ -11,7 +11,7 @@ that they all build the same body from the same settings.
   ``egg_asymmetry``, ``shape_file``), read and checked; a fitted outline in a recording's
   metadata;
 - :mod:`~twodisk_ros.run.description`: :class:`~twodisk_ros.run.description.RunDescription`,
-  the body (TwoDiskBody for ellipses, LaminaBody otherwise), its mass model, dynamics and
+  the body (EllipseBody for ellipses, LaminaBody otherwise), its mass model, dynamics and
   motion stream, and the recording's metadata;
 - :mod:`~twodisk_ros.run.simulation`, :mod:`~twodisk_ros.run.scene_simulation`: the
   settings' physics objects and the samples they give;

@@ -4,7 +4,7 @@ Read by the node (:class:`~twodisk_ros.run.simulation.Simulation`, the start-up 
 the inspector (:func:`~twodisk_ros.inspector.model.build_model`) and the tools that rebuild a
 run from its parameters, so that every reader builds the same body:
 
-- ``shape`` ellipse: :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (a, b, delta), the closed
+- ``shape`` ellipse: :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` (a, b, delta), the closed
   forms, and the closed-form mass models of a, b, delta (``settings.ellipse_mass_properties()``), bit for bit;
 - any other shape: :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` (lamina, delta,
   arrangement) on the lamina of :func:`~twodisk_ros.run.shape.lamina_of`, with the mass model
@@ -21,7 +21,7 @@ checking settings, describing the URDF and building the simulation pay for a bod
 from functools import cached_property, lru_cache
 
 from .parameters import parse_recorded
-from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.bodies.ellipse import EllipseBody
 from ..physics.motion.dynamics import RollingDynamics
 from ..physics.motion.simulate import MotionStream
 from . import shape as shapes
@@ -65,7 +65,7 @@ class RunDescription:
     lamina : Lamina
         The shape of each disk (an Ellipse for ``ellipse``).
     laminae_body : RollingBody
-        The body with its origin at the laminae's centroid G: TwoDiskBody for ``ellipse``,
+        The body with its origin at the laminae's centroid G: EllipseBody for ``ellipse``,
         LaminaBody otherwise (built here, so a shape that defines no body is refused here).
     body : RollingBody
         The body the run moves: ``laminae_body`` moved to the mass model's centre of mass
@@ -78,7 +78,7 @@ class RunDescription:
         s = self.settings = settings.checked(outline)
         self.outline = outline if s.shape == 'points' else None
         if s.shape == 'ellipse':
-            self.laminae_body = TwoDiskBody(s.a, s.b, s.delta)
+            self.laminae_body = EllipseBody(s.a, s.b, s.delta)
             self.lamina = self.laminae_body.lamina
         else:
             self.lamina = shapes.lamina_of(s, self.outline)

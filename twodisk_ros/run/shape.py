@@ -5,7 +5,7 @@ description (:mod:`~twodisk_ros.run.description`) builds the body on it. Setting
 attribute (any object with the parameter names: ``RollerSettings`` in practice).
 
 - ``ellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` (a, b); the body is
-  :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (closed forms);
+  :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` (closed forms);
 - ``superellipse``: :class:`~twodisk_ros.physics.laminae.shapes.Superellipse` (a, b, ``exponent``);
 - ``egg``: :class:`~twodisk_ros.physics.laminae.support.Egg` (a, b, ε) with
   ε = ``egg_asymmetry`` × ε_max(a, b) (m): ``egg_asymmetry`` is dimensionless, |·| ≤
@@ -28,8 +28,8 @@ import math
 import os
 import stat
 
-from ..physics.bodies.ellipse import TwoDiskBody
-from ..physics.bodies.contact_solver import GeneralTwoDiskBody
+from ..physics.bodies.ellipse import EllipseBody
+from ..physics.bodies.contact_solver import ContactSolver
 from ..physics.laminae.shapes import Ellipse, Superellipse
 from ..physics.laminae.support import Egg
 from ..physics.laminae.fit import Outline, read_outline
@@ -163,7 +163,7 @@ def axes_of(lamina):
 
 @lru_cache(maxsize=32)
 def _general(lamina, delta, arrangement):
-    return GeneralTwoDiskBody(lamina, delta, arrangement)
+    return ContactSolver(lamina, delta, arrangement)
 
 
 def clear_caches():
@@ -177,13 +177,13 @@ def theta_max_of(settings, lamina):
     :func:`lamina_of`): ValueError if the laminae at Δ in the arrangement have no cycle.
 
     Only the contact geometry is built (not a rolling body's tables): for ``shape`` ellipse
-    the closed form of :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (both
+    the closed form of :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` (both
     arrangements are the same body), for the others the
-    :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody` of the lamina.
+    :class:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver` of the lamina.
     """
     s = settings
     if s.shape == 'ellipse':
-        return TwoDiskBody(s.a, s.b, s.delta).theta_max
+        return EllipseBody(s.a, s.b, s.delta).theta_max
     return _general(lamina, s.delta, s.arrangement).theta_max
 
 

@@ -11,7 +11,7 @@ bodies as array operations (docs/sweeps.md, "The batched path"):
    (:func:`~twodisk_ros.physics.bodies.cycle.required_resolutions`, batched);
 3. bodies of one resolution are evaluated together in blocks of at most :data:`POINTS`
    nodes × bodies: the closed forms on the 4 × resolution nodes of the scalar path's tables
-   (:meth:`~twodisk_ros.physics.bodies.ellipse_batch.TwoDiskBodies.cycle_samples`), then every
+   (:meth:`~twodisk_ros.physics.bodies.ellipse_batch.EllipseBodies.cycle_samples`), then every
    quantity from these samples with numpy over the batch axis: the cycle's displacement
    (spectral integration), the eight equilibria, the cycle time (trapezoidal), the extremes
    of |AB| (nodes, then Newton on the closed form), the kinematic contact-force columns,
@@ -33,8 +33,8 @@ import time
 import numpy as np
 
 from ..physics.numerics.analytic import COMPLEX_STEP
-from ..physics.bodies.ellipse import TwoDiskBody
-from ..physics.bodies.ellipse_batch import TwoDiskBodies, dot
+from ..physics.bodies.ellipse import EllipseBody
+from ..physics.bodies.ellipse_batch import EllipseBodies, dot
 from ..physics.forces.contact import kinematic_coefficients
 from ..physics.forces.validity import liftoff_speed_batch, mu_required_kinematic_batch
 from ..physics.bodies.cycle import TWO_PI, displacement_from_rates, required_resolutions
@@ -85,7 +85,7 @@ def _checked_bodies(b_values, delta_values, mass_model, out):
         if not (math.isfinite(b) and math.isfinite(d)) or d >= 1.0:
             continue
         try:
-            body = TwoDiskBody(1.0, b, d)
+            body = EllipseBody(1.0, b, d)
             props = mass_properties(mass_model, 1.0, b, d, 1.0)
         except Exception:  # noqa: BLE001 (the scalar path gives this body's reason)
             continue
@@ -217,7 +217,7 @@ def batch_quantities(b_values, delta_values, mass_model='laminae', reference_spe
     scalar = sorted(set(range(size)) - set(chosen.tolist()))
     if chosen.size:
         with clock('resolution'):
-            everyone = TwoDiskBodies(1.0, b_values[chosen], delta_values[chosen])
+            everyone = EllipseBodies(1.0, b_values[chosen], delta_values[chosen])
             resolution = required_resolutions(everyone, POINTS)
         for r in np.unique(resolution):
             group = np.flatnonzero(resolution == r)

@@ -22,7 +22,7 @@ import time
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..physics.bodies.ellipse import TwoDiskBody
+from ..physics.bodies.ellipse import EllipseBody
 from ..physics.forces.contact import ContactForceModel
 from ..physics.forces.validity import liftoff_speed, mu_required_kinematic
 from ..physics.bodies.cycle import RollingCycle, TWO_PI
@@ -155,7 +155,7 @@ def body_quantities(b_over_a, delta_over_a, mass_model='laminae', reference_spee
         return values, failure
 
     def body_stage(state, values):
-        state['body'] = body = TwoDiskBody(1.0, b, d)
+        state['body'] = body = EllipseBody(1.0, b, d)
         values['theta_max'] = body.theta_max
         values['stability_margin'] = body.stability_margin
 

@@ -108,7 +108,7 @@ def body_update(stamp_ns, body_frame, body, parts, disks):
 
     Parameters
     ----------
-    body : TwoDiskBody, LaminaBody or GeneralTwoDiskBody
+    body : EllipseBody, LaminaBody or ContactSolver
         For the rims: the real outline of ``body.lamina`` (model/outline.py), to a polygon
         error of :data:`RIM_TOLERANCE` of its size.
     parts : dict of str to Mesh

@@ -2,7 +2,7 @@
 
 docs/physics.md#the-contact-geometry-of-any-laminae. :class:`~twodisk_ros.physics.bodies.lamina_body.
 LaminaBody` tabulates these exact solutions over the cycle; the hull (hull_general.py) and the
-drawing (model/) use them directly. :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` stays the
+drawing (model/) use them directly. :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` stays the
 exact, fast path for ellipses and is the reference the tests hold this one to.
 
 Body frame as in body.py (metres): O, the midpoint of the centres, is the origin; e2 is the
@@ -15,7 +15,7 @@ lamina point (x, y) sits at C2 + x e3 + σ y e2, C2 = +Δ e2, with the arrangeme
 * ``'swapped'`` (σ = −1): disk 2 is the image of disk 1 under the disk-swap rotation
   (x1, x2, x3) ↦ (x3, −x2, x1), so the body keeps that symmetry, (θ, ψ) ↦ (−ψ, −θ).
 
-For an ellipse both are the same body as TwoDiskBody(a, b, Δ). G is the centroid of the two
+For an ellipse both are the same body as EllipseBody(a, b, Δ). G is the centroid of the two
 laminae (equal masses): G = (1 + σ) ȳ/2 e2 with ȳ the lamina's centroid (0 unless the lamina
 is asymmetric along y, as the egg is). θ and ψ are the polar angles of A about C1 (from −e2
 towards +e1) and of B about C2 (from +e2 towards −e3), as in body.py.
@@ -45,7 +45,7 @@ import numpy as np
 
 from ..laminae.shapes import Lamina, check_length
 
-__all__ = ['ARRANGEMENTS', 'ContactGeometry', 'GeneralTwoDiskBody']
+__all__ = ['ARRANGEMENTS', 'ContactGeometry', 'ContactSolver']
 
 #: Disk 2's orientation: σ, the sign of its lamina y along e2 (see the module docstring).
 ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
@@ -147,7 +147,7 @@ class ContactGeometry:
     parameter_b: np.ndarray = None  #: B's lamina parameter on disk 2 (rad, in (−π, π])
 
 
-class GeneralTwoDiskBody:
+class ContactSolver:
     """Two congruent convex laminae in perpendicular planes, centres at ∓Δ along e2.
 
     Parameters
@@ -213,7 +213,7 @@ class GeneralTwoDiskBody:
     offset = 0.0
 
     def __repr__(self):
-        return (f'GeneralTwoDiskBody({self.lamina!r}, delta={self.delta!r}, '
+        return (f'ContactSolver({self.lamina!r}, delta={self.delta!r}, '
                 f'arrangement={self.arrangement!r})')
 
     # -- the support function of the lamina and the contact equation --------------------------

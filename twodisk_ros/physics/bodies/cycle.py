@@ -119,7 +119,7 @@ def required_resolutions(bodies, points=2**16):
 
     Parameters
     ----------
-    bodies : TwoDiskBodies
+    bodies : EllipseBodies
     points : int
         Nodes × bodies evaluated at once (bounds the memory: ~100 B per point).
 
@@ -186,7 +186,7 @@ class RollingCycle:
     Parameters
     ----------
     body : RollingBody
-        TwoDiskBody or LaminaBody (rolling_body.py).
+        EllipseBody or LaminaBody (rolling_body.py).
     resolution : int, optional
         Grid size of the spectral integration (power of two). By default it is doubled from
         512 until the upper half of the spectra of dα/du and of the trace's rate is below

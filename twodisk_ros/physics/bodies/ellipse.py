@@ -44,7 +44,7 @@ from ..laminae.shapes import Ellipse
 from .protocol import PhaseGeometry, RollingBody
 from ..numerics.vectors import cross, vector
 
-__all__ = ['LENGTH_RANGE', 'TwoDiskForms', 'TwoDiskBody', 'PhaseGeometry']
+__all__ = ['LENGTH_RANGE', 'EllipseForms', 'EllipseBody', 'PhaseGeometry']
 
 #: Allowed a, b and Δ (m). Every result is scale-invariant (θ_max, z_G / a, S / a, periods
 #: × √(g/a) agree with the unit body's to ≤ 3e-13 from 1e-35 to 1e35 m, tests/
@@ -66,14 +66,14 @@ def _check_parameter(name, value, low, high, rule):
     return value
 
 
-class TwoDiskForms:
+class EllipseForms:
     """The closed forms of the body in the cycle phase u, for one body or for a batch.
 
     The methods read the parameters ``a``, ``b``, ``delta`` (m), ``theta_max`` (rad) and the
     constants derived from them in the constructor of a subclass (``_cos_theta_max``,
     ``_sin_theta_max``, ``_d_max``, ``_eta_max``, ``_cos_eta_max``, ``_sin_eta_max``,
-    ``_e_max``): floats in :class:`TwoDiskBody` (one body), arrays of shape (B,) in
-    :class:`~twodisk_ros.physics.bodies.ellipse_batch.TwoDiskBodies` (B bodies at once; phases of shape
+    ``_e_max``): floats in :class:`EllipseBody` (one body), arrays of shape (B,) in
+    :class:`~twodisk_ros.physics.bodies.ellipse_batch.EllipseBodies` (B bodies at once; phases of shape
     (..., B) or (..., 1) then broadcast against them). The formulas are the same for both.
     """
 
@@ -319,7 +319,7 @@ class TwoDiskForms:
         return dalpha[..., None] * n_re - frame_rate
 
 
-class TwoDiskBody(TwoDiskForms, RollingBody):
+class EllipseBody(EllipseForms, RollingBody):
     """Two identical elliptic disks in perpendicular planes, joined along their axis ``a``.
 
     Parameters
@@ -333,7 +333,7 @@ class TwoDiskBody(TwoDiskForms, RollingBody):
 
     Examples
     --------
-    >>> oloid = TwoDiskBody(1.0, 1.0, 0.5)
+    >>> oloid = EllipseBody(1.0, 1.0, 0.5)
     >>> round(float(oloid.height(0.0)), 12)   # z_G at θ = 0 (m)
     0.75
     """
@@ -366,7 +366,7 @@ class TwoDiskBody(TwoDiskForms, RollingBody):
         self._e_max = math.hypot(a * self._cos_eta_max, b * self._sin_eta_max)
 
     def __repr__(self):
-        return f'TwoDiskBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
+        return f'EllipseBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
 
     def describe(self):
         return f'a = {self.a:.4g} m, b = {self.b:.4g} m, Δ = {self.delta:.4g} m'

@@ -1,15 +1,15 @@
 """Many two-disk bodies at once: the closed forms of :mod:`~twodisk_ros.physics.bodies.ellipse` on a
 batch axis.
 
-:class:`TwoDiskBodies` holds B bodies (a, b, Δ as arrays of shape (B,), metres) and inherits
-every closed form in the cycle phase u from :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskForms`,
-the same code as :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody`: a phase array of shape
+:class:`EllipseBodies` holds B bodies (a, b, Δ as arrays of shape (B,), metres) and inherits
+every closed form in the cycle phase u from :class:`~twodisk_ros.physics.bodies.ellipse.EllipseForms`,
+the same code as :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody`: a phase array of shape
 (..., B) (one phase per body) or (..., 1) (the same phases for every body) broadcasts against
 the parameters, and vectors get a trailing axis of 3 (body frame). Only the constants of the
 constructor are computed with numpy instead of ``math``; results agree with the scalar body's
 to rounding (~1e-16 relative).
 
-:meth:`TwoDiskBodies.cycle_samples` evaluates on the nodes u_j = 2πj/N of one cycle
+:meth:`EllipseBodies.cycle_samples` evaluates on the nodes u_j = 2πj/N of one cycle
 everything that the sweep's tables need (contact vectors, ground normal, height and its
 slope, angular velocity per u̇, the rates of the contact trace), vectors component first.
 """
@@ -19,10 +19,10 @@ import math
 
 import numpy as np
 
-from .ellipse import LENGTH_RANGE, TwoDiskForms
+from .ellipse import LENGTH_RANGE, EllipseForms
 from ..numerics.spectral import real_spectral_derivative
 
-__all__ = ['TwoDiskBodies', 'CycleSamples', 'cross', 'dot']
+__all__ = ['EllipseBodies', 'CycleSamples', 'cross', 'dot']
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class CycleSamples:
     tangent_a: np.ndarray       #: t1, unit tangent of disk 1 at A
     height: np.ndarray          #: z_G (m)
     height_slope: np.ndarray    #: dz_G/du (m/rad), spectral
-    angular_velocity: np.ndarray   #: ω_u (rad per unit u), as TwoDiskForms.phase_angular_velocity
+    angular_velocity: np.ndarray   #: ω_u (rad per unit u), as EllipseForms.phase_angular_velocity
     arc_rate: np.ndarray        #: ds/du of the trace of A (m/rad)
     turn_rate: np.ndarray       #: dα/du of the trace of A (rad/rad)
 
@@ -61,14 +61,14 @@ def dot(x, y):
     return out
 
 
-class TwoDiskBodies(TwoDiskForms):
+class EllipseBodies(EllipseForms):
     """B two-disk bodies (a, b, Δ) at once, for array evaluation of the closed forms in u.
 
     Parameters
     ----------
     a, b, delta : array_like
         Broadcast to one axis of B bodies (m): each finite, in ``LENGTH_RANGE``, b > 0 and
-        0 < delta < a, as for :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (whose
+        0 < delta < a, as for :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` (whose
         constructor gives the per-body message).
 
     Raises
@@ -92,7 +92,7 @@ class TwoDiskBodies(TwoDiskForms):
                              f'not allowed: lengths must be finite in [{low:g}, {high:g}] m '
                              f'with 0 < delta < a')
         self.a, self.b, self.delta = a, b, delta
-        # the constants of TwoDiskBody.__init__, element by element
+        # the constants of EllipseBody.__init__, element by element
         root = np.sqrt(a**4 + 4 * a * delta * b * b + 4 * delta * delta * b * b)
         self._cos_theta_max = -a * a / root
         self.theta_max = np.arctan2(2 * b * np.sqrt(delta * (a + delta)), -a * a)
@@ -107,15 +107,15 @@ class TwoDiskBodies(TwoDiskForms):
         return self.a.size
 
     def __repr__(self):
-        return f'TwoDiskBodies({len(self)} bodies)'
+        return f'EllipseBodies({len(self)} bodies)'
 
     def subset(self, index):
         """The bodies ``index`` (an integer array or a boolean mask) as a new batch."""
-        return TwoDiskBodies(self.a[index], self.b[index], self.delta[index])
+        return EllipseBodies(self.a[index], self.b[index], self.delta[index])
 
     @property
     def size(self):
-        """:attr:`TwoDiskBody.size` of each body (m), shape (B,)."""
+        """:attr:`EllipseBody.size` of each body (m), shape (B,)."""
         a, b, d = self.a, self.b, self.delta
         with np.errstate(divide='ignore', invalid='ignore'):
             wide = np.sqrt(b * b + d * d + (a * d) ** 2 / (b * b - a * a))
@@ -125,7 +125,7 @@ class TwoDiskBodies(TwoDiskForms):
         """:class:`CycleSamples` at u_j = 2πj/``nodes``, from the closed forms.
 
         The values (contact vectors, normal, tangent, height, the trace's rates) are the
-        scalar body's closed forms. ω_u is :meth:`TwoDiskForms.phase_angular_velocity`'s
+        scalar body's closed forms. ω_u is :meth:`EllipseForms.phase_angular_velocity`'s
         formula, ω_u = α′ n − ½ Σ b × b′ over the frame b = t1, n × t1, n, with the
         u-derivatives of n and t1 in closed form (:meth:`frame_rates`) instead of a complex
         step: the same values to ~1e-15 relative (measured over b/a ∈ [0.01, 100],
@@ -137,7 +137,7 @@ class TwoDiskBodies(TwoDiskForms):
         theta, cos_t, sin_t, j = self.phase_angles(u)
         d = self._ellipse_terms(cos_t, sin_t)
         root = np.sqrt(j * self._q_cofactor(cos_t, d))
-        sq = np.cos(u) * root               # σ√Q, as TwoDiskForms._phase_sqrt_q
+        sq = np.cos(u) * root               # σ√Q, as EllipseForms._phase_sqrt_q
         r1, r2, normal, t1, height, planar, norm_n = self._geometry_components(cos_t, sin_t,
                                                                                 sq)
         ds, dalpha = self._rates(u, cos_t, sin_t, sq)
@@ -159,7 +159,7 @@ class TwoDiskBodies(TwoDiskForms):
         T = (b² cos θ, a² sin θ, 0), so n′ = (N′ − n (n·N′))/|N|, likewise t1′, with
         θ′ = dθ/dη · dη/du = (D²/ab) η_max cos u (tan θ = (b/a) tan η, D = √(a² sin²θ +
         b² cos²θ) = ab/E(η)) and (σ√Q)′ = Q_θ θ′ / (2 σ√Q) = Q_θ (D²/ab) η_max / (2 r), where
-        σ√Q = r cos u (r > 0, :meth:`TwoDiskForms.phase_signed_sqrt_q`): regular at the
+        σ√Q = r cos u (r > 0, :meth:`EllipseForms.phase_signed_sqrt_q`): regular at the
         turning points. Q_θ = 2 sin θ (a⁴ cos θ − 2abΔ D + 2abΔ (a² − b²) cos²θ / D
         − 4b²Δ² cos θ), from Q = a⁴ sin²θ + 4abΔ cos θ D + 4b²Δ² cos²θ.
 

@@ -19,7 +19,7 @@ Complex-step contract (rolling_body.py): at u + i h the table returns f(u) + i h
 f′ the interpolant's derivative, so callers' complex steps give the spectral derivative.
 
 Frames as in body.py and general_body.py: body frame with origin G, the centroid of the two
-laminae (GeneralTwoDiskBody.centroid); r1 = GA, r2 = GB (m); n the upward ground normal.
+laminae (ContactSolver.centroid); r1 = GA, r2 = GB (m); n the upward ground normal.
 :meth:`LaminaBody.about` moves the origin (the reference point P) along e2, sharing the
 tables: then r1 = PA, r2 = PB and the height is P's, z_P = z_G + n·(P − G). That is how a
 solid whose centre of mass lies off G (an egg in the parallel arrangement) gets a body whose
@@ -34,7 +34,7 @@ import numpy as np
 
 from ..numerics.analytic import COMPLEX_STEP
 from .ellipse import PhaseGeometry
-from .contact_solver import ARRANGEMENTS, GeneralTwoDiskBody
+from .contact_solver import ARRANGEMENTS, ContactSolver
 from ..laminae.shapes import VERTEX_AXES
 from .regular_phase import BRANCH_FLIP, COLUMNS, PhaseSolver, THETA_FLIP, unfold
 from .protocol import RollingBody
@@ -118,13 +118,13 @@ class LaminaBody(RollingBody):
         The shape of both disks (lamina.py).
     delta : float
         Half the distance between the centres (m) (limits as in
-        :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody`).
+        :class:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver`).
     arrangement : str
         'parallel' (default) or 'swapped' (general_body.py).
 
     Attributes
     ----------
-    general : GeneralTwoDiskBody
+    general : ContactSolver
         The exact contact geometry (θ and tilt charts).
     resolution : int
         Exactly solved phases per cycle.
@@ -136,7 +136,7 @@ class LaminaBody(RollingBody):
         if arrangement not in ARRANGEMENTS:
             raise ValueError(f'arrangement must be one of {sorted(ARRANGEMENTS)}, '
                              f'got {arrangement!r}')
-        self.general = GeneralTwoDiskBody(lamina, delta, arrangement)
+        self.general = ContactSolver(lamina, delta, arrangement)
         self._solver = PhaseSolver(self.general)
         self._offset = 0.0
         self._sample()

@@ -2,7 +2,7 @@
 
 Two implementations:
 
-* :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` (two ellipses): the paper's closed forms, the
+* :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` (two ellipses): the paper's closed forms, the
   exact and fast path, analytic in the phase u;
 * :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` (two congruent laminae of any shape of
   :mod:`~twodisk_ros.physics.laminae.shapes`): the contact solved from the lamina, tabulated over one
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact_solver import GeneralTwoDiskBody
+from .contact_solver import ContactSolver
 
 __all__ = ['PhaseGeometry', 'RollingBody', 'check_rolling_body']
 
@@ -150,12 +150,12 @@ class RollingBody(abc.ABC):
     # -- the exact contact geometry (drawings) ------------------------------------------------
     @property
     def contact_solver(self):
-        """The :class:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody` of the
+        """The :class:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver` of the
         body's lamina, Δ and arrangement: its contact geometry solved from the support
         function, whose rims every drawing of the body takes (built once)."""
         solver = self.__dict__.get('_contact_solver')
         if solver is None:
-            solver = GeneralTwoDiskBody(self.lamina, self.delta, self.arrangement)
+            solver = ContactSolver(self.lamina, self.delta, self.arrangement)
             self.__dict__['_contact_solver'] = solver
         return solver
 
@@ -179,6 +179,6 @@ class RollingBody(abc.ABC):
 def check_rolling_body(body, what='body'):
     """``body`` if it implements :class:`RollingBody`, else TypeError naming what it got."""
     if not isinstance(body, RollingBody):
-        raise TypeError(f'{what} must be a rolling body (TwoDiskBody or LaminaBody), got '
+        raise TypeError(f'{what} must be a rolling body (EllipseBody or LaminaBody), got '
                         f'{type(body).__name__}')
     return body

@@ -23,9 +23,9 @@ as smooth in u as the points are in t; in θ, ψ or the normal angles it is not 
 **The solve.** Given u, the point on the ray is found by a bracketing root finder (scipy's
 elementwise Chandrupatla) on the signed distance p cos u − q sin u from the ray, in the chart
 that is well conditioned there: A's phase parameter for u ≤ π/4 (q from the convex elevation
-equation of :meth:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody.elevation_of_parameter`
+equation of :meth:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver.elevation_of_parameter`
 and the support point of disk 2), B's phase parameter for u > π/4
-(:meth:`~twodisk_ros.physics.bodies.contact_solver.GeneralTwoDiskBody.chart_from_b`, regular at the
+(:meth:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver.chart_from_b`, regular at the
 turning points where ψ(θ) ~ √(θ_max − θ) is not).
 """
 
@@ -52,7 +52,7 @@ def _wrap(angle):
 
 
 class PhaseSolver:
-    """Exact resting poses at phases u ∈ [0, π/2] of a :class:`GeneralTwoDiskBody`.
+    """Exact resting poses at phases u ∈ [0, π/2] of a :class:`ContactSolver`.
 
     Raises ValueError (one line) when the cycle's curve in the (p, q) plane is not
     star-shaped about the origin (u would not be one-to-one).

@@ -95,7 +95,7 @@ def squeeze_split(normal_a, normal_b, tangential_a, tangential_b, along_ab):
 def kinematic_coefficients(samples, inertia, mass, gravity):
     """The kinematic columns of :class:`ContactForceModel` at one cycle's nodes, for a batch.
 
-    Ellipses only (TwoDiskBodies, which turn at every u: |ω_u| > 0); the same construction
+    Ellipses only (EllipseBodies, which turn at every u: |ω_u| > 0); the same construction
     as the model's tables in u (Newton-Euler per unit u, moments about A,
     spectral u-derivatives of dG/du, ω_u and |ω_u|), for B bodies at once and component by
     component, without the heading and the drive torque, which the lift-off speed and
@@ -104,8 +104,8 @@ def kinematic_coefficients(samples, inertia, mass, gravity):
     Parameters
     ----------
     samples : CycleSamples
-        The bodies' closed forms at u_j = 2πj/N (:meth:`TwoDiskBodies.cycle_samples
-        <twodisk_ros.physics.bodies.ellipse_batch.TwoDiskBodies.cycle_samples>`): vectors (3, N, B).
+        The bodies' closed forms at u_j = 2πj/N (:meth:`EllipseBodies.cycle_samples
+        <twodisk_ros.physics.bodies.ellipse_batch.EllipseBodies.cycle_samples>`): vectors (3, N, B).
     inertia : ndarray, shape (B, 3, 3)
         Inertia about G (kg m², body frame).
     mass, gravity : float or ndarray of shape (B,)
@@ -298,7 +298,7 @@ class ContactForceModel:
         ``'kinematic'``: A (7 columns) then C (7) with Q = A + Ω² C / s for each of
         :data:`QUANTITIES` and γ̈ (rad/s²), then s = dγ/dy, dγ/du = |ω_u|, d²γ/du² and the
         periodic part of the heading of ê (rad), tabulated in y = ``terms.coordinate(u)``
-        (u itself for TwoDiskBody and LaminaBody); ``'dynamic'``: the same with
+        (u itself for EllipseBody and LaminaBody); ``'dynamic'``: the same with
         Q = A + w² C / s along a free motion of angular speed w; ``'general'``:
         (Q_g, Q_u̇², Q_ü), 6 each, then dγ/du, d²γ/du² and the heading, tabulated in u.
         """

@@ -14,7 +14,7 @@ Q_g = (M g n, 0), Q_a = (M c, I ω̂) and P = (M(s ω̂ × c + dc/dy), I dω̂/d
 flat vertex: dr1/dγ is infinite there); then P ≠ 0 and the force is infinite for an instant.
 
 **Table coordinate y.** y = u where the pose moves at a rate bounded away from zero per unit u
-(TwoDiskBody, LaminaBody: their contacts move at a finite rate per u even where the body does
+(EllipseBody, LaminaBody: their contacts move at a finite rate per u even where the body does
 not turn). A phase that stops the whole pose (the test double's u = g(v) with g′ = 0) would
 make s and P vanish together (0/0); there y = x, the pose's arc length normalised to 2π per
 cycle, dx/du ∝ √(s_u² + (|r1′|² + |r2′|²)/L²) (L the body size), in which the pose moves at a

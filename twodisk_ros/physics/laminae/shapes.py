@@ -40,7 +40,7 @@ __all__ = ['AreaMoments', 'Ellipse', 'Lamina', 'LENGTH_RANGE', 'SUPERELLIPSE_EXP
            'Superellipse', 'Support', 'VERTEX_AXES', 'Vertex', 'check_length', 'direction_angle',
            'normal_of_angle']
 
-#: Allowed lengths (m), as for TwoDiskBody: the forms hold up to sixth powers of lengths.
+#: Allowed lengths (m), as for EllipseBody: the forms hold up to sixth powers of lengths.
 LENGTH_RANGE = (1e-30, 1e30)
 #: Allowed superellipse exponents n: from the ellipse (2) to a rounded rectangle whose corner
 #: radius of curvature is a few per cent of its size (about 0.05 b at n = 100, b = a).

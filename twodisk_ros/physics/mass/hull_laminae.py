@@ -26,7 +26,7 @@ length), so ℓ_B,p = ℓ_A,p κ_A (m·ν_A)(e·t_B) / (κ_B (m·ν_B)(e·t_A)).
 **The charts.** θ is a regular parameter of A, but B passes disk 2's far tip at the turning
 points θ = ±θ_max, where its rate in θ is infinite (and, at a superellipse's flat tip, B is not
 even a smooth function of θ). There the **dual chart** is used: the same hull seen from disk 2,
-GeneralTwoDiskBody(L′, Δ, arrangement) with L′ the lamina mirrored in its x axis for the
+ContactSolver(L′, Δ, arrangement) with L′ the lamina mirrored in its x axis for the
 parallel arrangement (itself for swapped), related to the body by the disk-swap rotation
 R: (x1, x2, x3) ↦ (x3, −x2, x1); its θ′ is B's polar angle about C2. The cycle is cut into four
 arcs at |θ| = θ_c, the polar angle of A's lamina parameter halfway between disk 1's side
@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ..bodies.contact_solver import GeneralTwoDiskBody
+from ..bodies.contact_solver import ContactSolver
 from .hull import PAIRS, relative_change
 from ..laminae.shapes import AreaMoments, Lamina, Support
 
@@ -114,7 +114,7 @@ def _arc_integrand(body, s, branch):
 
     Parameters
     ----------
-    body : GeneralTwoDiskBody
+    body : ContactSolver
     s : numpy.ndarray, shape (k,)
         A's lamina parameter (rad), away from the turning points ±s_max.
     branch : int or numpy.ndarray, shape (k,)
@@ -188,9 +188,9 @@ class _Arcs:
     """The four arcs of the cycle (module docstring) and their Gauss–Legendre sums."""
 
     def __init__(self, lamina, delta, arrangement):
-        self.body = GeneralTwoDiskBody(lamina, delta, arrangement)
+        self.body = ContactSolver(lamina, delta, arrangement)
         dual_lamina = MirroredLamina(lamina) if self.body.sigma > 0 else lamina
-        self.dual = GeneralTwoDiskBody(dual_lamina, delta, arrangement)
+        self.dual = ContactSolver(dual_lamina, delta, arrangement)
         side = float(lamina.support(np.array([1.0, 0.0])).parameter)
         s_cut = 0.5 * (side + self.body.s_max)
         # pieces (body, s_from, s_to, branch, rotation): cut where a rim may be flat (the
@@ -212,7 +212,7 @@ class _Arcs:
         """The 10 integrals over the whole surface with n Gauss–Legendre nodes per piece.
 
         The pieces of one chart are evaluated in one vectorised call (the bisections of
-        GeneralTwoDiskBody cost per call, not per node)."""
+        ContactSolver cost per call, not per node)."""
         nodes, weights = _gauss_legendre(n)
         total = np.zeros(10)
         for chart, rotation in ((self.body, None), (self.dual, SWAP)):
@@ -235,7 +235,7 @@ def general_hull_moments(lamina, delta, arrangement='parallel', rtol=1e-9):
     lamina : Lamina
         The shape of both disks (lamina.py).
     delta : float
-        Half the distance between the disk centres (m), as GeneralTwoDiskBody allows.
+        Half the distance between the disk centres (m), as ContactSolver allows.
     arrangement : str
         'parallel' or 'swapped' (general_body.py).
     rtol : float
@@ -257,7 +257,7 @@ def general_hull_moments(lamina, delta, arrangement='parallel', rtol=1e-9):
     Raises
     ------
     ValueError
-        From GeneralTwoDiskBody for a body it refuses (one line).
+        From ContactSolver for a body it refuses (one line).
     RuntimeError
         If ``rtol`` cannot be reached with N_MAX nodes per arc.
     """

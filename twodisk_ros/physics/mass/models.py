@@ -352,7 +352,7 @@ def solid_of(lamina, delta, arrangement, mass, *, rtol=1e-9):
     Raises
     ------
     ValueError
-        For a body GeneralTwoDiskBody refuses (one line).
+        For a body ContactSolver refuses (one line).
     RuntimeError
         If the quadrature cannot reach ``rtol``.
     """
@@ -379,8 +379,8 @@ def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
     model : str
         'laminae', 'solid' or 'custom'.
     body : RollingBody
-        Anything with ``lamina``, ``delta`` and ``arrangement`` (TwoDiskBody, LaminaBody,
-        GeneralTwoDiskBody). An :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` lamina takes the
+        Anything with ``lamina``, ``delta`` and ``arrangement`` (EllipseBody, LaminaBody,
+        ContactSolver). An :class:`~twodisk_ros.physics.laminae.shapes.Ellipse` lamina takes the
         closed-form path: exactly :func:`mass_properties` (model, a, b, delta, ...).
     mass, principal_moments, rtol
         As in :func:`mass_properties`.
@@ -408,7 +408,7 @@ def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
     centre of mass's e2 coordinate (``body.about``, sharing its tables) and the returned
     centre of mass is exactly zero (its e1 and e3 parts vanish by the mirror symmetries;
     more than 1e-12 of the size there is refused). Any other body (the ellipse's
-    TwoDiskBody, centre of mass at G by its symmetries) is returned as it is, with its
+    EllipseBody, centre of mass at G by its symmetries) is returned as it is, with its
     properties. Arguments as in :func:`mass_properties_of`.
 
     Returns
@@ -435,7 +435,7 @@ def _properties_of(model, body, mass, principal_moments, rtol):
         lamina, delta, arrangement = body.lamina, body.delta, body.arrangement
     except AttributeError:
         raise ValueError(f'body must be a rolling body with lamina, delta and arrangement '
-                         f'(TwoDiskBody, LaminaBody), got {type(body).__name__}') from None
+                         f'(EllipseBody, LaminaBody), got {type(body).__name__}') from None
     if type(lamina) is Ellipse:
         return mass_properties(model, lamina.a, lamina.b, delta, mass, principal_moments, rtol)
     _shape(lamina, delta, arrangement)

@@ -21,7 +21,7 @@ import numpy as np
 from ..numerics.analytic import complex_step
 from ..bodies.cycle import RollingCycle, TWO_PI
 from ..stability.equilibria import equilibria, NEUTRAL, STABLE
-from ..bodies.ellipse import TwoDiskBody
+from ..bodies.ellipse import EllipseBody
 from ..mass.models import MassProperties
 from ..bodies.protocol import check_rolling_body
 from ..numerics.spectral import spectral_derivative
@@ -78,7 +78,7 @@ class RollingDynamics:
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
         #: True for any body but the ellipse (whose closed forms keep the (u, u̇) path)
-        self._general = not isinstance(body, TwoDiskBody)
+        self._general = not isinstance(body, EllipseBody)
         self._feature_width = body.feature_width
         self._build_tables(4 * self.cycle.resolution)
         self._equilibria = None

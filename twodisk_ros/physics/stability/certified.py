@@ -1,6 +1,6 @@
 """Equilibria of any rolling body: every root of dz_G/du over one cycle, with a certificate.
 
-For a :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody` :func:`equilibria.equilibria` uses the
+For a :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` :func:`equilibria.equilibria` uses the
 eight fixed angles of the ellipse; every other :class:`~twodisk_ros.physics.bodies.protocol.
 RollingBody` comes here (docs/physics.md#equilibria-of-any-body).
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from ..numerics.analytic import complex_step
-from ..bodies.ellipse import TwoDiskBody
+from ..bodies.ellipse import EllipseBody
 from .certified import (certified_roots, classify_root, max_rotation_rate,
                                  root_series_curvatures)
 from ..bodies.protocol import check_rolling_body
@@ -111,7 +111,7 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE, certificate=False):
     Parameters
     ----------
     body : RollingBody
-        A :class:`~twodisk_ros.physics.bodies.ellipse.TwoDiskBody`: the eight equilibria at the
+        A :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody`: the eight equilibria at the
         ellipse's fixed angles (exact). Any other body: every root of dz_G/du over the cycle
         with a certificate that none is missed (:mod:`~twodisk_ros.physics.stability.certified`).
     neutral_tolerance : float
@@ -127,7 +127,7 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE, certificate=False):
     list of Equilibrium, or (list, RootCertificate or None)
     """
     check_rolling_body(body)
-    if not isinstance(body, TwoDiskBody):
+    if not isinstance(body, EllipseBody):
         found, proof = _general_equilibria(body, neutral_tolerance)
         return (found, proof) if certificate else found
     found = _ellipse_equilibria(body, neutral_tolerance)
@@ -219,12 +219,12 @@ class EquilibriumArrays:
 def equilibria_batch(bodies, slope, neutral_tolerance=NEUTRAL_TOLERANCE):
     """:func:`equilibria` of a batch of bodies at once (arrays instead of a list).
 
-    Ellipses only (TwoDiskBodies: the eight equilibria at the fixed angles); a batch of other
+    Ellipses only (EllipseBodies: the eight equilibria at the fixed angles); a batch of other
     bodies takes :func:`equilibria` body by body.
 
     Parameters
     ----------
-    bodies : TwoDiskBodies
+    bodies : EllipseBodies
         B bodies (:mod:`~twodisk_ros.physics.bodies.ellipse_batch`).
     slope : ndarray, shape (N, B)
         dz_G/du (m/rad) at u_j = 2πj/N, N a multiple of 4, resolved (e.g.

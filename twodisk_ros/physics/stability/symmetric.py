@@ -40,7 +40,7 @@ import math
 import numpy as np
 
 from .equilibria import NEUTRAL, STABLE, UNSTABLE
-from ..bodies.contact_solver import GeneralTwoDiskBody
+from ..bodies.contact_solver import ContactSolver
 from ..laminae.shapes import normal_of_angle
 
 __all__ = ['NOT_AN_EQUILIBRIUM', 'SymmetricEquilibrium', 'symmetric_equilibria']
@@ -174,7 +174,7 @@ def symmetric_equilibria(lamina, delta, arrangement='parallel',
     lamina : Lamina
         Shape of both disks (lamina.py), convex and symmetric about the common axis.
     delta : float
-        Half the distance between the disk centres (m), as for GeneralTwoDiskBody.
+        Half the distance between the disk centres (m), as for ContactSolver.
     arrangement : str
         'parallel' (default) or 'swapped' (general_body.py).
     neutral_tolerance : float
@@ -190,10 +190,10 @@ def symmetric_equilibria(lamina, delta, arrangement='parallel',
     Raises
     ------
     ValueError
-        One line, for what GeneralTwoDiskBody refuses, or for a vertex that is flat without a
+        One line, for what ContactSolver refuses, or for a vertex that is flat without a
         known order of contact.
     """
-    body = GeneralTwoDiskBody(lamina, delta, arrangement)
+    body = ContactSolver(lamina, delta, arrangement)
     sigma, delta, g = body.sigma, body.delta, float(body.centroid[1])
     tol = float(neutral_tolerance)
 
