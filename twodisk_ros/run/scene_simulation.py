@@ -1,9 +1,10 @@
-"""The node's motion in a scene other than the flat free one (no rclpy here).
+"""The node's motion in its scene, one stretch at a time (no rclpy here).
 
-:class:`~twodisk_ros.run.simulation.Simulation` keeps the flat free scene's path (its
-MotionStream, poses and contact forces, bit for bit) where the settings describe the flat,
-free, conservative scene and the motion starts at ``theta0``; everything else is a
-:class:`SceneMotion`: the scene's stream
+:class:`~twodisk_ros.run.simulation.Simulation` samples one of two motions through the same
+interface (``sample``, ``forces``, ``track_rest``): :class:`FlatMotion` where the settings
+describe the flat, free, conservative scene and the motion starts at ``theta0`` (the
+library's MotionStream, poses and contact forces, bit for bit), and :class:`SceneMotion`
+everywhere else: the scene's stream
 (:func:`~twodisk_ros.physics.scenes.motion.scene_stream`, or the integrator of the speed
 drive), poses and ground forces in the gravity-aligned ``frame_id``
 (:class:`~twodisk_ros.physics.scenes.terms.SceneTerms`), and the energy balance
@@ -28,8 +29,8 @@ from ..physics.scenes.scene import Scene
 from ..physics.scenes.motion import SceneStream, scene_stream
 from ..physics.scenes.terms import SceneTerms
 
-__all__ = ['REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion', 'SceneValues',
-           'flat_free', 'frame_metadata', 'ground_normal', 'scene_of']
+__all__ = ['FlatMotion', 'REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion',
+           'SceneValues', 'flat_free', 'frame_metadata', 'ground_normal', 'scene_of']
 
 #: At rest: energy above the stable rest pose at most this × M g L (as physics.scene_events).
 REST_ENERGY = 1e-9
@@ -185,8 +186,9 @@ class SceneMotion:
             values = SceneValues(energy, zero + w0, zero + wd0, zero, zero)
         return u, u_dot, u_ddot, speed, values, self.terms.poses(u)
 
-    def forces(self, u, u_dot, u_ddot):
-        """The ground's forces (:class:`~twodisk_ros.physics.scenes.terms.SceneForces`)."""
+    def forces(self, u, u_dot, u_ddot, speed=None):
+        """The ground's forces (:class:`~twodisk_ros.physics.scenes.terms.SceneForces`) at the
+        states of :meth:`sample` (the scene's terms take u̇ and ü; ``speed`` is not needed)."""
         return self.terms.forces(u, u_dot, u_ddot)
 
     @property
@@ -208,16 +210,17 @@ class SceneMotion:
                 excess = np.where(near & (gap < excess), gap, excess)
         return excess
 
-    def track_rest(self, t, u, u_dot, u_ddot, energy):
+    def track_rest(self, t, u, u_dot, u_ddot, values):
         """Note the first time (s, the node's) at which a scene with losses is at rest, the
         criterion of :func:`~twodisk_ros.physics.scenes.events.settle`: stuck (rolling
         resistance holds it: u̇ = ü = 0) or E − V(u*) ≤ :data:`REST_ENERGY` × M g L; judged
-        at every sample, so to within one sample period."""
+        at every sample, so to within one sample period. ``values``: the samples'
+        :class:`SceneValues`."""
         if not self.comes_to_rest or not math.isnan(self.rested) or not len(t):
             return
         threshold = REST_ENERGY * self.terms.dynamics.energy_scale
         stuck = (np.asarray(u_dot) == 0) & (np.asarray(u_ddot) == 0)
-        resting = np.flatnonzero(stuck | (self.rest_excess(u, energy) <= threshold))
+        resting = np.flatnonzero(stuck | (self.rest_excess(u, values.energy) <= threshold))
         if resting.size:
             self.rested = float(np.asarray(t)[resting[0]])
 
@@ -240,3 +243,53 @@ class SceneMotion:
                 f'{"stable" if eq.stable else "unstable"}, N_A={eq.normal_a:.6g} N, '
                 f'N_B={eq.normal_b:.6g} N, mu_required={eq.mu_required:.4g}{period}')))
         return values
+
+
+class FlatMotion:
+    """The flat free scene's motion: level ground, no drive, no losses, from the run's
+    :class:`~twodisk_ros.physics.motion.simulate.MotionStream`, with the poses of the rolling
+    cycle and the contact forces of the level ground
+    (:class:`~twodisk_ros.physics.forces.contact.ContactForceModel`), exactly as the library's
+    ``simulate``. Sampled as :class:`SceneMotion` is (:meth:`sample`, :meth:`forces`,
+    :meth:`track_rest`), so the simulation has one sample function.
+    """
+
+    #: nothing comes to rest without losses
+    comes_to_rest = False
+    rested = math.nan
+
+    def __init__(self, dynamics, settings, stream, model):
+        self.dynamics, self.stream, self.model = dynamics, stream, model
+        self.kinematic = settings.mode == 'kinematic'
+        self.angular_speed0 = abs(settings.omega0)
+        self.energy0 = stream.initial_energy
+
+    @property
+    def solver(self):
+        """The stream's solver ('quadrature', 'libration', 'DOP853', ...)."""
+        return self.stream.solver
+
+    def sample(self, t):
+        """(u, u̇, None, w or None, None, (G, A, B, q)) at times t (s, increasing), as
+        :meth:`SceneMotion.sample`: no ü or scene values; w (rad/s) for a body other than the
+        ellipse (finite where u̇ is not), None for the ellipse (|ω_u| u̇, read where needed)."""
+        if self.dynamics.general:
+            u, u_dot, speed = self.stream.sample_with_speed(t)
+        else:
+            (u, u_dot), speed = self.stream.sample(t), None
+        poses = self.dynamics.cycle.poses(u)
+        return (u, u_dot, None, speed, None,
+                (poses.position_g, poses.contact_a, poses.contact_b, poses.quaternion))
+
+    def track_rest(self, t, u, u_dot, u_ddot, values):
+        """Nothing to note: the flat free motion never comes to rest by itself."""
+
+    def forces(self, u, u_dot, u_ddot, speed):
+        """The contact forces (:class:`~twodisk_ros.physics.forces.contact.ContactForces`)
+        at the states of :meth:`sample`: the motor's at the constant |omega0| in kinematic
+        mode, else the free motion's from (u, u̇) (the ellipse) or (u, w)."""
+        if self.kinematic:
+            return self.model.kinematic(u, self.angular_speed0)
+        if speed is None:
+            return self.model.dynamic(u, u_dot)
+        return self.model.dynamic(u, angular_speed=speed)

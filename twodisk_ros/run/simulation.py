@@ -15,7 +15,7 @@ from ..physics.forces.contact import ContactForceModel
 from ..physics.forces.validity import check_validity
 from ..physics.motion.dynamics import PhaseState
 from .description import RunDescription
-from .scene_simulation import SceneMotion, flat_free
+from .scene_simulation import FlatMotion, SceneMotion, flat_free
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
 
@@ -117,17 +117,16 @@ class Simulation:
         #: None on the flat free scene's path, else the SceneMotion of this stretch
         self.scene = None
         if start is None and flat_free(s):
-            self.stream = run.stream()
             self.start = None
+            self.motion = FlatMotion(self.dynamics, s, run.stream(), self.forces)
         else:
             self.start = run.start() if start is None else start
-            self.scene = SceneMotion(self.dynamics, s, self.forces, drive=drive,
-                                     command=command, start=self.start, carry=carry,
-                                     terms=terms)
-            self.stream = self.scene.stream
+            self.motion = self.scene = SceneMotion(
+                self.dynamics, s, self.forces, drive=drive, command=command, start=self.start,
+                carry=carry, terms=terms)
             self.invalid = self.scene.standing_report()
-        self.energy0 = (self.stream.initial_energy if self.scene is None
-                        else self.scene.energy0)
+        self.stream = self.motion.stream
+        self.energy0 = self.motion.energy0
         if start is None:
             self.equilibria     # (computed before the first sample, not during it)
 
@@ -189,49 +188,19 @@ class Simulation:
         time reported as ``t + time_offset`` (s, the node's simulated time).
         """
         t = np.asarray(t, dtype=float)
-        if self.scene is not None:
-            return self._scene_sample(t, forces, time_offset)
-        if self.dynamics.general:      # w: finite where u̇ is not
-            u, u_dot, speed = self.stream.sample_with_speed(t)
-        else:                           # w = |ω_u| u̇ read where it is needed (angular_speed)
-            (u, u_dot), speed = self.stream.sample(t), None
-        poses = self.dynamics.cycle.poses(u)
-        quaternion = continuous_quaternions(poses.quaternion, self._last_quaternion)
-        if len(quaternion):
-            self._last_quaternion = quaternion[-1]
-        theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
-        contact = None
-        if forces:
-            if self.settings.mode == 'kinematic':
-                contact = self.forces.kinematic(u, self.angular_speed0)
-            elif speed is None:              # the ellipse: u̇ is finite everywhere
-                contact = self.forces.dynamic(u, u_dot)
-            else:
-                contact = self.forces.dynamic(u, angular_speed=speed)
-            self._check(t + time_offset, contact)
-        return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
-                      theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot,
-                      position_g=poses.position_g, contact_a=poses.contact_a,
-                      contact_b=poses.contact_b, quaternion=quaternion, forces=contact,
-                      angular_speed=speed)
-
-    def _check(self, times, contact):
-        if self.invalid is None and len(times):
-            report = check_validity(times, contact, self.settings.friction)
-            if not report.valid:
-                self.invalid = report
-
-    def _scene_sample(self, t, forces, time_offset):
-        u, u_dot, u_ddot, speed, values, (g, a, b, q) = self.scene.sample(t)
-        self.scene.track_rest(t + time_offset, u, u_dot, u_ddot, values.energy)
+        u, u_dot, u_ddot, speed, values, (g, a, b, q) = self.motion.sample(t)
+        self.motion.track_rest(t + time_offset, u, u_dot, u_ddot, values)
         quaternion = continuous_quaternions(q, self._last_quaternion)
         if len(quaternion):
             self._last_quaternion = quaternion[-1]
         theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(u)
         contact = None
         if forces:
-            contact = self.scene.forces(u, u_dot, u_ddot)
-            self._check(t + time_offset, contact)
+            contact = self.motion.forces(u, u_dot, u_ddot, speed)
+            if self.invalid is None and len(t):
+                report = check_validity(t + time_offset, contact, self.settings.friction)
+                if not report.valid:
+                    self.invalid = report
         return Sample(t=t, phase=u, phase_rate=u_dot, theta=theta, psi=psi,
                       theta_rate=dtheta * u_dot, psi_rate=dpsi * u_dot, position_g=g,
                       contact_a=a, contact_b=b, quaternion=quaternion, forces=contact,
