@@ -1,7 +1,7 @@
 """The drawers (Foxglove /body, RViz markers, the animation) draw the real lamina outline.
 
 References: the laminae's own definitions (the superellipse's implicit equation, the egg's
-support function h of lamina.py) and the placement of the laminae in general_body.py's
+support function h of laminae/shapes.py) and the placement of the laminae in bodies/contact_solver.py's
 docstring, written out here; the lamina's area (lamina.moments: closed forms for the
 superellipse) against the shoelace area of what is drawn. The drawers get a
 ContactSolver (any lamina) as a body: LaminaBody has the same attributes.
@@ -89,7 +89,7 @@ def test_marker_fans_fill_the_egg():
     for outline, fan, plane in ((specs[0], specs[3], 2), (specs[1], specs[4], 0)):
         points = np.asarray(outline.points)
         assert np.array_equal(points[0], points[-1]) and np.all(points[:, plane] == 0)
-        # back to lamina coordinates (general_body.py's placement) and onto the egg: every
+        # back to lamina coordinates (bodies/contact_solver.py's placement) and onto the egg: every
         # vertex is a boundary point (p·n = h(n) along its own outward normal, found as the
         # best of a dense circle of directions, to that circle's resolution)
         if plane == 2:

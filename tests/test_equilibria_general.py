@@ -5,7 +5,7 @@ u = g(v), smooth (g = v + ε sin 2v) or degenerate (g = v − ½ sin 2v: the bod
 at v = 0, π, as at a superellipse's flat vertex). Its equilibria are physically the ellipse's,
 which the ellipse path knows in closed form (eight fixed angles, paper section 4), and
 d²z_G/dγ² (γ the body's turn about AB) is also given in closed form for any lamina by
-symmetric_stability.symmetric_equilibria: two independent references for the general search,
+stability.symmetric.symmetric_equilibria: two independent references for the general search,
 which uses nothing of the ellipse.
 """
 
@@ -61,7 +61,7 @@ def test_general_search_finds_the_ellipse_equilibria(shape, kind):
 
 def test_degenerate_phase_is_classified_in_the_turn():
     """Claim: at a phase where the body does not turn (|ω_u| = 0, m = 0) the equilibrium is
-    still found and classified, in γ: d²z_G/dγ² equals symmetric_stability's closed form for
+    still found and classified, in γ: d²z_G/dγ² equals stability.symmetric's closed form for
     θ = 0 (an independent derivation from the lamina's radius of curvature at its tip)."""
     base = EllipseBody(1.0, 1.6, 0.4)
     double = ReparametrisedBody(base, 'degenerate')
@@ -109,10 +109,10 @@ FLAT_VERTEX_BODIES = [((0.1, 0.1, 4.0), 0.05), ((0.1, 0.07, 6.0), 0.04), ((1.0, 
                       ((0.1, 0.1, 2.5), 0.05), ((0.1, 0.1, 3.0), 0.05), ((0.1, 0.08, 3.0), 0.03),
                       ((0.1, 0.1, 7.5), 0.05)]
 #: the flat-vertex order q (z_G − z* ≈ A|γ|^q + Bγ²) estimated by the search from three levels
-#: (the γ² term eliminated), against symmetric_stability's n/(n − 1): measured ≤ 9.0e-3
+#: (the γ² term eliminated), against stability.symmetric's n/(n − 1): measured ≤ 9.0e-3
 #: (n = 10, where the o(γ²) rest is largest), ≤ 2.1e-4 for n ≤ 4
 ORDER_TOL = 1.5e-2
-#: A against symmetric_stability's leading coefficient (relative) for n ≤ 4 (q ≥ 4/3), where
+#: A against stability.symmetric's leading coefficient (relative) for n ≤ 4 (q ≥ 4/3), where
 #: the order is that close: measured ≤ 2.4e-3
 LEADING_RTOL = 5e-3
 
@@ -121,7 +121,7 @@ LEADING_RTOL = 5e-3
 def test_flat_vertex_equilibria_sit_exactly_on_the_vertex(shape, delta):
     """Claim: an equilibrium resting on a flat vertex is reported at exactly the phase of the
     flat-vertex pose (bisection of the sign of dz_G/du stopped 1.3e-5 rad off: z_G − z* is
-    below rounding there), with θ, stability and order of symmetric_stability's closed forms
+    below rounding there), with θ, stability and order of stability.symmetric's closed forms
     (an independent derivation from the vertex's order of contact)."""
     from twodisk_ros.physics.stability.certified import flat_vertex_phases
     from twodisk_ros.physics.laminae.shapes import Superellipse

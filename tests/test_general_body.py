@@ -68,7 +68,7 @@ def test_ellipse_agrees_with_closed_forms(a, b, delta, arrangement):
             scale = size if name.startswith('contact') else 1.0
             np.testing.assert_allclose(getattr(got, name), getattr(exact, name)[mask],
                                        rtol=0, atol=ELLIPSE_TOL * scale, err_msg=name)
-    # the θ-named functions mirror body.py's one to one
+    # the θ-named functions mirror bodies/ellipse.py's one to one
     theta = ref.theta_max * np.linspace(-0.99, 0.99, 41)
     for branch in (1, -1):
         np.testing.assert_allclose(body.contact_angle_psi(theta, branch),

@@ -1,4 +1,4 @@
-"""The mass models of bodies of any lamina (mass_models.mass_properties_of, hull_general.py).
+"""The mass models of bodies of any lamina (mass.models.mass_properties_of, mass/hull_laminae.py).
 
 Independent references, never the code's own output:
 - the ellipse's closed-form path (hull.py: another parametrisation, another derivation) for
@@ -36,7 +36,7 @@ OLOID_VOLUME = 2.0 / 3.0 * (2.0 * ellipe(0.75) + ellipk(0.75))
 
 
 def _outline():
-    """A fitted outline (lamina_fit.py) of 200 points sampled on a small egg (m)."""
+    """A fitted outline (laminae/fit.py) of 200 points sampled on a small egg (m)."""
     s = np.linspace(0.0, 2 * np.pi, 200, endpoint=False)
     return Outline.from_points(Egg(0.05, 0.04, 0.002).point(s))
 
@@ -196,7 +196,7 @@ def test_solid_symmetries(lamina, delta, arrangement):
 
 
 def test_mirrored_egg_is_the_egg_of_opposite_epsilon():
-    # Egg(a, b, −ε) is the mirror image of Egg(a, b, ε) (lamina.py): the same hull.
+    # Egg(a, b, −ε) is the mirror image of Egg(a, b, ε) (laminae/shapes.py): the same hull.
     a = general_hull_moments(MirroredLamina(Egg(1.0, 0.8, 0.05)), 0.4, 'parallel', 1e-12)
     b = general_hull_moments(Egg(1.0, 0.8, -0.05), 0.4, 'parallel', 1e-12)
     assert abs(a[0] / b[0] - 1) <= 1e-12

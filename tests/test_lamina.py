@@ -1,4 +1,4 @@
-"""The lamina protocol (physics/laminae/shapes.py, lamina_fit.py) against independent references.
+"""The lamina protocol (physics/laminae/shapes.py, laminae/fit.py) against independent references.
 
 References: closed forms from the literature (ellipse area, moments, curvature; the
 superellipse's Gamma-function area), and a generic numeric path written here from the

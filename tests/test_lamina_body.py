@@ -4,7 +4,7 @@ independent references.
 References: EllipseBody's closed forms (eccentric-anomaly phase, complex step) for ellipses,
 matched pose by pose through (θ, branch) since the two phases differ; RollingCycle of the
 closed forms; the oloid's literature values; for other shapes, checks written here from the
-lamina alone: its support function (lamina.py) at the ground normal, central-difference rim
+lamina alone: its support function (laminae/shapes.py) at the ground normal, central-difference rim
 tangents, 5-point differences of the cycle's poses (no slip) and of the phase functions
 (complex-step contract), the FFT of samples (smoothness), and the landmarks of the protocol.
 """
@@ -205,7 +205,7 @@ def test_ground_supports_both_laminae(name):
     size = body.size
     u = np.linspace(-1.0, TWO_PI + 1.0, 777)
     a_o, b_o, m = _lamina_frame(body, body.phase_vectors(u))
-    # the support heights of both laminae in direction m (lamina.py's support function)
+    # the support heights of both laminae in direction m (laminae/shapes.py's support function)
     h1 = -delta * m[:, 1] + lam.support(m[:, :2]).height
     h2 = delta * m[:, 1] + lam.support(np.stack([m[:, 2], sigma * m[:, 1]], -1)).height
     assert_allclose(np.sum(m * a_o, -1), h1, rtol=0, atol=GEOMETRY_RTOL * size)

@@ -1,7 +1,7 @@
-"""LaminaBody.about (the body seen from another point on e2) and mass_models.centred_on_mass
+"""LaminaBody.about (the body seen from another point on e2) and mass.models.centred_on_mass
 (a solid whose centre of mass lies off the laminae's centroid G: the parallel egg).
 
-References: the exact contact geometry of general_body.py (support height of the lamina at
+References: the exact contact geometry of bodies/contact_solver.py (support height of the lamina at
 the ground normal, from O), brute-force distances over the rims, the unmoved body's own
 vectors (a moved point is a translation), and for the dynamics the energy of the real body
 computed from the unmoved body's world poses alone: the centre of mass at G + c e2, its

@@ -1,4 +1,4 @@
-"""Lamina.vertex (lamina.py): extent, radius of curvature and order of contact at the vertices.
+"""Lamina.vertex (laminae/shapes.py): extent, radius of curvature and order of contact at the vertices.
 
 References: the ellipse's and the egg's closed forms written here (b²/a, a²/b, b²/a ∓ 8ε,
 a ± ε, the egg's widest point at y = 3ε); for the superellipse, the support function taken by

@@ -80,7 +80,7 @@ def test_hull_vertices_lie_on_the_rims_and_cover_both(abd):
     body = EllipseBody(*abd)
     mesh = hull_mesh(body, 128)
     plane, rim, on_1 = _rim_residuals(body, mesh.vertices)
-    # the closed forms' accuracy (body.py): lengths to 2e-14 of the size, 2e-13 at extremes;
+    # the closed forms' accuracy (bodies/ellipse.py): lengths to 2e-14 of the size, 2e-13 at extremes;
     # off the disk's plane by rounding only (16 ulps of the size)
     assert plane.max() <= ulps(16)
     assert rim.max() <= (2e-14 if abd in BODIES else 2e-13)

@@ -1,8 +1,8 @@
 """Drawing any lamina (model/outline.py, model/rulings.py and their users) against references.
 
 Independent references: the laminae's own definitions (the superellipse's implicit equation
-|x/b|ⁿ + |y/a|ⁿ = 1, the support function h of lamina.py, evaluated on a dense circle of
-directions); the placement of the laminae written out here from general_body.py's docstring
+|x/b|ⁿ + |y/a|ⁿ = 1, the support function h of laminae/shapes.py, evaluated on a dense circle of
+directions); the placement of the laminae written out here from bodies/contact_solver.py's docstring
 (disk 1's point (x, y) at (x, y − Δ, 0) − G, disk 2's at (0, Δ + σy, x) − G); trimesh (a
 second library) for closedness, winding and volume; scipy.spatial.ConvexHull of densely
 sampled rims (20 001 points of lamina.point per rim, not model/outline.py's polygon: 1e-7
@@ -70,7 +70,7 @@ def test_outline_misses_the_support_function_by_at_most_its_tolerance(lamina, to
 
 
 def test_outline_of_a_fitted_outline():
-    # a lamina fitted from points (lamina_fit.Outline: a support-function lamina whose
+    # a lamina fitted from points (laminae.fit.Outline: a support-function lamina whose
     # parameter is the normal angle) is drawn to the same guarantee
     from twodisk_ros.physics.laminae.fit import Outline
     given = Egg(1.0, 0.7, 0.05).point(np.linspace(0, 2 * np.pi, 200, endpoint=False))
@@ -110,7 +110,7 @@ def test_rims_sit_where_general_body_puts_the_laminae(body):
     rim_1, rim_2 = disk_rims(general, 1e-4, closed=False)
     sigma = 1.0 if arrangement == 'parallel' else -1.0
     g = general.centroid
-    # back to lamina coordinates by the placement of general_body.py's docstring
+    # back to lamina coordinates by the placement of bodies/contact_solver.py's docstring
     lamina_1 = np.stack([rim_1[:, 0] + g[0], rim_1[:, 1] + g[1] + delta], axis=-1)
     lamina_2 = np.stack([rim_2[:, 2] + g[2], sigma * (rim_2[:, 1] + g[1] - delta)], axis=-1)
     assert np.all(rim_1[:, 2] == 0) and np.all(rim_2[:, 0] == 0)

@@ -1,7 +1,7 @@
 """A body moved to its centre of mass (LaminaBody.about) is drawn about that point.
 
 The solid hull of a parallel egg has its centre of mass off the laminae's centroid G; the
-run description moves the body there (mass_models.centred_on_mass), and the node's pose is
+run description moves the body there (mass.models.centred_on_mass), and the node's pose is
 that of the moved origin P. The drawing (rims, disk frames, the hull's rulings) must then
 place the laminae at −offset e2 from P. References: the physics' contact geometry (r1 = PA,
 r2 = PB, the ground normal n, from the phase tables) and the laminae's placement written out

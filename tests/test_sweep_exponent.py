@@ -268,7 +268,7 @@ def test_maps_draw_one_panel_per_exponent_on_one_scale(tmp_path):
 # -- a real superellipse (once LaminaBody is implemented) -----------------------------------
 
 def _superellipse_plate_moments(b, n):
-    """Area and ∫x² dA, ∫y² dA of |x/b|ⁿ + |y|ⁿ ≤ 1 (Γ functions; not lamina.py's code)."""
+    """Area and ∫x² dA, ∫y² dA of |x/b|ⁿ + |y|ⁿ ≤ 1 (Γ functions; not laminae/shapes.py's code)."""
     g = math.gamma
     area = 4 * b * g(1 + 1 / n) ** 2 / g(1 + 2 / n)
     xx = 4 * b**3 * g(3 / n) * g(1 / n) / (n**2 * g(1 + 4 / n))
@@ -287,7 +287,7 @@ def test_a_real_superellipse_n4_body():
     first, turning, side = symmetric_equilibria(Superellipse(1.0, b, n), d)
     # claim (issue 20): the general path is exact to <= 1e-11 of the size (size ~ 1.5 a)
     size = 1.5
-    # flat vertices: every symmetric pose a local minimum (symmetric_stability.py)
+    # flat vertices: every symmetric pose a local minimum (stability/symmetric.py)
     assert (first.stability, side.stability) == ('stable', 'stable')
     assert got['stable_family'][0] == 2.0
     # the lowest pose rests on the side vertices: z_G = w/√2 with w = b (closed form)

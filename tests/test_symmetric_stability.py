@@ -4,7 +4,7 @@ equilibria against independent references.
 References, sharing no code with the module under test:
 
 * the height of G along the rolling motion from ContactSolver's contact geometry (the
-  support-function solve of general_body.py), differentiated numerically here: z_G is sampled
+  support-function solve of bodies/contact_solver.py), differentiated numerically here: z_G is sampled
   at six poses whose rolling angle γ (the signed angle between the ground normal n and its
   value at the equilibrium, both in the body frame) is about ±h, ±h/2, ±h/4, and
   z_G − z_G* = Σ_{j=1..6} c_j γ^j is solved exactly: d²z_G/dγ² = 2c₂. The same solve of

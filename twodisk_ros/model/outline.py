@@ -1,7 +1,7 @@
 """The outlines of a body's two laminae, sampled for drawing: any lamina, any body.
 
 Everything that draws the body (meshes, URDF, RViz markers, the Foxglove view, animations)
-takes its rims from here, so it draws the real outline of :attr:`body.lamina` (lamina.py):
+takes its rims from here, so it draws the real outline of :attr:`body.lamina` (laminae/shapes.py):
 an ellipse, a superellipse, an egg or a fitted outline.
 
 **The polygon.** :func:`lamina_outline` inscribes a polygon in the lamina's boundary, in
@@ -17,7 +17,7 @@ s = π at index N/2, runs counterclockwise and is exactly symmetric about the co
 the lamina (``lamina.point``). :func:`resolution_tolerance` converts a mesh resolution n
 (vertices of a regular n-gon) into the equivalent tolerance 1 − cos(π/n).
 
-**In the body.** Body frame G e1 e2 e3 (m). With general_body.py's placement, disk 1's
+**In the body.** Body frame G e1 e2 e3 (m). With bodies/contact_solver.py's placement, disk 1's
 lamina point (x, y) sits at (x, y − Δ, 0) − G and disk 2's at (0, Δ + σy, x) − G, σ = ±1 the
 arrangement ('parallel', 'swapped'); G = ContactSolver(lamina, Δ, arrangement).centroid,
 the midpoint of the centres for laminae symmetric along y (ellipses, superellipses). A body

@@ -43,7 +43,7 @@ SHAPES = ('ellipse', 'superellipse', 'egg', 'points')
 ARRANGEMENT_NAMES = ('parallel', 'swapped')
 #: Largest |egg_asymmetry|: the egg's radius of curvature stays ≥ 5 % of the ellipse's.
 EGG_ASYMMETRY = 0.95
-#: Largest shape file read (bytes): lamina_fit accepts at most 20 000 points (~ 1 MB of text).
+#: Largest shape file read (bytes): laminae.fit accepts at most 20 000 points (~ 1 MB of text).
 MAX_SHAPE_FILE_BYTES = 4 << 20
 #: Most coefficients accepted from a recording (the fit uses at most 129).
 MAX_COEFFICIENTS = 1024

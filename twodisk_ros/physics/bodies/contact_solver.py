@@ -1,12 +1,12 @@
 """Two congruent laminae of any shape: the contact geometry solved from the support function.
 
 docs/physics.md#the-contact-geometry-of-any-laminae. :class:`~twodisk_ros.physics.bodies.lamina_body.
-LaminaBody` tabulates these exact solutions over the cycle; the hull (hull_general.py) and the
+LaminaBody` tabulates these exact solutions over the cycle; the hull (mass/hull_laminae.py) and the
 drawing (model/) use them directly. :class:`~twodisk_ros.physics.bodies.ellipse.EllipseBody` stays the
 exact, fast path for ellipses and is the reference the tests hold this one to.
 
-Body frame as in body.py (metres): O, the midpoint of the centres, is the origin; e2 is the
-common axis. Disk 1 lies in the plane x3 = 0 and its lamina point (x, y) (lamina.py
+Body frame as in bodies/ellipse.py (metres): O, the midpoint of the centres, is the origin; e2 is the
+common axis. Disk 1 lies in the plane x3 = 0 and its lamina point (x, y) (laminae/shapes.py
 coordinates) sits at C1 + x e1 + y e2, C1 = −Δ e2. Disk 2 lies in the plane x1 = 0 and its
 lamina point (x, y) sits at C2 + x e3 + σ y e2, C2 = +Δ e2, with the arrangement σ:
 
@@ -18,7 +18,7 @@ lamina point (x, y) sits at C2 + x e3 + σ y e2, C2 = +Δ e2, with the arrangeme
 For an ellipse both are the same body as EllipseBody(a, b, Δ). G is the centroid of the two
 laminae (equal masses): G = (1 + σ) ȳ/2 e2 with ȳ the lamina's centroid (0 unless the lamina
 is asymmetric along y, as the egg is). θ and ψ are the polar angles of A about C1 (from −e2
-towards +e1) and of B about C2 (from +e2 towards −e3), as in body.py.
+towards +e1) and of B about C2 (from +e2 towards −e3), as in bodies/ellipse.py.
 
 The contact relation. Let m = −n be the downward unit ground normal (body frame). The body
 rests on the plane when its lowest points on both laminae are equally low, i.e. when the two
@@ -26,7 +26,7 @@ support heights agree: h1(m) = −Δ m2 + h(m1, m2) = h2(m) = Δ m2 + h(m3, σ m
 lamina's support function. Writing the in-plane part of m as the outward lamina normal ν at
 A, m = (ν_x, ν_y, τ)/√(1 + τ²), the condition becomes one equation in the elevation τ,
 h(τ, σν_y) = A·ν − 2Δ ν_y =: L, whose left side is even and convex in τ: two roots ±|τ| (the
-two branches; branch +1 has τ < 0, n·e3 > 0, as in body.py) while L ≥ h(0, σν_y), none
+two branches; branch +1 has τ < 0, n·e3 > 0, as in bodies/ellipse.py) while L ≥ h(0, σν_y), none
 beyond. The family ends where F = L − h(0, σν_y) vanishes: θ_max; there disk 1 stands
 vertical (τ = 0). |ψ| is largest at θ = 0, where the normal lies in the plane of disk 2.
 
@@ -153,7 +153,7 @@ class ContactSolver:
     Parameters
     ----------
     lamina : Lamina
-        The shape of both disks (lamina.py); its origin is the disk's centre and must lie
+        The shape of both disks (laminae/shapes.py); its origin is the disk's centre and must lie
         inside it (θ is a polar angle about it).
     delta : float
         Half the distance between the centres (m), 0 < Δ < (y_max − y_min)/2 (the laminae's
@@ -332,7 +332,7 @@ class ContactSolver:
         s = _bisect(polar, np.zeros_like(target), np.full_like(target, self.s_max))
         return np.where(theta < 0, -s, s)
 
-    # -- the θ chart (body.py's names) -------------------------------------------------------
+    # -- the θ chart (bodies/ellipse.py's names) -------------------------------------------------------
     def geometry(self, theta, branch=1):
         """:class:`ContactGeometry` at contact angle θ (rad) on a branch (±1)."""
         theta = self._theta_array(theta)
@@ -420,7 +420,7 @@ class ContactSolver:
                     np.full_like(tau_abs, self.s_max))
         return self._pose(side * s, tau_abs, branch)
 
-    # -- the charts of the regular phase (lamina_phase.py) ------------------------------------
+    # -- the charts of the regular phase (bodies/regular_phase.py) ------------------------------------
     @property
     def far_tip(self):
         """Disk 2's lamina parameter (0 or π) of the tip B touches at the turning points."""

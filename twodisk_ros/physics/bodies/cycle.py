@@ -186,7 +186,7 @@ class RollingCycle:
     Parameters
     ----------
     body : RollingBody
-        EllipseBody or LaminaBody (rolling_body.py).
+        EllipseBody or LaminaBody (bodies/protocol.py).
     resolution : int, optional
         Grid size of the spectral integration (power of two). By default it is doubled from
         512 until the upper half of the spectra of dα/du and of the trace's rate is below

@@ -15,15 +15,15 @@ flat_vertex_phases` is the hook for the equilibria search: the exact phases wher
 sits on a flat vertex (z_G flat to high order there), onto which a root of dz_G/du found
 nearby should be snapped.
 
-Complex-step contract (rolling_body.py): at u + i h the table returns f(u) + i h f′(u) with
+Complex-step contract (bodies/protocol.py): at u + i h the table returns f(u) + i h f′(u) with
 f′ the interpolant's derivative, so callers' complex steps give the spectral derivative.
 
-Frames as in body.py and general_body.py: body frame with origin G, the centroid of the two
+Frames as in bodies/ellipse.py and bodies/contact_solver.py: body frame with origin G, the centroid of the two
 laminae (ContactSolver.centroid); r1 = GA, r2 = GB (m); n the upward ground normal.
 :meth:`LaminaBody.about` moves the origin (the reference point P) along e2, sharing the
 tables: then r1 = PA, r2 = PB and the height is P's, z_P = z_G + n·(P − G). That is how a
 solid whose centre of mass lies off G (an egg in the parallel arrangement) gets a body whose
-origin is its centre of mass, as RollingDynamics needs (mass_models.centred_on_mass).
+origin is its centre of mass, as RollingDynamics needs (mass.models.centred_on_mass).
 """
 
 import copy
@@ -115,12 +115,12 @@ class LaminaBody(RollingBody):
     Parameters
     ----------
     lamina : Lamina
-        The shape of both disks (lamina.py).
+        The shape of both disks (laminae/shapes.py).
     delta : float
         Half the distance between the centres (m) (limits as in
         :class:`~twodisk_ros.physics.bodies.contact_solver.ContactSolver`).
     arrangement : str
-        'parallel' (default) or 'swapped' (general_body.py).
+        'parallel' (default) or 'swapped' (bodies/contact_solver.py).
 
     Attributes
     ----------
@@ -335,10 +335,10 @@ class LaminaBody(RollingBody):
         return cached
 
     def contact_angle_psi(self, theta, branch=1):
-        """ψ(θ) (rad) on a branch (the exact θ chart of general_body.py)."""
+        """ψ(θ) (rad) on a branch (the exact θ chart of bodies/contact_solver.py)."""
         return self.general.contact_angle_psi(theta, branch)
 
-    # -- the paper's θ chart, exact (general_body.py) ----------------------------------------
+    # -- the paper's θ chart, exact (bodies/contact_solver.py) ----------------------------------------
     def geometry(self, theta, branch=1):
         """:class:`~twodisk_ros.physics.bodies.contact_solver.ContactGeometry` at θ on a branch
         (contact vectors and height of the reference point)."""

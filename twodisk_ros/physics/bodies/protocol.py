@@ -8,7 +8,7 @@ Two implementations:
   :mod:`~twodisk_ros.physics.laminae.shapes`): the contact solved from the lamina, tabulated over one
   cycle and evaluated spectrally.
 
-Frames and units as in body.py: body frame G e1 e2 e3 (metres), e2 the common axis, disk 1 in
+Frames and units as in bodies/ellipse.py: body frame G e1 e2 e3 (metres), e2 the common axis, disk 1 in
 the plane x3 = 0, disk 2 in the plane x1 = 0. The **phase** u (rad) is a regular,
 2π-periodic parameter of the one-parameter family of resting poses (docs/physics.md#the-
 regular-phase-u): u = 0 is θ = 0 on branch +1, u = π/2 the turning point θ = +θ_max, u = π
@@ -70,9 +70,9 @@ class RollingBody(abc.ABC):
     size : float
         The largest distance of a disk point from G (m); relative errors are quoted to it.
     lamina : Lamina
-        The shape of both disks (lamina.py), in disk 1's lamina coordinates.
+        The shape of both disks (laminae/shapes.py), in disk 1's lamina coordinates.
     arrangement : str
-        'parallel' or 'swapped' (general_body.py; the same body for symmetric laminae).
+        'parallel' or 'swapped' (bodies/contact_solver.py; the same body for symmetric laminae).
     feature_width : float
         Width (rad of u) of the sharpest feature of the functions of u, in (0, 1]: finite-
         difference steps and table resolutions scale with it.

@@ -15,7 +15,7 @@ world, solves the paper's eqs. (4)-(6).
 
 Public API: :class:`ContactForceModel` (``forces``, ``dynamic``, ``kinematic``, ``along``,
 ``coefficients``), :class:`ContactForces`, :func:`squeeze_split`. Validity checks and
-speed sweeps are in :mod:`contact_validity` (same folder).
+speed sweeps are in :mod:`forces.validity` (same folder).
 """
 
 from dataclasses import dataclass

@@ -86,7 +86,7 @@ def motion_validity(model, motion, mu=math.inf):
 def liftoff_speed(model):
     """Critical |ω| (rad/s) above which a contact lifts off in kinematic motion.
 
-    In kinematic mode N(u; Ω) = N0(u) + Ω² C_N(u)/s(u) exactly (s = dγ/dy ≥ 0, contact_terms),
+    In kinematic mode N(u; Ω) = N0(u) + Ω² C_N(u)/s(u) exactly (s = dγ/dy ≥ 0, forces.terms),
     so Ω_c² = min over u and both contacts of −N0 s/C_N where C_N < 0 (Ω_c = 0 if N0 ≤ 0
     somewhere: the drive holding the body at rest already lifts a contact; Ω_c = 0 also
     where the body stops turning on a flat vertex with C_N < 0: the force there is −∞ at any

@@ -1,7 +1,7 @@
 """A planar lamina in its own plane: one protocol, the ellipse and the superellipse.
 
-The foundation of bodies of any two congruent symmetric laminae: :mod:`general_body` solves
-their contact geometry from it and :mod:`lamina_body` makes them rolling bodies
+The foundation of bodies of any two congruent symmetric laminae: :mod:`~twodisk_ros.physics.bodies.contact_solver` solves
+their contact geometry from it and :mod:`~twodisk_ros.physics.bodies.lamina_body` makes them rolling bodies
 (docs/physics.md#laminae-other-than-ellipses).
 
 Lamina coordinates (metres), those of disk 1 in the body frame seen from its centre C1:
@@ -12,7 +12,7 @@ need not be symmetric about the x axis (the egg is not).
 The boundary is a closed curve r(s) of a 2π-periodic parameter ``s`` (rad), in the sense of
 the package's θ: s = 0 is the far tip on −y (where θ = 0 touches), s = π the tip on +y, s
 increases counterclockwise (towards +x first) and s → −s is the mirror x → −x. What s is
-depends on the shape: the eccentric anomaly for the ellipse (as in body.py), its radial
+depends on the shape: the eccentric anomaly for the ellipse (as in bodies/ellipse.py), its radial
 projection for the superellipse, the outward normal's angle for the laminae defined by their
 support function (egg, fitted outline). Everything is vectorised: ``s`` of any shape gives
 results of shape ``s.shape`` (scalars) or ``s.shape + (2,)`` (vectors); a direction array of

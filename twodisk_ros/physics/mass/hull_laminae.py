@@ -1,8 +1,8 @@
 """The solid convex hull of two congruent laminae of any shape: volume and moments.
 
-Body frame of general_body.py (metres): O, the midpoint of the disk centres, is the origin,
+Body frame of bodies/contact_solver.py (metres): O, the midpoint of the disk centres, is the origin,
 e2 the common axis, disk 1 in the plane x3 = 0, disk 2 in the plane x1 = 0 (σ = ±1 by the
-arrangement). The moments here are about O; mass_models.py moves them to the centre of mass.
+arrangement). The moments here are about O; mass/models.py moves them to the centre of mass.
 
 **The surface.** A boundary point of the hull lies on a segment AB whose ends A (on rim 1) and
 B (on rim 2) share a supporting plane: the resting poses of the rolling body. No flat part of
@@ -64,7 +64,7 @@ _FLIP = np.array([1.0, -1.0])
 
 
 class MirroredLamina(Lamina):
-    """A lamina mirrored in its x axis, (x, y) ↦ (x, −y), with lamina.py's conventions.
+    """A lamina mirrored in its x axis, (x, y) ↦ (x, −y), with laminae/shapes.py's conventions.
 
     Its parameter s is the original's π − s (so s = 0 is again the tip on −y and s increases
     counterclockwise). The dual chart of a parallel body uses it for disk 2 seen as disk 1.
@@ -233,11 +233,11 @@ def general_hull_moments(lamina, delta, arrangement='parallel', rtol=1e-9):
     Parameters
     ----------
     lamina : Lamina
-        The shape of both disks (lamina.py).
+        The shape of both disks (laminae/shapes.py).
     delta : float
         Half the distance between the disk centres (m), as ContactSolver allows.
     arrangement : str
-        'parallel' or 'swapped' (general_body.py).
+        'parallel' or 'swapped' (bodies/contact_solver.py).
     rtol : float
         Requested relative change between the last two grids (0 < rtol < 1; the roundoff
         floor is about 1e-13).

@@ -24,7 +24,7 @@ Three models are offered:
 
 The solid hull is computed in :mod:`twodisk_ros.physics.mass.hull`; docs/physics.md#mass-models.
 
-Any lamina (general_body.py's frame): disk 1's lamina point (x, y) at (x, y − Δ, 0) from O,
+Any lamina (bodies/contact_solver.py's frame): disk 1's lamina point (x, y) at (x, y − Δ, 0) from O,
 the midpoint of the centres, disk 2's at (0, Δ + σ y, x); G, the body-frame origin, is the
 laminae's centroid (1 + σ) ȳ/2 e2 (ȳ the lamina's centroid). ``laminae`` takes the lamina's
 area moments (centre of mass G exactly); ``solid`` the convex hull of the two laminae from
@@ -304,11 +304,11 @@ def laminae_of(lamina, delta, arrangement, mass):
     Parameters
     ----------
     lamina : Lamina
-        The plates' shape (lamina.py), from its area moments (area A, centroid ȳ, ∫x², ∫y²).
+        The plates' shape (laminae/shapes.py), from its area moments (area A, centroid ȳ, ∫x², ∫y²).
     delta : float
         Half the distance between the centres (m), 0 < Δ < (y_max − y_min)/2.
     arrangement : str
-        'parallel' or 'swapped' (σ = ±1, general_body.py).
+        'parallel' or 'swapped' (σ = ±1, bodies/contact_solver.py).
     mass : float
         Total mass (kg), > 0.
 
@@ -334,7 +334,7 @@ def laminae_of(lamina, delta, arrangement, mass):
 
 
 def solid_of(lamina, delta, arrangement, mass, *, rtol=1e-9):
-    """Uniform solid convex hull of two laminae of any shape (hull_general.py).
+    """Uniform solid convex hull of two laminae of any shape (mass/hull_laminae.py).
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The record of a body's mass properties, and the checks of the numbers that make one.
 
-Shared by the mass models of ellipses and of any lamina (mass_models.py). Every check raises a
+Shared by the mass models of ellipses and of any lamina (mass/models.py). Every check raises a
 one-line ValueError naming the parameter, what is allowed and what it got.
 """
 

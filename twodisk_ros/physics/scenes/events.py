@@ -2,7 +2,7 @@
 
 Both read the dense output of a :class:`~twodisk_ros.physics.scenes.motion.SceneStream` or
 :class:`~twodisk_ros.physics.scenes.motion.ClosedSceneStream` (``samples_at``) and locate the
-instant by Brent's method (docs/physics.md#scenes). Re-exported by scene_motion.
+instant by Brent's method (docs/physics.md#scenes). Re-exported by scenes.motion.
 """
 
 import math

@@ -349,7 +349,7 @@ class SceneStream:
 
 class ClosedSceneStream:
     """The motion of a conservative scene in closed form (:mod:`~twodisk_ros.physics.
-    scene_closed`): ``sample``/``samples`` as :class:`SceneStream`, no time stepping."""
+    scenes.closed`): ``sample``/``samples`` as :class:`SceneStream`, no time stepping."""
 
     rest_time = math.nan
     nfev = 0

@@ -47,7 +47,7 @@ M, DM, W, DW, H, DH, P, K_G = 0, 1, 2, 3, 4, 5, 6, 8
 CN, KRE, KIM, C2, CU, EDGE = 9, 15, 21, 27, 33, 39
 # per unit turn γ (regular where the body stops turning in u): ρ = |dG/dγ| (the distance of
 # G from AB), c·n and e^{iα_p}(c·t1 + i c·m) (c = dG/dγ), the quantities per ẇ and per w²
-# (contact_terms' Q_a and P) and J, J′
+# (forces.terms' Q_a and P) and J, J′
 RHO, CGN, CGP, QA, PW, J, DJ = 41, 42, 43, 45, 51, 57, 58
 WIDTH = 59
 

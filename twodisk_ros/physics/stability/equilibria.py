@@ -136,7 +136,7 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE, certificate=False):
 
 def _general_equilibria(body, neutral_tolerance):
     """Equilibria of any RollingBody: certified roots of dz_G/du, classified (module
-    equilibria_general)."""
+    stability.certified)."""
     roots, proof = certified_roots(body)
     if not roots:
         return [], proof

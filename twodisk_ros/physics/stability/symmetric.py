@@ -1,7 +1,7 @@
 """Stability of the symmetric equilibria of two congruent laminae, in closed form.
 
 Issue 20 (docs/physics.md#stability-of-the-symmetric-equilibria-for-any-laminae). The body is
-that of :mod:`general_body` (frame, arrangement σ, G on the common axis at g e2). Three resting
+that of :mod:`~twodisk_ros.physics.bodies.contact_solver` (frame, arrangement σ, G on the common axis at g e2). Three resting
 poses are fixed by a symmetry of the body, so z_G is stationary there:
 
 * ``'theta=0'``: disk 1 stands on its far tip (lamina vertex −y), disk 2 on the tangent from
@@ -172,11 +172,11 @@ def symmetric_equilibria(lamina, delta, arrangement='parallel',
     Parameters
     ----------
     lamina : Lamina
-        Shape of both disks (lamina.py), convex and symmetric about the common axis.
+        Shape of both disks (laminae/shapes.py), convex and symmetric about the common axis.
     delta : float
         Half the distance between the disk centres (m), as for ContactSolver.
     arrangement : str
-        'parallel' (default) or 'swapped' (general_body.py).
+        'parallel' (default) or 'swapped' (bodies/contact_solver.py).
     neutral_tolerance : float
         Criteria within this fraction of their scale are reported as 'neutral'
         (:data:`NEUTRAL_TOLERANCE`).
