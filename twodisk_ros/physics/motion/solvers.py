@@ -61,6 +61,19 @@ class PhaseSolution:
         asked for: nothing here (a solution built piece by piece as time runs on frees its
         earlier pieces)."""
 
+    def state(self, t, turn_rate=None):
+        """(u, w) at times t (s): the phase (rad) and the angular speed about AB (rad/s),
+        w = |ω_u|(u) u̇ with ``turn_rate(u)`` = |ω_u| (a solution in the chart (u, w) gives
+        w itself and needs no ``turn_rate``)."""
+        u, u_dot = self(t)
+        return u, u_dot * turn_rate(u)
+
+    def initial_energy(self, energy_turning, turn_rate):
+        """E (J) of the motion: ``energy_turning(u, w)`` of the state at t = 0 (a solution
+        that holds its energy gives it instead)."""
+        return float(energy_turning(*(float(np.ravel(x)[0])
+                                      for x in self.state(0.0, turn_rate))))
+
     def _evaluate(self, t):
         raise NotImplementedError
 
@@ -388,7 +401,7 @@ class SundmanSolution(PhaseSolution):
         self._tau_end = float(tau_end)
         self.t_end = float(dense(self._tau_end)[2]) if dense is not None else 0.0
 
-    def state(self, t):
+    def state(self, t, turn_rate=None):
         """(u, w) at times t (s): the phase and the body's angular speed about AB (rad/s)."""
         t = np.asarray(t, dtype=float).ravel()
         if self._dense is None or t.size == 0:

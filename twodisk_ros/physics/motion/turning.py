@@ -155,6 +155,10 @@ class TurningPointSolution(PhaseSolution):
         #: the period of the oscillation (s)
         self.period = self._phase.cycle_time
 
+    def initial_energy(self, energy_turning=None, turn_rate=None):
+        """E (J): the level the motion keeps between its turning points."""
+        return float(self.energy)
+
     def _inverse_rate(self, phi):
         """dt/dφ = √(m / (2Q)) at φ (s/rad)."""
         r = self._r

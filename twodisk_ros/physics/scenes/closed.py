@@ -137,10 +137,14 @@ class DriftQuadrature(PhaseSolution):
         with np.errstate(divide='ignore', invalid='ignore'):
             return u, w / rate
 
-    def state(self, t):
+    def state(self, t, turn_rate=None):
         """(u, w) at times t (s): the phase and the angular speed about AB,
         w = σ √(2(E − V)/J) (rad/s, finite where the body stops turning in u)."""
         return self._state(t)[:2]
+
+    def initial_energy(self, energy_turning=None, turn_rate=None):
+        """E (J): the energy it was built from."""
+        return float(self.energy)
 
     def _state(self, t):
         """(u, w, |ω_u|) at times t (s): one read of the energy table per call."""

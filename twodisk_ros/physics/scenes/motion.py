@@ -356,8 +356,7 @@ class ClosedSceneStream:
 
     def __init__(self, terms, solution):
         self.terms, self.scene, self.solution = terms, terms.scene, solution
-        self.initial_energy = float(solution.energy) if hasattr(solution, 'energy') else \
-            float(terms.energy_turning(*(float(np.ravel(x)[0]) for x in self.state(0.0))))
+        self.initial_energy = solution.initial_energy(terms.energy_turning, self._turn_rate)
 
     @property
     def solver(self):
@@ -375,13 +374,13 @@ class ClosedSceneStream:
         u, u_dot = self.solution(t)
         return u, u_dot
 
+    def _turn_rate(self, u):
+        """|ω_u| (rad per rad of u) at phases u, from the scene's energy jet."""
+        return self.terms.energy_jet(u)[..., 4]
+
     def state(self, t):
         """(u, w) at times t (s): the phase and the angular speed about AB (rad/s)."""
-        t = np.asarray(t, dtype=float)
-        if hasattr(self.solution, 'state'):
-            return self.solution.state(t)
-        u, u_dot = self.solution(t)
-        return u, u_dot * self.terms.energy_jet(u)[..., 4]
+        return self.solution.state(np.asarray(t, dtype=float), self._turn_rate)
 
     def samples(self, t):
         """:class:`SceneSamples` at times t (s, increasing)."""
