@@ -88,7 +88,7 @@ def first_failure(terms, samples, stream=None, *, resolution=0.01):
     friction = terms.scene.friction
     forces = _forces(terms, samples)
     report = check_validity(samples.t, forces, friction)
-    if not hasattr(stream, 'samples_at') or samples.t.size < 2:
+    if stream is None or samples.t.size < 2:
         return report
     last = samples.t.size - 1 if report.valid else report.index
     t, u = samples.t[:last + 1], samples.phase[:last + 1]
