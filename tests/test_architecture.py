@@ -178,7 +178,7 @@ PROTOCOLS = {'Lamina', 'SupportLamina', 'RollingBody', 'RollingDynamics', 'Scene
              'SceneTerms'}
 #: names under which bodies, laminae, scenes, streams and solutions are passed around: a
 #: ``hasattr`` or a defaulted ``getattr`` on them asks what kind of thing it is
-SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'candidate'}
+SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'sol', 'candidate'}
 #: The switches still in the package, each (module, what): the aim is none. Removing one
 #: shrinks this list; adding one fails the test.
 KNOWN_SWITCHES = sorted([

@@ -470,9 +470,8 @@ class ContactForceModel:
 
     def along(self, motion):
         """Forces at the samples of a :class:`~twodisk_ros.dynamics.RollingMotion`."""
-        state = getattr(motion.sol, 'state', None)
-        if state is not None:                       # SundmanSolution: (u, w) directly
-            speed = state(motion.t)[1]
+        if motion.sol.regular_chart:                # SundmanSolution: (u, w) directly
+            speed = motion.sol.state(motion.t)[1]
         else:
             s_u = self.terms.turn_rates(motion.phase)[0]
             with np.errstate(invalid='ignore'):

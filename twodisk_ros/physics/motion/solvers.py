@@ -37,6 +37,10 @@ class PhaseSolution:
     t_end = math.inf
     #: the equilibrium u* (rad) the motion oscillates about (or rests at), else None
     centre = None
+    #: True if the solution holds the state (u, w) of the regular chart itself (w the angular
+    #: speed about AB, finite where the body stops turning in u): :meth:`state` needs no
+    #: ``turn_rate`` then, and u̇ = w/|ω_u| is only what it reports
+    regular_chart = False
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
@@ -391,6 +395,7 @@ class SundmanSolution(PhaseSolution):
         |ω_u|(u) (rad per rad of u), to report u̇ = w/|ω_u| (inf where it vanishes).
     """
 
+    regular_chart = True
     name = 'DOP853'
     closed_form = False
 

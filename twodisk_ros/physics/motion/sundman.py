@@ -136,9 +136,8 @@ def turning_state(dynamics, sol, t, mode, energy, speed):
     and ½ m u̇² are not: 2.17 rad/s and a 2e-5 error of E at the vertex of the n = 4
     square at 3 rad/s.)
     """
-    state = getattr(sol, 'state', None)
-    if state is not None:
-        u, w = state(t)
+    if sol.regular_chart:
+        u, w = sol.state(t)
         with np.errstate(divide='ignore', invalid='ignore'):
             return u, w / dynamics.angular_speed_per_phase(u), w
     u, u_dot = sol(t)

@@ -65,6 +65,7 @@ class DriftQuadrature(PhaseSolution):
         w0 = |ω_u(u0)| u̇0 (rad/s, ≠ 0) instead of u̇0: the start where |ω_u(u0)| = 0.
     """
 
+    regular_chart = True
     name = 'quadrature'
     #: cycles of nodes kept before the earliest time of the latest call (older ones dropped)
     KEEP = 2
