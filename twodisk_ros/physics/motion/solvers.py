@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..bodies.cycle import TWO_PI
+from ..numerics.dense import dense_reader
 from ..numerics.spectral import (STALL, refine_grid, spectral_antiderivative, spectral_derivative,
                        spectral_tail, upsample)
 from ..numerics.tables import HermiteTable
@@ -122,7 +123,8 @@ class OdeSolution(PhaseSolution):
 
     def __init__(self, dense, y0, t_end, rate=None, centre=None):
         import_integrator()
-        self._dense, self._y0, self._rate = dense, np.asarray(y0, dtype=float), rate
+        self._dense = None if dense is None else dense_reader(dense)
+        self._y0, self._rate = np.asarray(y0, dtype=float), rate
         self.t_end = float(t_end)
         self.centre = None if centre is None else float(centre)
 
@@ -401,8 +403,8 @@ class SundmanSolution(PhaseSolution):
 
     def __init__(self, dense, y0, tau_end, rotation_rate):
         import_integrator()
-        self._dense, self._y0, self._rotation_rate = dense, np.asarray(y0, dtype=float), \
-            rotation_rate
+        self._dense = None if dense is None else dense_reader(dense)
+        self._y0, self._rotation_rate = np.asarray(y0, dtype=float), rotation_rate
         self._tau_end = float(tau_end)
         self.t_end = float(dense(self._tau_end)[2]) if dense is not None else 0.0
 

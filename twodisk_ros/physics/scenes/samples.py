@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..numerics.dense import dense_reader
 from .terms import DW, STOPPED
 
 __all__ = ['Piece', 'SceneSamples', 'samples_from']
@@ -47,7 +48,8 @@ class Piece:
     |ω_u| from ``rate``); ``start_of`` a callable for the closed-form start from a stop."""
 
     def __init__(self, start, end, sol=None, rest=None, steps=None, rate=None, start_of=None):
-        self.start, self.end, self.sol, self.rest = start, end, sol, rest
+        self.start, self.end, self.rest = start, end, rest
+        self.sol = None if sol is None else dense_reader(sol)
         self.steps, self.rate, self.start_of = steps, rate, start_of
 
     def __call__(self, t):
