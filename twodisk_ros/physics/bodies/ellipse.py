@@ -39,8 +39,9 @@ import math
 
 import numpy as np
 
-from ..numerics.analytic import COMPLEX_STEP, complex_step, complex_step_jet, sinc
+from ..numerics.analytic import COMPLEX_STEP, complex_step, complex_step_jet
 from ..laminae.shapes import Ellipse
+from .ellipse_phase import phase_angles
 from .protocol import PhaseGeometry, RollingBody
 from ..numerics.vectors import cross, vector
 
@@ -169,34 +170,9 @@ class EllipseForms:
     def phase_angles(self, u):
         """(θ, cos θ, sin θ, j) at phase u (rad), with cos θ − cos θ_max = j cos²u.
 
-        Analytic in u (complex-step safe); exact near the turning points u = ±π/2.
-        """
-        a, b = self.a, self.b
-        eta_m, tm = self._eta_max, self.theta_max
-        w = np.sin(u)
-        sign_w = np.where(w.real < 0, -1.0, 1.0)
-        abs_w = w * sign_w
-        abs_eta = eta_m * abs_w
-        cos_eta, sin_eta = np.cos(abs_eta), np.sin(abs_eta)
-        e = np.sqrt(a * a * cos_eta ** 2 + b * b * sin_eta ** 2)
-        e_m = self._e_max
-        cos_t = a * cos_eta / e
-        sin_abs = b * sin_eta / e
-        # v = η_max − |η| = η_max cos²u / (1 + |w|) ≥ 0, exactly
-        v_over_c2 = eta_m / (1 + abs_w)
-        v = v_over_c2 * np.cos(u) ** 2
-        x = a * a * cos_eta * self._cos_eta_max + b * b * sin_eta * self._sin_eta_max
-        # tan((θ_max − |θ|)/2) = a b sin v / (E E_m + X), denominator > 0 over the whole cycle
-        denom = e * e_m + x
-        t = a * b * np.sin(v) / denom
-        # |θ| = θ_max − 2 arctan t, exact near the turning points; away from them (|η| < 1,
-        # cos η > 0) the direct tan θ = (b/a) tan η has no cancellation near θ = 0
-        near_axis = abs_eta.real < 1.0
-        tan_eta = np.tan(np.where(near_axis, abs_eta, 0.0))
-        abs_theta = np.where(near_axis, np.arctan(b * tan_eta / a), tm - 2 * np.arctan(t))
-        j = (2 * np.sin((tm + abs_theta) / 2) / np.sqrt(1 + t * t)
-             * a * b * v_over_c2 * sinc(v) / denom)
-        return sign_w * abs_theta, cos_t, sign_w * sin_abs, j
+        Analytic in u (complex-step safe); exact near the turning points u = ±π/2
+        (:func:`.ellipse_phase.phase_angles`)."""
+        return phase_angles(u, self._phase_constants)
 
     def phase_theta(self, u):
         """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
@@ -364,6 +340,8 @@ class EllipseBody(EllipseForms, RollingBody):
         self._cos_eta_max = math.cos(self._eta_max)
         self._sin_eta_max = math.sin(self._eta_max)
         self._e_max = math.hypot(a * self._cos_eta_max, b * self._sin_eta_max)
+        self._phase_constants = (a, b, self._eta_max, self.theta_max, self._cos_eta_max,
+                                 self._sin_eta_max, self._e_max)
 
     def __repr__(self):
         return f'EllipseBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
