@@ -39,20 +39,22 @@ def _line(ax, gid):
     return lines[0]
 
 
-def test_write_figures(tmp_path):
-    written = figures.write_figures(tmp_path / 'out')
-    assert [p.name for p in written] == EXPECTED
-    for path in written:
-        assert path.is_file()
+def test_main_overwrites_writes_and_lists(tmp_path, capsys):
+    """``twodisk-figures --out DIR --overwrite`` over an older figure: every figure written
+    (write_figures, a PNG of a sensible size), listed on stdout in order, the old one replaced.
+    One run for the three claims: drawing the figures is what costs (~4 s)."""
+    old = tmp_path / 'height.png'
+    old.write_bytes(b'an older figure')
+    assert figures.main(['--out', str(tmp_path), '--overwrite']) == 0
+    printed = capsys.readouterr().out.split()
+    assert [p.rsplit('/', 1)[-1] for p in printed] == EXPECTED
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(figures.NAMES) == sorted(EXPECTED)
+    assert old.read_bytes()[:8] == PNG_SIGNATURE
+    for name in EXPECTED:
+        path = tmp_path / name
         width, height = _png_size(path)
         assert 600 <= width <= 3000 and 300 <= height <= 2000, (path.name, width, height)
         assert path.stat().st_size > 20_000, path.name
-
-
-def test_main_writes_and_lists(tmp_path, capsys):
-    assert figures.main(['--out', str(tmp_path)]) == 0
-    printed = capsys.readouterr().out.split()
-    assert [p.rsplit('/', 1)[-1] for p in printed] == EXPECTED
 
 
 def test_lamina_outline_is_the_superellipse():
@@ -209,14 +211,6 @@ def test_existing_figure_refused_without_overwrite(tmp_path, module):
     assert 'Traceback' not in done.stderr
     assert old.read_bytes() == b'an older figure'
     assert sorted(p.name for p in tmp_path.iterdir()) == [old.name]    # nothing else written
-
-
-def test_overwrite_replaces_the_figures(tmp_path, capsys):
-    old = tmp_path / 'height.png'
-    old.write_bytes(b'an older figure')
-    assert figures.main(['--out', str(tmp_path), '--overwrite']) == 0
-    assert old.read_bytes()[:8] == PNG_SIGNATURE
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(figures.NAMES)
 
 
 # -- the sweep maps -----------------------------------------------------------------------
