@@ -59,7 +59,7 @@ def test_main_overwrites_writes_and_lists(tmp_path, capsys):
 
 def test_lamina_outline_is_the_superellipse():
     """The drawn outline of the rounded square lies on |x/b|^4 + |y/a|^4 = 1 (its definition)."""
-    title, lamina, *_ = figures.LAMINA_BODIES[0]
+    title, lamina, *_ = figures.lamina_bodies()[0]
     fig, ax = plt.subplots()
     try:
         figures.plot_outline(lamina, ax)

@@ -31,19 +31,25 @@ from ..model import palette  # noqa: E402
 from ..physics.bodies.cycle import RollingCycle  # noqa: E402
 from ..physics.stability.equilibria import NEUTRAL, STABLE, equilibria, stability_map  # noqa: E402
 
-__all__ = ['FIGURE3', 'FIGURE4', 'LAMINA_BODIES', 'NAMES', 'plot_traces', 'plot_height',
+__all__ = ['FIGURE3', 'FIGURE4', 'lamina_bodies', 'NAMES', 'plot_traces', 'plot_height',
            'plot_outline', 'plot_stability_map',
            'write_figures', 'main']
 
 #: The paper's bodies (a, b, Δ) in m.
 FIGURE3 = (2.0, 1.0, 1.0)
 FIGURE4 = (math.sqrt(1.5), 1.0, 1.0)
-#: The bodies of other laminae in config/ (rounded_square.yaml, egg.yaml): title, lamina, Δ (m),
-#: arrangement, cycles drawn. The egg's ε is half its largest convex value (egg_asymmetry 0.5).
-LAMINA_BODIES = (
-    ('Rounded square (superellipse n = 4)', Superellipse(0.1, 0.1, 4.0), 0.05, 'parallel', 3),
-    ('Egg (parallel)', Egg(0.1, 0.08, 0.5 * Egg.epsilon_max(0.1, 0.08)), 0.04, 'parallel', 8),
-)
+
+
+def lamina_bodies():
+    """The bodies of other laminae in config/ (rounded_square.yaml, egg.yaml): (title, lamina,
+    Δ (m), arrangement, cycles drawn). The egg's ε is half its largest convex value
+    (egg_asymmetry 0.5): a minimisation, so built when drawn, not when imported (--help)."""
+    return (
+        ('Rounded square (superellipse n = 4)', Superellipse(0.1, 0.1, 4.0), 0.05, 'parallel', 3),
+        ('Egg (parallel)', Egg(0.1, 0.08, 0.5 * Egg.epsilon_max(0.1, 0.08)), 0.04, 'parallel',
+         8),
+    )
+
 
 COLOR_A, COLOR_B, COLOR_RULING = palette.A, palette.B, '0.72'
 DPI = 150
@@ -336,9 +342,10 @@ def write_figures(out_dir):
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     plot_stability_map(ax)
     written.append(_save(fig, out / 'stability_map.png'))
-    fig, axes = plt.subplots(len(LAMINA_BODIES), 2, figsize=(10.0, 4.3 * len(LAMINA_BODIES)),
+    bodies = lamina_bodies()
+    fig, axes = plt.subplots(len(bodies), 2, figsize=(10.0, 4.3 * len(bodies)),
                              gridspec_kw={'width_ratios': (1, 3.2)})
-    for (title, lamina, delta, arrangement, cycles), (left, right) in zip(LAMINA_BODIES, axes):
+    for (title, lamina, delta, arrangement, cycles), (left, right) in zip(bodies, axes):
         plot_outline(lamina, left)
         left.set_title(title.split(' (')[0], fontsize=9)
         plot_traces(LaminaBody(lamina, delta, arrangement), cycles, right, name=title)
