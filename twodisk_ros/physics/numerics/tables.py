@@ -39,9 +39,6 @@ class HermiteTable:
         self.values, self.first, self.second = (self._nodes[:, k] for k in range(3))
         self._rows = self._nodes.reshape(len(self._nodes), -1)
         self.last_index = len(self.values) - 2
-        # a real table of scalars, as Python floats: a scalar read does float arithmetic only
-        self._float_rows = self._rows.tolist() if self._nodes.ndim == 2 \
-            and self._rows.dtype == np.float64 else None
 
     def _locate(self, x):
         s = (np.asarray(x, dtype=float) - self.start) / self.step
@@ -59,9 +56,6 @@ class HermiteTable:
             position = (float(x) - self.start) / self.step
             i = min(max(math.floor(position), 0), self.last_index)
             t = position - i
-            if self._float_rows is not None:
-                (y0, d0, s0), (y1, d1, s1) = self._float_rows[i], self._float_rows[i + 1]
-                return self._combine(t, derivative, y0, d0, s0, y1, d1, s1)
         else:
             i, t = self._locate(x)
         y0, y1 = self.values[i], self.values[i + 1]
@@ -69,11 +63,6 @@ class HermiteTable:
         s0, s1 = self.second[i], self.second[i + 1]
         if not isinstance(t, float):
             t = t.reshape(t.shape + (1,) * (y0.ndim - t.ndim))
-        return self._combine(t, derivative, y0, d0, s0, y1, d1, s1)
-
-    def _combine(self, t, derivative, y0, d0, s0, y1, d1, s1):
-        """The Hermite combination at t ∈ [0, 1] of one interval's node data (scalars or
-        arrays alike: the same operations in the same order)."""
         t2 = t * t
         t3 = t2 * t
         if derivative == 0:
