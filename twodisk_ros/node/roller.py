@@ -404,6 +404,11 @@ class Roller(Node):
             self._wall_start = now
             self._start_ns = self.get_clock().now().nanoseconds
         due = int(math.floor((now - self._wall_start) * rate)) + 1   # ticks due so far
+        limit = self._end_tick()
+        if not self.control.paused:
+            # before the queued changes: they are stamped with the tick they take effect at,
+            # which must be a sample that is published, not one dropped
+            self._drop_backlog(due if limit is None else min(due, limit))
         if self._pending is not None:
             self._apply_pending()
         for paused in self.control.apply(self._tick):
@@ -414,19 +419,9 @@ class Roller(Node):
                 due = int(math.floor((now - self._wall_start) * rate)) + 1
         if self.control.paused:
             return
-        limit = self._end_tick()
         if limit is not None:
             due = min(due, limit)
-        backlog = due - self._tick
-        allowed = max(1, int(MAX_LAG * rate))
-        if backlog > allowed:
-            self.samples_dropped += backlog - allowed
-            self._tick = due - allowed
-            self._block = None
-            self.get_logger().warn(
-                f'cannot hold rate {rate:g} Hz: dropped {backlog - allowed} samples '
-                f'({self.samples_dropped} so far) to keep real time',
-                throttle_duration_sec=5.0)
+        self._drop_backlog(due)
         while self._tick < due:
             self.control.check_timeout(self._tick)
             block = self._block
@@ -445,6 +440,21 @@ class Roller(Node):
             self.lag.append(now - self._wall_start - (self._tick - 1) / rate)
         if limit is not None and self._tick >= limit:
             self.finished = True
+
+    def _drop_backlog(self, due):
+        """Skip the samples beyond MAX_LAG behind the wall clock (``due``: ticks due), counted
+        in ``samples_dropped`` and said in a WARN."""
+        rate = self.settings.rate
+        backlog = due - self._tick
+        allowed = max(1, int(MAX_LAG * rate))
+        if backlog > allowed:
+            self.samples_dropped += backlog - allowed
+            self._tick = due - allowed
+            self._block = None
+            self.get_logger().warn(
+                f'cannot hold rate {rate:g} Hz: dropped {backlog - allowed} samples '
+                f'({self.samples_dropped} so far) to keep real time',
+                throttle_duration_sec=5.0)
 
     def _end_tick(self):
         """One past the last tick of a run with a duration, or None."""
