@@ -58,9 +58,10 @@ def inspect(path, *extra):
 
 @pytest.fixture
 def inspect_here(capsys):
-    """The entry point's function in this process: (exit status, stdout, stderr). Each test
-    runs the real entry point (a subprocess) first; its other readings of the same file go
-    through the same function here, without a second interpreter start."""
+    """The entry point's function in this process: (exit status, stdout, stderr). The real
+    entry point (a subprocess) gives each verdict once — PASS (the complete recording), FAIL
+    (a failing check on a cut file), INCOMPLETE (the file cut at a third) —; every other
+    reading goes through the same function here, without an interpreter start each."""
     from twodisk_ros.inspector.cli import main
 
     def run(path, *extra):
@@ -123,12 +124,13 @@ def test_complete_recording_passes(node_recording, inspect_here):
 @pytest.mark.parametrize('fraction', [1 / 3, 2 / 3])
 def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_recording,
                                                                 fraction, inspect_here):
+    """The cut at a third through the real entry point, at two thirds in this process."""
     data = node_recording.read_bytes()
     cut = tmp_path / 'cut.mcap'
     cut.write_bytes(data[:int(fraction * len(data))])
     samples, diagnostics = independent_count(cut.read_bytes())
     assert 0 < samples < EXPECTED and diagnostics == 0      # the diagnostics went with the cut
-    status, out, err = inspect(cut)
+    status, out, err = (inspect if fraction < 0.5 else inspect_here)(cut)
     assert status == 4 and err == '', out
     # one decimal, but a run short of a sample is never shown as 100.0 %
     share = f'{min(100 * samples / EXPECTED, 99.9):.1f} %'
@@ -180,7 +182,7 @@ def test_signal_stopped_node_recording_passes(tmp_path, inspect_here):
     samples, _ = independent_count(path.read_bytes())
     expected = 10_000_001
     assert 0 < samples < expected
-    status, out, err = inspect(path, '--json')
+    status, out, err = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 0 and err == '', [c for c in document['checks'] if not c['passed']]
     assert document['verdict'] == 'PASS'
@@ -203,10 +205,10 @@ def short_run():
     return simulate_run(SHORT)
 
 
-def test_recorder_closed_early_is_a_pass(tmp_path, short_run):
+def test_recorder_closed_early_is_a_pass(tmp_path, short_run, inspect_here):
     """A file closed by its writer after 60 of 101 samples: what a stopped run leaves."""
     path = write_run(tmp_path / 'early.mcap', short_run, SHORT, skip=set(range(60, 101)))
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 0 and document['verdict'] == 'PASS'
     run = document['summary']['run']
@@ -216,7 +218,7 @@ def test_recorder_closed_early_is_a_pass(tmp_path, short_run):
 
 def test_samples_missing_inside_a_closed_file_are_not_a_pass(tmp_path, short_run, inspect_here):
     path = write_run(tmp_path / 'gap.mcap', short_run, SHORT, skip={50})
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 1 and document['verdict'] == 'FAIL'   # the timestamps check sees the gap
     run = document['summary']['run']
@@ -233,7 +235,7 @@ def test_run_until_stopped_has_no_expected_count(tmp_path, short_run, cut, inspe
     if cut:
         data = path.read_bytes()
         path.write_bytes(data[:len(data) // 2])
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     run = document['summary']['run']
     assert run['expected_samples'] is None and run['share'] is None
