@@ -37,6 +37,8 @@ from twodisk_ros.physics.stability.equilibria import equilibria  # noqa: E402
 from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.node.roller import Roller  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
+
 pytestmark = pytest.mark.ros
 
 REPO = Path(__file__).resolve().parents[1]
@@ -501,26 +503,28 @@ def test_subprocess_sigterm_exits_0(client_context):
         assert code == 0, stderr
 
 
-def test_subprocess_invalid_start_value_exits_2():
-    result = subprocess.run(
-        roller_command('--params-file', 'config/oloid.yaml', '-p', 'delta:=0.5'),
-        cwd=REPO, env=node_env(), capture_output=True, text=True, timeout=30)
-    assert result.returncode == 2, result.stderr
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
+# The refusals below and the batch recording run the entry function in this process
+# (tests/roller_here.py): the same refusals as real processes (one by the node after
+# rclpy.init, one by the recorder) are in test_node_reliability.py.
+
+def test_invalid_start_value_exits_2(monkeypatch, capfd):
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'delta:=0.5'),
+                                monkeypatch, capfd, domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 2, err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
     assert 'delta' in lines[0]
-    assert 'Traceback' not in result.stderr
+    assert 'Traceback' not in err
 
 
-def test_subprocess_batch_recording(tmp_path):
+def test_batch_recording(tmp_path, monkeypatch, capfd):
     target = tmp_path / 'x.mcap'
-    result = subprocess.run(
-        roller_command('--params-file', 'config/oloid.yaml', '-p', f'rate:={RATE}',
-                       '-p', 'realtime:=false', '-p', 'duration:=2.0',
-                       '-p', f'record:={target}'),
-        cwd=REPO, env=node_env(), capture_output=True, text=True, timeout=60)
-    assert result.returncode == 0, result.stderr
-    assert 'Traceback' not in result.stderr
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', f'rate:={RATE}',
+                                 '-p', 'realtime:=false', '-p', 'duration:=2.0',
+                                 '-p', f'record:={target}'), monkeypatch, capfd,
+                                domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 0, err
+    assert 'Traceback' not in err
     assert target.is_file()
     recording = read_recording(target, decode=lambda topic: topic == '/pose')
     assert not recording.truncated
@@ -560,14 +564,14 @@ def test_signal_finishes_the_recording(tmp_path, sig):
     assert 'twodisk_ros' in recording.metadata and 'rosbag2' in recording.metadata
 
 
-def test_unwritable_record_path_exits_2(tmp_path):
+def test_unwritable_record_path_exits_2(tmp_path, monkeypatch, capfd):
     missing = tmp_path / 'no' / 'such' / 'dir' / 'x.mcap'
-    result = subprocess.run(roller_command('-p', f'record:={missing}'), cwd=REPO,
-                            env=node_env(), capture_output=True, text=True, timeout=60)
-    assert result.returncode == 2
-    lines = result.stderr.strip().splitlines()
+    code, err = run_roller_main(('-p', f'record:={missing}'), monkeypatch, capfd,
+                                domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 2
+    lines = err.strip().splitlines()
     assert len(lines) == 1 and str(missing.parent) in lines[0]
-    assert 'Traceback' not in result.stderr
+    assert 'Traceback' not in err
     assert not missing.exists()
 
 
