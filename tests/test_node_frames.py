@@ -313,9 +313,6 @@ def assert_urdf(text, body_frame, static=None, mass=1.0):
 
 # -- bad input -------------------------------------------------------------------------------
 
-#: Real processes: body_frame:=12 is refused by the argument check (before rclpy),
-#: use_sim_time:=true by the node (after rclpy.init).
-FRAMES_IN_A_PROCESS = ('body_frame:=12', 'use_sim_time:=true')
 
 
 @pytest.mark.parametrize('arguments, words', [
@@ -331,15 +328,13 @@ FRAMES_IN_A_PROCESS = ('body_frame:=12', 'use_sim_time:=true')
 ], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time',
         'frame_id-slash'])
 def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words, monkeypatch, capfd):
-    """Two cases as real processes (one refused before rclpy, one by the node); the others
-    through the same entry function in this process (tests/roller_here.py)."""
+    """Through the entry function in this process (tests/roller_here.py): body_frame:=12 is
+    refused by the argument check (before rclpy), use_sim_time:=true by the node (after
+    rclpy.init); refusals at both places as real processes are in test_node_reliability.py."""
     params = [arg for argument in arguments for arg in ('-p', argument)]
     args = ('-p', 'realtime:=false', '-p', 'duration:=0.1', *params)
-    if arguments[-1] in FRAMES_IN_A_PROCESS:
-        code, err = stop(start_roller(*args), sig=None, timeout=STARTED)
-    else:
-        code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *args),
-                                    monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *args),
+                                monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
     lines = err.strip().splitlines()
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err
