@@ -157,11 +157,9 @@ def test_several_ros_args_sections_run(tmp_path):
 ])
 def test_type_mismatch_hint_quotes_the_value_and_the_declared_type(argument, expected,
                                                                    monkeypatch, capfd):
-    """rate:=50 as a real process; the others through the entry function in this process."""
-    if argument == 'rate:=50':
-        code, _, err = roller('--ros-args', '-p', argument, *BATCH, timeout=60.0)
-    else:
-        code, err = here(['-p', argument, *BATCH], monkeypatch, capfd)
+    """Through the entry function in this process (rate:=50 as a real process, refused by
+    the same check, is in test_node_reliability.py)."""
+    code, err = here(['-p', argument, *BATCH], monkeypatch, capfd)
     assert code == 2
     assert expected in one_line(err)
 
@@ -201,11 +199,13 @@ def test_rcl_keeps_a_value_of_another_type():
             rclpy.try_shutdown(context=context)
 
 
-def test_a_params_file_for_other_nodes_says_nothing_was_applied(tmp_path):
+def test_a_params_file_for_other_nodes_says_nothing_was_applied(tmp_path, monkeypatch, capfd):
+    """The run through the entry function in this process (the several sections above run
+    as a real process)."""
     params = tmp_path / 'other.yaml'
     params.write_text('other:\n  ros__parameters:\n    rate: 50.0\n'
                       '/ns/roller:\n  ros__parameters:\n    rate: 50.0\n')
-    code, _, err = roller('--ros-args', '--params-file', str(params), *BATCH, timeout=60.0)
+    code, err = here(['--params-file', str(params), *BATCH], monkeypatch, capfd)
     assert code == 0, err
     # the run logs its start and end lines at INFO; the warning is the only other line
     line = one_line('\n'.join(x for x in err.splitlines() if not x.startswith('[INFO]')))
