@@ -225,10 +225,17 @@ def _poses_on_disk(path):
 
 # -- a second signal during a long start-up --------------------------------------------------
 
+#: (count, phase, signal): every pair of values of two of the three factors once (the
+#: handler is the same for both signals, node/stop.py: what differs between the cases is
+#: the phase and the count; each signal still meets each phase and each count)
+START_UP_SIGNALS = [(1, 'during-imports', signal.SIGINT), (2, 'during-imports', signal.SIGTERM),
+                    (1, 'during-tables', signal.SIGTERM), (2, 'during-tables', signal.SIGINT)]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
-@pytest.mark.parametrize('phase', ['during-imports', 'during-tables'])
-@pytest.mark.parametrize('count', [1, 2], ids=['one-signal', 'two-signals'])
+@pytest.mark.parametrize('count, phase, sig', START_UP_SIGNALS,
+                         ids=[f'{("one-signal", "two-signals")[c - 1]}-{p}-{s.name}'
+                              for c, p, s in START_UP_SIGNALS])
 def test_a_signal_ends_a_long_start_up_at_once(tmp_path, sig, phase, count):
     """The tables of SLOW_BODY take seconds; one or two signals end the process within 1.5 s.
 
