@@ -76,6 +76,12 @@ def here(args, monkeypatch, capfd):
     return run_roller_main(args, monkeypatch, capfd, domain=os.environ['ROS_DOMAIN_ID'])
 
 
+#: A node that only reads its parameter overrides (rcl parses them from the context's
+#: arguments in Node.__init__ whatever these flags): without the parameter services and
+#: the /rosout publisher each costs about half as much
+BARE = dict(start_parameter_services=False, enable_rosout=False)
+
+
 def one_line(stderr):
     lines = stderr.strip().splitlines()
     assert len(lines) == 1 and 'Traceback' not in stderr, stderr[-3000:]
@@ -192,7 +198,7 @@ def test_rcl_keeps_a_value_of_another_type():
         rclpy.init(args=['x', '--ros-args', *[a for v in args for a in ('-p', v)]],
                    context=context)
         try:
-            node = Node('roller', context=context)
+            node = Node('roller', context=context, **BARE)
             assert node.declare_parameter('duration', 0.0).value == expected
             node.destroy_node()
         finally:
@@ -232,7 +238,7 @@ def test_section_keys_select_the_node_as_rclpy_does(namespace, tmp_path):
         context = rclpy.Context()
         rclpy.init(args=['x', '--ros-args', '--params-file', str(params)], context=context)
         try:
-            node = Node('roller', namespace=namespace, context=context)
+            node = Node('roller', namespace=namespace, context=context, **BARE)
             assert node_matches(key, fqn) == ('x' in node._parameter_overrides), key
             node.destroy_node()
         finally:
@@ -390,7 +396,7 @@ def test_value_typing_is_rcls(rclpy_module, text):
             parse_value(text, 'x', f'-p x:={text}')
         return
     try:
-        node = Node('roller', context=context)
+        node = Node('roller', context=context, **BARE)
         reference = node._parameter_overrides['x'].value
         node.destroy_node()
     finally:
