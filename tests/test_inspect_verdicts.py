@@ -1,7 +1,7 @@
 """The verdict of ``twodisk-inspect``: PASS (0), FAIL (1), INCOMPLETE (4), and the share of the
 run a file holds.
 
-A real recording of the node (batch, 2 s at 1 kHz: 2001 samples, t = 0 … 2 s) is cut at a
+A real recording of the node (batch, 1 s at 1 kHz: 1001 samples, t = 0 … 1 s) is cut at a
 third and at two thirds of its bytes: the checks pass on what was recovered, but the run is
 not all there, so the verdict is INCOMPLETE, exit 4, and the share is of the run (samples
 recovered / (duration × rate + 1)), not of the cut file.  The recovered samples are counted
@@ -34,8 +34,8 @@ from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 pytestmark = pytest.mark.ros
 
 ROOT = Path(__file__).resolve().parents[1]
-DURATION, RATE = 2.0, 1000.0
-EXPECTED = 2001           # the node publishes ticks 0 … duration × rate, both included
+DURATION, RATE = 1.0, 1000.0
+EXPECTED = 1001           # the node publishes ticks 0 … duration × rate, both included
 SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 TYPES = {'pose': 'geometry_msgs/msg/PoseStamped', 'contact_a': 'geometry_msgs/msg/PointStamped',
          'contact_b': 'geometry_msgs/msg/PointStamped',
@@ -96,7 +96,7 @@ def independent_count(data):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make), through
+    """A real recording: the node in batch mode, 1 s at 1 kHz (about half a second to make), through
     its entry function in this process (the signal-stopped run below is a real process)."""
     path = tmp_path_factory.mktemp('verdicts') / 'run.mcap'
     assert record_with_roller_main(('-p', 'realtime:=false', '-p', f'rate:={RATE}',
@@ -110,15 +110,15 @@ def test_complete_recording_passes(node_recording, inspect_here):
     status, out, err = inspect(node_recording)
     assert status == 0 and err == '', out
     assert 'result: PASS (all ' in out
-    assert 'recovered 2 001 of 2 001 samples of the run (100.0 %), t = 0 … 2 s of 2 s' in out
-    assert independent_count(node_recording.read_bytes()) == (EXPECTED, 3)
+    assert 'recovered 1 001 of 1 001 samples of the run (100.0 %), t = 0 … 1 s of 1 s' in out
+    assert independent_count(node_recording.read_bytes()) == (EXPECTED, 2)
     status, out, _ = inspect_here(node_recording, '--json')
     document = json.loads(out)
     assert status == 0 and document['verdict'] == 'PASS' and document['exit_status'] == 0
     run = document['summary']['run']
     assert run['complete'] and run['file_complete'] and not run['stopped_early']
     assert run['recovered_samples'] == run['expected_samples'] == EXPECTED
-    assert run['share'] == 1.0 and run['recovered_diagnostics'] == 3
+    assert run['share'] == 1.0 and run['recovered_diagnostics'] == 2
 
 
 @pytest.mark.parametrize('fraction', [1 / 3, 2 / 3])
@@ -135,15 +135,15 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     # one decimal, but a run short of a sample is never shown as 100.0 %
     share = f'{min(100 * samples / EXPECTED, 99.9):.1f} %'
     count = f'{samples:,}'.replace(',', ' ')
-    phrase = (f'recovered {count} of 2 001 samples of the run ({share}), '
-              f't = 0 … {(samples - 1) / RATE:.6g} s of 2 s')
+    phrase = (f'recovered {count} of 1 001 samples of the run ({share}), '
+              f't = 0 … {(samples - 1) / RATE:.6g} s of 1 s')
     result = [line for line in out.splitlines() if line.startswith('result: ')]
     # 14 checks: the node records /tf, so the tf check (/tf against the poses) is one of them
     assert len(result) == 1 and result[0].startswith('result: INCOMPLETE (all 14 checks '
                                                      'passed on the recovered part'), result
     assert phrase in result[0] and 'the file is cut' in result[0]
     assert 'PASS (' not in out and 'FAIL' not in out
-    assert '0 of 3 diagnostics' in ' '.join(out.split())      # (the run: line may wrap)
+    assert '0 of 2 diagnostics' in ' '.join(out.split())      # (the run: line may wrap)
     status, out, _ = inspect_here(cut, '--json')
     document = json.loads(out)
     assert status == 4
@@ -155,7 +155,7 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     assert run['share'] == samples / EXPECTED
     assert run['last_s'] == pytest.approx((samples - 1) / RATE, abs=1e-12)
     assert run['truncated'] and not run['complete'] and not run['file_complete']
-    assert run['recovered_diagnostics'] == 0 and run['expected_diagnostics'] == 3
+    assert run['recovered_diagnostics'] == 0 and run['expected_diagnostics'] == 2
     # the share of the file's bytes is another number: that of the cut file
     assert document['summary']['recovered']['total_bytes'] == len(cut.read_bytes())
 
