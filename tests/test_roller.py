@@ -174,8 +174,15 @@ def check_geometry(got, body, tol=1e-9):
 def oloid_run():
     harness = Harness([Parameter('rate', value=RATE),
                        Parameter('path_length', value=PATH_LENGTH)])
+    def enough():
+        """What the tests below read: 30 poses, the diagnostics, markers, and each path
+        grown to its bound (at 50 Hz, about 0.6 s of the run)."""
+        got = harness.got
+        return (len(got['pose']) >= 30 and got['/diagnostics'] and got['markers']
+                and all(got[topic] and len(got[topic][-1].poses) == PATH_LENGTH
+                        and len(got[topic]) >= 2 for topic in ('path_a', 'path_b', 'path_g')))
     try:
-        harness.spin(1.6)
+        assert harness.spin(10.0, until=enough), {t: len(m) for t, m in harness.got.items()}
         harness.got['samples_dropped'] = harness.node.samples_dropped
         yield harness.got
     finally:
@@ -324,7 +331,8 @@ def test_parameter_changes():
         assert 'delta' in result.reason
         assert harness.node.get_parameter('delta').value == 0.05
         harness.clear()
-        harness.spin(0.5)
+        harness.spin(3.0, until=lambda: min(len(harness.got[t]) for t in (
+            'pose', 'contact_a', 'contact_b', 'rolling_state')) >= 15)
         assert harness.node.simulation is simulation and harness.node.settings is settings
         check_geometry(harness.got, EllipseBody(0.1, 0.1, 0.05))
         stamps = [stamp_ns(m.header) for m in harness.got['pose']]
@@ -344,7 +352,8 @@ def test_parameter_changes():
                 if abs(parse_equilibria(d)[0][3] - equilibria(new_body)[0].height) < 1e-9][-1]
         assert_equilibria_match(diag, new_body)
         harness.clear()
-        harness.spin(0.5)
+        harness.spin(3.0, until=lambda: min(len(harness.got[t]) for t in (
+            'pose', 'contact_a', 'contact_b', 'rolling_state')) >= 15)
         assert harness.node.settings.delta == 0.06
         check_geometry(harness.got, new_body)
     finally:
