@@ -387,11 +387,14 @@ def test_direct_method_in_real_time_runs_past_its_integration_chunks(ros_context
 
 
 def test_published_orientation_is_continuous_across_blocks(tmp_path, monkeypatch, capfd):
-    """Batch blocks are 2000 samples (node/roller.py BATCH_SAMPLES): 40 s at 100 Hz crosses
-    two block boundaries. The node through its entry function in this process."""
+    """Batch blocks (node/roller.py BATCH_SAMPLES, 2000 samples) made 100 here: 10 s at
+    100 Hz crosses ten block boundaries, at ten phases (was 40 s and two at the node's
+    size). The node through its entry function in this process."""
+    from twodisk_ros.node import roller as roller_module
+    monkeypatch.setattr(roller_module, 'BATCH_SAMPLES', 100)
     target = tmp_path / 'q.mcap'
     code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'realtime:=false',
-                                 '-p', 'rate:=100.0', '-p', 'duration:=40.0',
+                                 '-p', 'rate:=100.0', '-p', 'duration:=10.0',
                                  '-p', 'omega0:=8.0', '-p', f'record:={target}'),
                                 monkeypatch, capfd, domain=86, cwd=REPO)
     assert code == 0, err
@@ -399,5 +402,5 @@ def test_published_orientation_is_continuous_across_blocks(tmp_path, monkeypatch
     q = np.array([[m.msg.pose.orientation.x, m.msg.pose.orientation.y,
                    m.msg.pose.orientation.z, m.msg.pose.orientation.w]
                   for m in recording.messages if m.topic == '/pose'])
-    assert len(q) == 4001
+    assert len(q) == 1001
     assert np.all(np.einsum('ij,ij->i', q[1:], q[:-1]) >= 0)
