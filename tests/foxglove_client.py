@@ -20,6 +20,8 @@ from websockets.asyncio.client import connect
 
 SUBPROTOCOL = 'foxglove.sdk.v1'
 MESSAGE_DATA, TIME = 0x01, 0x02
+#: s to wait for the server's answer to the client's close frame (websockets' default: 10)
+CLOSE_TIMEOUT = 0.2
 
 
 @dataclass
@@ -68,8 +70,11 @@ async def _collect(port, topics, enough, timeout, request_parameters):
     received = Received()
     url = f'ws://127.0.0.1:{port}'
     deadline = time.monotonic() + timeout
+    # close_timeout: the client has what it came for when it closes; a view that is idle
+    # (its run ended, nothing sent) answers the closing handshake only after websockets'
+    # default 10 s, which the tests would otherwise sit through
     async with connect(url, subprotocols=[SUBPROTOCOL], max_size=None,
-                       open_timeout=timeout) as socket:
+                       open_timeout=timeout, close_timeout=CLOSE_TIMEOUT) as socket:
         assert socket.subprotocol == SUBPROTOCOL
         decoders, by_subscription = {}, {}
         while time.monotonic() < deadline:

@@ -12,23 +12,27 @@ from the recorded wrenches, reaches the verdict the node reached while it ran
 (:func:`~twodisk_ros.physics.forces.validity.check_validity` in the node, which logs "outside
 the rolling model"): two readers of the same forces agree.
 
-Nodes run as subprocesses in ROS domain 60 (discovery localhost-only); the view runs with
-rclpy unimportable (view_process.py).
+Nodes run in ROS domain 60 (discovery localhost-only): the oloid's run as a subprocess, the
+others through the entry function in this process; the view runs with rclpy unimportable
+(view_process.py).
 """
 
 import os
 
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 
+import contextlib  # noqa: E402
+import io  # noqa: E402
 from pathlib import Path  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
+import tempfile  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from roller_here import run_roller_main  # noqa: E402
+from roller_here import record_with_roller_main, run_roller_main  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -54,16 +58,39 @@ def _record(directory, name, *params):
     return out, made
 
 
+def _record_here(directory, name, *params):
+    """As :func:`_record`, through the entry function in this process
+    (tests/roller_here.py): what the node writes to stderr (rclpy's log lines, at the file
+    descriptor, and Python's) is read from a file that stands in for fd 2 meanwhile."""
+    out = Path(directory) / f'{name}.mcap'
+    with tempfile.TemporaryFile() as log, io.StringIO() as said:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        os.dup2(log.fileno(), 2)
+        try:
+            with contextlib.redirect_stderr(said):
+                code = record_with_roller_main(
+                    (*params, '-p', 'realtime:=false', '-p', f'record:={out}'), DOMAIN,
+                    cwd=directory)
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        log.seek(0)
+        err = log.read().decode(errors='replace') + said.getvalue()
+    return out, subprocess.CompletedProcess([], code, '', err)
+
+
 @pytest.fixture(scope='module')
 def recordings(tmp_path_factory):
-    """path of a recording made once per module (node runs are the slow part); with
-    ``run=True`` (path, the finished process)."""
+    """path of a recording made once per module (node runs are the slow part), through the
+    entry function in this process; with ``run=True`` (path, the finished run: exit code
+    and the node's log)."""
     directory = tmp_path_factory.mktemp('recordings')
     made = {}
 
     def get(name, *params, run=False):
         if name not in made:
-            out, process = _record(directory, name, *params)
+            out, process = _record_here(directory, name, *params)
             assert process.returncode == 0, process.stderr
             made[name] = out, process
         return made[name] if run else made[name][0]
@@ -78,8 +105,9 @@ SQUARE = ('--params-file', str(REPO / 'config' / 'rounded_square.yaml'), '-p',
 SHARED = {'rounded_square': SQUARE}
 
 
-#: The config whose run is a real process; the others run the same entry function in this
-#: process (tests/roller_here.py), without an interpreter start each.
+#: The config whose run is a real process (the cheapest: a 0.3 s run of the oloid); the
+#: others run the same entry function in this process (tests/roller_here.py), without an
+#: interpreter start each.
 AS_A_PROCESS = 'oloid'
 
 

@@ -56,9 +56,10 @@ def inspect(*args):
 
 @pytest.fixture
 def inspect_here(capsys):
-    """The entry point's function in this process: (exit status, stdout, stderr). A test
-    runs the real entry point (a subprocess) first; its further calls go through the same
-    function here, without another interpreter start."""
+    """The entry point's function in this process: (exit status, stdout, stderr). The real
+    entry point (a subprocess) writes the module's tables (``exported``) and gives each kind
+    of refusal once (an existing output, a wrong suffix) and ``--help``; the other calls go
+    through the same function here, without an interpreter start each."""
     from twodisk_ros.inspector.cli import main
 
     def run(*args):
@@ -169,11 +170,11 @@ def test_npz_one_array_per_column_with_units(exported):
             assert_same(data[name], expected[name], name)
 
 
-def test_recording_without_wrenches_has_nan_forces(tmp_path):
+def test_recording_without_wrenches_has_nan_forces(tmp_path, inspect_here):
     params = dict(OLOID, duration='0.5')
     path = write_run(tmp_path / 'old.mcap', simulate_run(params), params)
     csv, npz = tmp_path / 'old.csv', tmp_path / 'old.npz'
-    status, out, err = inspect(path, '--npz', npz, '--csv', csv, '--json')
+    status, out, err = inspect_here(path, '--npz', npz, '--csv', csv, '--json')
     assert status == 0 and err == ''
     assert out.lstrip().startswith('{')   # --json: stdout is the JSON document only
     frame = pd.read_csv(csv)
@@ -187,12 +188,12 @@ def test_recording_without_wrenches_has_nan_forces(tmp_path):
         assert np.all(np.isnan(data['F_B_z'])) and data['t'].size == 51
 
 
-def test_cut_recording_exports_what_was_recovered(tmp_path, node_recording):
+def test_cut_recording_exports_what_was_recovered(tmp_path, node_recording, inspect_here):
     data = node_recording.read_bytes()
     cut = tmp_path / 'cut.mcap'
     cut.write_bytes(data[:len(data) // 3])
     csv = tmp_path / 'cut.csv'
-    status, _, err = inspect(cut, '--csv', csv)
+    status, _, err = inspect_here(cut, '--csv', csv)
     assert status == 4 and err == ''      # INCOMPLETE, the table written all the same
     frame = pd.read_csv(csv)
     expected = decoded_table(cut)
@@ -208,9 +209,11 @@ def test_cut_recording_exports_what_was_recovered(tmp_path, node_recording):
                                             ('--plot', '.png')])
 def test_existing_output_is_refused_without_overwrite(tmp_path, node_recording, option,
                                                       suffix, inspect_here):
+    """--csv through the real entry point, the others in this process."""
     target = tmp_path / f'out{suffix}'
     target.write_bytes(b'precious\x00bytes')
-    status, out, err = inspect(node_recording, option, target)
+    status, out, err = (inspect if option == '--csv' else inspect_here)(node_recording, option,
+                                                                         target)
     assert status == 2 and out == ''
     lines = err.splitlines()
     assert len(lines) == 1 and str(target) in lines[0] and '--overwrite' in lines[0], err
@@ -227,15 +230,17 @@ def test_existing_output_is_refused_without_overwrite(tmp_path, node_recording, 
 @pytest.mark.parametrize('option, name', [('--plot', 'figure.pdf'), ('--plot', 'figure'),
                                           ('--csv', 'states.txt'), ('--npz', 'states.npy'),
                                           ('--csv', 'states.npz')])
-def test_wrong_suffix_is_refused(tmp_path, node_recording, option, name):
-    status, out, err = inspect(node_recording, option, tmp_path / name)
+def test_wrong_suffix_is_refused(tmp_path, node_recording, option, name, inspect_here):
+    """The first case through the real entry point, the others in this process."""
+    run = inspect if name == 'figure.pdf' else inspect_here
+    status, out, err = run(node_recording, option, tmp_path / name)
     assert status == 2 and out == '' and len(err.splitlines()) == 1, err
     assert 'allowed: .' in err and list(tmp_path.iterdir()) == []
 
 
-def test_three_outputs_at_once(tmp_path, node_recording):
-    status, _, err = inspect(node_recording, '--csv', tmp_path / 'a.csv', '--npz',
-                             tmp_path / 'a.npz', '--plot', tmp_path / 'a.png')
+def test_three_outputs_at_once(tmp_path, node_recording, inspect_here):
+    status, _, err = inspect_here(node_recording, '--csv', tmp_path / 'a.csv', '--npz',
+                                  tmp_path / 'a.npz', '--plot', tmp_path / 'a.png')
     assert status == 0 and err == ''
     assert sorted(p.name for p in tmp_path.iterdir()) == ['a.csv', 'a.npz', 'a.png']
 

@@ -141,8 +141,25 @@ def set_field(data, offset, fmt, value):
     return bytes(out)
 
 
+#: Of these random groups only the first half of the draws is inspected (the draws of the
+#: others are still made, so the cases kept are those of the full list): a throw-away
+#: arc-coverage run of the 582 cases of the full list over twodisk_ros (branch coverage,
+#: 3672 arcs) found no arc that only their second halves reached; the groups left whole
+#: (structure and plain flips) reach arcs in their second halves too.
+HALVED = ('zstd flip', 'lz4 flip', 'random cut', 'plain cut', 'zero', 'copy', 'remove')
+
+
 def mutations(variants, rng):
-    """``(kind, name, bytes)`` of every case; the same list for the same seed."""
+    """``(number, kind, name, bytes)`` of the cases (``number``: the case's place in the full
+    list); the same list for the same seed."""
+    for number, (kind, name, case, index, count) in enumerate(_drawn(variants, rng)):
+        if index is None or not name.startswith(HALVED) or index < count // 2:
+            yield number, kind, name, case
+
+
+def _drawn(variants, rng):
+    """``(kind, name, bytes, index, count)`` of every drawn case (``index`` of ``count`` in
+    its random group, None for the deterministic ones); the same list for the same seed."""
     data = variants['zstd']
     size = len(data)
     recs = records(data)
@@ -150,35 +167,40 @@ def mutations(variants, rng):
                         for k in range(start, min(end, start + 9 + 64))})
     chunks = [(start, end) for opcode, start, end in recs if opcode == CHUNK]
     for i in range(100):
-        yield 'flip', f'zstd flip {i}', flip(data, rng, rng.randint(1, 50))
+        yield 'flip', f'zstd flip {i}', flip(data, rng, rng.randint(1, 50)), i, 100
     for i in range(40):
-        yield 'flip', f'zstd structure flip {i}', flip(data, rng, rng.randint(1, 8), structure)
+        yield ('flip', f'zstd structure flip {i}',
+               flip(data, rng, rng.randint(1, 8), structure), i, 40)
     for i in range(80):
-        yield 'flip', f'plain flip {i}', flip(variants['plain'], rng, rng.randint(1, 50))
+        yield 'flip', f'plain flip {i}', flip(variants['plain'], rng, rng.randint(1, 50)), i, 80
     for i in range(20):
-        yield 'flip', f'lz4 flip {i}', flip(variants['lz4'], rng, rng.randint(1, 50))
+        yield 'flip', f'lz4 flip {i}', flip(variants['lz4'], rng, rng.randint(1, 50)), i, 20
     for i in range(40):
         cut = rng.randrange(size)
-        yield 'truncate', f'random cut at {cut}', data[:cut]
+        yield 'truncate', f'random cut at {cut}', data[:cut], i, 40
     for opcode, start, end in recs:
         for cut in (start, start + 9):
-            yield 'truncate', f'cut at {cut} (record 0x{opcode:02x} at {start})', data[:cut]
+            yield ('truncate', f'cut at {cut} (record 0x{opcode:02x} at {start})', data[:cut],
+                   None, None)
     plain = variants['plain']
-    for start in rng.sample(inner_messages(plain), 30):
-        yield 'truncate', f'plain cut at message {start}', plain[:start + rng.randrange(30)]
+    for i, start in enumerate(rng.sample(inner_messages(plain), 30)):
+        yield ('truncate', f'plain cut at message {start}', plain[:start + rng.randrange(30)],
+               i, 30)
     for i in range(40):
         a, b = span(rng, size, 4096)
-        yield 'zero', f'zero {a}:{b}', data[:a] + bytes(b - a) + data[b:]
+        yield 'zero', f'zero {a}:{b}', data[:a] + bytes(b - a) + data[b:], i, 40
     for i in range(30):
         a, b = span(rng, size, 8192)
         at = rng.randrange(size)
-        yield 'duplicate', f'copy {a}:{b} to {at}', data[:at] + data[a:b] + data[at:]
+        yield 'duplicate', f'copy {a}:{b} to {at}', data[:at] + data[a:b] + data[at:], i, 30
     for i in range(30):
         a, b = span(rng, size, 8192)
-        yield 'remove', f'remove {a}:{b}', data[:a] + data[b:]
+        yield 'remove', f'remove {a}:{b}', data[:a] + data[b:], i, 30
     for opcode, start, end in rng.sample(recs, 10):
-        yield 'duplicate', f'record 0x{opcode:02x} at {start} twice', data[:end] + data[start:]
-        yield 'remove', f'record 0x{opcode:02x} at {start} removed', data[:start] + data[end:]
+        yield ('duplicate', f'record 0x{opcode:02x} at {start} twice', data[:end] + data[start:],
+               None, None)
+        yield ('remove', f'record 0x{opcode:02x} at {start} removed', data[:start] + data[end:],
+               None, None)
     header_end = recs[0][2]
     garbage = bytes(rng.randrange(256) for _ in range(4096))
     for name, case in [
@@ -190,17 +212,19 @@ def mutations(variants, rng):
             ('magic, zeros', MAGIC + bytes(4096)), ('footer only', MAGIC + data[-37:]),
             ('trailing garbage', data + garbage[:100]),
             ('garbage between magic and header', MAGIC + garbage[:50] + data[8:])]:
-        yield 'tiny', name, case
+        yield 'tiny', name, case, None, None
     for start, end in chunks:   # wrong CRCs of the chunks (uncompressed records)
-        yield 'crc', f'chunk crc at {start}', set_field(data, start + 9 + 24, '<I', 0xDEADBEEF)
+        yield ('crc', f'chunk crc at {start}',
+               set_field(data, start + 9 + 24, '<I', 0xDEADBEEF), None, None)
     footer = size - 8 - 29
-    yield 'crc', 'summary crc', set_field(data, footer + 9 + 16, '<I', 0x12345678)
+    yield 'crc', 'summary crc', set_field(data, footer + 9 + 16, '<I', 0x12345678), None, None
     data_end = next(start for opcode, start, _ in recs if opcode == DATA_END)
-    yield 'crc', 'data section crc', set_field(data, data_end + 9, '<I', 0x12345678)
+    yield ('crc', 'data section crc', set_field(data, data_end + 9, '<I', 0x12345678),
+           None, None)
     for start, end in chunks:   # a declared uncompressed size far too large or small
         for value in (2**62, 1, 0):
-            yield 'crc', f'chunk size {value} at {start}', set_field(data, start + 9 + 16,
-                                                                     '<Q', value)
+            yield ('crc', f'chunk size {value} at {start}',
+                   set_field(data, start + 9 + 16, '<Q', value), None, None)
 
 
 def run_in_process(path, *extra):
@@ -237,7 +261,7 @@ def test_inspector_survives_every_mutation(tmp_path, variants):
     rng = random.Random(SEED)
     outcomes = collections.defaultdict(collections.Counter)
     path = tmp_path / 'case.mcap'
-    for number, (kind, name, case) in enumerate(mutations(variants, rng)):
+    for number, kind, name, case in mutations(variants, rng):
         path.write_bytes(case)
         why = f'seed {SEED}, case {number} ({kind}: {name}, {len(case)} bytes): '
         as_json = number % 4 == 0
@@ -252,7 +276,7 @@ def test_inspector_survives_every_mutation(tmp_path, variants):
         outcomes[kind][status] += 1
     report = {kind: dict(sorted(c.items())) for kind, c in sorted(outcomes.items())}
     print(f'\nfuzz outcomes by kind (exit status: cases): {report}')
-    assert sum(sum(c.values()) for c in outcomes.values()) > 550
+    assert sum(sum(c.values()) for c in outcomes.values()) > 400   # 437 of 582 drawn (HALVED)
     # the mutations reach every outcome: reports of what was recovered, and refusals
     assert outcomes['flip'][1] and outcomes['truncate'][4] and outcomes['tiny'][2]
     assert not outcomes['truncate'][0]      # a cut file is never a PASS
@@ -280,6 +304,12 @@ def test_cached_models_give_the_results_of_fresh_ones(tmp_path, original):
     assert (info.misses, info.hits) == (2, 2), info
 
 
+#: Cases of test_damaged_files_through_a_subprocess run by the real entry point: one for each
+#: way a damaged file ends (refused with one line: exit 2; a report: the cut file); the others
+#: through its function in this process.
+AS_A_PROCESS = ('garbage', 'cut')
+
+
 def test_damaged_files_through_a_subprocess(tmp_path, variants):
     data = variants['zstd']
     rng = random.Random(SEED + 1)
@@ -287,14 +317,20 @@ def test_damaged_files_through_a_subprocess(tmp_path, variants):
     cases = {'empty': b'', 'magic': MAGIC, 'flips': flip(data, rng, 30),
              'cut': data[:len(data) // 2], 'chunk': flip(data, rng, 1, [first_chunk + 5000]),
              'garbage': MAGIC + bytes(rng.randrange(256) for _ in range(300))}
+    statuses = {}
     for name, case in cases.items():
         path = tmp_path / f'{name}.mcap'
         path.write_bytes(case)
-        result = subprocess.run([sys.executable, '-m', 'twodisk_ros.inspect_mcap', str(path)],
-                                capture_output=True, text=True, cwd=ROOT, env=node_env(),
-                                timeout=120)
-        assert_outcome(result.returncode, result.stdout, result.stderr, path,
-                       f'seed {SEED + 1}, case {name}: ')
+        if name in AS_A_PROCESS:
+            result = subprocess.run(
+                [sys.executable, '-m', 'twodisk_ros.inspect_mcap', str(path)],
+                capture_output=True, text=True, cwd=ROOT, env=node_env(), timeout=120)
+            status, out, err = result.returncode, result.stdout, result.stderr
+        else:
+            status, out, err = run_in_process(path)
+        assert_outcome(status, out, err, path, f'seed {SEED + 1}, case {name}: ')
+        statuses[name] = status
+    assert statuses['garbage'] == 2 and statuses['cut'] != 2, statuses
 
 
 @settings(max_examples=60, deadline=None, derandomize=True,

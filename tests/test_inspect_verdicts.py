@@ -1,7 +1,7 @@
 """The verdict of ``twodisk-inspect``: PASS (0), FAIL (1), INCOMPLETE (4), and the share of the
 run a file holds.
 
-A real recording of the node (batch, 2 s at 1 kHz: 2001 samples, t = 0 … 2 s) is cut at a
+A real recording of the node (batch, 1 s at 1 kHz: 1001 samples, t = 0 … 1 s) is cut at a
 third and at two thirds of its bytes: the checks pass on what was recovered, but the run is
 not all there, so the verdict is INCOMPLETE, exit 4, and the share is of the run (samples
 recovered / (duration × rate + 1)), not of the cut file.  The recovered samples are counted
@@ -34,8 +34,8 @@ from test_inspect import OLOID, simulate_run, write_run  # noqa: E402
 pytestmark = pytest.mark.ros
 
 ROOT = Path(__file__).resolve().parents[1]
-DURATION, RATE = 2.0, 1000.0
-EXPECTED = 2001           # the node publishes ticks 0 … duration × rate, both included
+DURATION, RATE = 1.0, 1000.0
+EXPECTED = 1001           # the node publishes ticks 0 … duration × rate, both included
 SAMPLED = ('pose', 'contact_a', 'contact_b', 'rolling_state')
 TYPES = {'pose': 'geometry_msgs/msg/PoseStamped', 'contact_a': 'geometry_msgs/msg/PointStamped',
          'contact_b': 'geometry_msgs/msg/PointStamped',
@@ -58,9 +58,10 @@ def inspect(path, *extra):
 
 @pytest.fixture
 def inspect_here(capsys):
-    """The entry point's function in this process: (exit status, stdout, stderr). Each test
-    runs the real entry point (a subprocess) first; its other readings of the same file go
-    through the same function here, without a second interpreter start."""
+    """The entry point's function in this process: (exit status, stdout, stderr). The real
+    entry point (a subprocess) gives each verdict once — PASS (the complete recording), FAIL
+    (a failing check on a cut file), INCOMPLETE (the file cut at a third) —; every other
+    reading goes through the same function here, without an interpreter start each."""
     from twodisk_ros.inspector.cli import main
 
     def run(path, *extra):
@@ -95,7 +96,7 @@ def independent_count(data):
 
 @pytest.fixture(scope='module')
 def node_recording(tmp_path_factory):
-    """A real recording: the node in batch mode, 2 s at 1 kHz (about 1 s to make), through
+    """A real recording: the node in batch mode, 1 s at 1 kHz (about half a second to make), through
     its entry function in this process (the signal-stopped run below is a real process)."""
     path = tmp_path_factory.mktemp('verdicts') / 'run.mcap'
     assert record_with_roller_main(('-p', 'realtime:=false', '-p', f'rate:={RATE}',
@@ -109,39 +110,40 @@ def test_complete_recording_passes(node_recording, inspect_here):
     status, out, err = inspect(node_recording)
     assert status == 0 and err == '', out
     assert 'result: PASS (all ' in out
-    assert 'recovered 2 001 of 2 001 samples of the run (100.0 %), t = 0 … 2 s of 2 s' in out
-    assert independent_count(node_recording.read_bytes()) == (EXPECTED, 3)
+    assert 'recovered 1 001 of 1 001 samples of the run (100.0 %), t = 0 … 1 s of 1 s' in out
+    assert independent_count(node_recording.read_bytes()) == (EXPECTED, 2)
     status, out, _ = inspect_here(node_recording, '--json')
     document = json.loads(out)
     assert status == 0 and document['verdict'] == 'PASS' and document['exit_status'] == 0
     run = document['summary']['run']
     assert run['complete'] and run['file_complete'] and not run['stopped_early']
     assert run['recovered_samples'] == run['expected_samples'] == EXPECTED
-    assert run['share'] == 1.0 and run['recovered_diagnostics'] == 3
+    assert run['share'] == 1.0 and run['recovered_diagnostics'] == 2
 
 
 @pytest.mark.parametrize('fraction', [1 / 3, 2 / 3])
 def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_recording,
                                                                 fraction, inspect_here):
+    """The cut at a third through the real entry point, at two thirds in this process."""
     data = node_recording.read_bytes()
     cut = tmp_path / 'cut.mcap'
     cut.write_bytes(data[:int(fraction * len(data))])
     samples, diagnostics = independent_count(cut.read_bytes())
     assert 0 < samples < EXPECTED and diagnostics == 0      # the diagnostics went with the cut
-    status, out, err = inspect(cut)
+    status, out, err = (inspect if fraction < 0.5 else inspect_here)(cut)
     assert status == 4 and err == '', out
     # one decimal, but a run short of a sample is never shown as 100.0 %
     share = f'{min(100 * samples / EXPECTED, 99.9):.1f} %'
     count = f'{samples:,}'.replace(',', ' ')
-    phrase = (f'recovered {count} of 2 001 samples of the run ({share}), '
-              f't = 0 … {(samples - 1) / RATE:.6g} s of 2 s')
+    phrase = (f'recovered {count} of 1 001 samples of the run ({share}), '
+              f't = 0 … {(samples - 1) / RATE:.6g} s of 1 s')
     result = [line for line in out.splitlines() if line.startswith('result: ')]
     # 14 checks: the node records /tf, so the tf check (/tf against the poses) is one of them
     assert len(result) == 1 and result[0].startswith('result: INCOMPLETE (all 14 checks '
                                                      'passed on the recovered part'), result
     assert phrase in result[0] and 'the file is cut' in result[0]
     assert 'PASS (' not in out and 'FAIL' not in out
-    assert '0 of 3 diagnostics' in ' '.join(out.split())      # (the run: line may wrap)
+    assert '0 of 2 diagnostics' in ' '.join(out.split())      # (the run: line may wrap)
     status, out, _ = inspect_here(cut, '--json')
     document = json.loads(out)
     assert status == 4
@@ -153,7 +155,7 @@ def test_cut_recording_is_incomplete_with_the_share_of_the_run(tmp_path, node_re
     assert run['share'] == samples / EXPECTED
     assert run['last_s'] == pytest.approx((samples - 1) / RATE, abs=1e-12)
     assert run['truncated'] and not run['complete'] and not run['file_complete']
-    assert run['recovered_diagnostics'] == 0 and run['expected_diagnostics'] == 3
+    assert run['recovered_diagnostics'] == 0 and run['expected_diagnostics'] == 2
     # the share of the file's bytes is another number: that of the cut file
     assert document['summary']['recovered']['total_bytes'] == len(cut.read_bytes())
 
@@ -180,7 +182,7 @@ def test_signal_stopped_node_recording_passes(tmp_path, inspect_here):
     samples, _ = independent_count(path.read_bytes())
     expected = 10_000_001
     assert 0 < samples < expected
-    status, out, err = inspect(path, '--json')
+    status, out, err = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 0 and err == '', [c for c in document['checks'] if not c['passed']]
     assert document['verdict'] == 'PASS'
@@ -203,10 +205,10 @@ def short_run():
     return simulate_run(SHORT)
 
 
-def test_recorder_closed_early_is_a_pass(tmp_path, short_run):
+def test_recorder_closed_early_is_a_pass(tmp_path, short_run, inspect_here):
     """A file closed by its writer after 60 of 101 samples: what a stopped run leaves."""
     path = write_run(tmp_path / 'early.mcap', short_run, SHORT, skip=set(range(60, 101)))
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 0 and document['verdict'] == 'PASS'
     run = document['summary']['run']
@@ -216,7 +218,7 @@ def test_recorder_closed_early_is_a_pass(tmp_path, short_run):
 
 def test_samples_missing_inside_a_closed_file_are_not_a_pass(tmp_path, short_run, inspect_here):
     path = write_run(tmp_path / 'gap.mcap', short_run, SHORT, skip={50})
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     assert status == 1 and document['verdict'] == 'FAIL'   # the timestamps check sees the gap
     run = document['summary']['run']
@@ -233,7 +235,7 @@ def test_run_until_stopped_has_no_expected_count(tmp_path, short_run, cut, inspe
     if cut:
         data = path.read_bytes()
         path.write_bytes(data[:len(data) // 2])
-    status, out, _ = inspect(path, '--json')
+    status, out, _ = inspect_here(path, '--json')
     document = json.loads(out)
     run = document['summary']['run']
     assert run['expected_samples'] is None and run['share'] is None

@@ -76,6 +76,12 @@ def here(args, monkeypatch, capfd):
     return run_roller_main(args, monkeypatch, capfd, domain=os.environ['ROS_DOMAIN_ID'])
 
 
+#: A node that only reads its parameter overrides (rcl parses them from the context's
+#: arguments in Node.__init__ whatever these flags): without the parameter services and
+#: the /rosout publisher each costs about half as much
+BARE = dict(start_parameter_services=False, enable_rosout=False)
+
+
 def one_line(stderr):
     lines = stderr.strip().splitlines()
     assert len(lines) == 1 and 'Traceback' not in stderr, stderr[-3000:]
@@ -157,11 +163,9 @@ def test_several_ros_args_sections_run(tmp_path):
 ])
 def test_type_mismatch_hint_quotes_the_value_and_the_declared_type(argument, expected,
                                                                    monkeypatch, capfd):
-    """rate:=50 as a real process; the others through the entry function in this process."""
-    if argument == 'rate:=50':
-        code, _, err = roller('--ros-args', '-p', argument, *BATCH, timeout=60.0)
-    else:
-        code, err = here(['-p', argument, *BATCH], monkeypatch, capfd)
+    """Through the entry function in this process (rate:=50 as a real process, refused by
+    the same check, is in test_node_reliability.py)."""
+    code, err = here(['-p', argument, *BATCH], monkeypatch, capfd)
     assert code == 2
     assert expected in one_line(err)
 
@@ -194,18 +198,20 @@ def test_rcl_keeps_a_value_of_another_type():
         rclpy.init(args=['x', '--ros-args', *[a for v in args for a in ('-p', v)]],
                    context=context)
         try:
-            node = Node('roller', context=context)
+            node = Node('roller', context=context, **BARE)
             assert node.declare_parameter('duration', 0.0).value == expected
             node.destroy_node()
         finally:
             rclpy.try_shutdown(context=context)
 
 
-def test_a_params_file_for_other_nodes_says_nothing_was_applied(tmp_path):
+def test_a_params_file_for_other_nodes_says_nothing_was_applied(tmp_path, monkeypatch, capfd):
+    """The run through the entry function in this process (the several sections above run
+    as a real process)."""
     params = tmp_path / 'other.yaml'
     params.write_text('other:\n  ros__parameters:\n    rate: 50.0\n'
                       '/ns/roller:\n  ros__parameters:\n    rate: 50.0\n')
-    code, _, err = roller('--ros-args', '--params-file', str(params), *BATCH, timeout=60.0)
+    code, err = here(['--params-file', str(params), *BATCH], monkeypatch, capfd)
     assert code == 0, err
     # the run logs its start and end lines at INFO; the warning is the only other line
     line = one_line('\n'.join(x for x in err.splitlines() if not x.startswith('[INFO]')))
@@ -232,7 +238,7 @@ def test_section_keys_select_the_node_as_rclpy_does(namespace, tmp_path):
         context = rclpy.Context()
         rclpy.init(args=['x', '--ros-args', '--params-file', str(params)], context=context)
         try:
-            node = Node('roller', namespace=namespace, context=context)
+            node = Node('roller', namespace=namespace, context=context, **BARE)
             assert node_matches(key, fqn) == ('x' in node._parameter_overrides), key
             node.destroy_node()
         finally:
@@ -390,7 +396,7 @@ def test_value_typing_is_rcls(rclpy_module, text):
             parse_value(text, 'x', f'-p x:={text}')
         return
     try:
-        node = Node('roller', context=context)
+        node = Node('roller', context=context, **BARE)
         reference = node._parameter_overrides['x'].value
         node.destroy_node()
     finally:

@@ -174,14 +174,19 @@ def assert_contacts_on_rims(tfs, contacts_a, contacts_b, states, static,
     return checked
 
 
-# -- /tf at rate, /tf_static and robot_description to late joiners ---------------------------
+# -- one process: /tf at rate, latched topics to late joiners, changes at run time ----------
 
-def test_tf_matches_pose_and_latched_topics_reach_late_joiners(client):
+def test_tf_latched_topics_and_changes_resend_what_they_alter_and_nothing_else(client):
+    """One ``roller`` process (its start and discovery are the slow part), checked in two
+    stages: first /tf against pose and the physics, /tf_static and robot_description reaching
+    late joiners; then parameter changes re-send only what they alter."""
     node, executor = client
     got = {'pose': [], '/tf': [], 'contact_a': [], 'contact_b': [], 'rolling_state': []}
-    for topic, kind in (('pose', PoseStamped), ('/tf', TFMessage), ('contact_a', PointStamped),
-                        ('contact_b', PointStamped), ('rolling_state', JointState)):
-        node.create_subscription(kind, topic, got[topic].append, 1000)
+    subscriptions = [node.create_subscription(kind, topic, got[topic].append, 1000)
+                     for topic, kind in (('pose', PoseStamped), ('/tf', TFMessage),
+                                         ('contact_a', PointStamped),
+                                         ('contact_b', PointStamped),
+                                         ('rolling_state', JointState))]
     process = start_roller('-p', f'rate:={RATE}', *body_params())
     try:
         assert spin_until(executor, lambda: len(got['/tf']) >= 40), 'no /tf'
@@ -191,9 +196,17 @@ def test_tf_matches_pose_and_latched_topics_reach_late_joiners(client):
         node.create_subscription(String, 'robot_description', descriptions.append, LATCHED)
         assert spin_until(executor, lambda: statics and descriptions), 'no latched message'
         assert spin_until(executor, lambda: len(got['/tf']) >= 60)
+        first = {topic: list(messages) for topic, messages in got.items()}   # the first body
+        _check_tf_and_latched(first, statics, descriptions)
+        for subscription in subscriptions[2:]:      # the contacts and states: not needed now
+            node.destroy_subscription(subscription)
+        _check_changes(executor, node, got['pose'], got['/tf'], statics, descriptions)
     finally:
         code, err = stop(process)
     assert code == 0 and 'Traceback' not in err, err
+
+
+def _check_tf_and_latched(got, statics, descriptions):
     poses = {stamp_ns(m.header): m for m in got['pose']}
     tfs = {stamp_ns(m.transforms[0].header): m for m in got['/tf']}
     # /tf at rate: consecutive stamps one period apart (reliable, keep last 100)
@@ -212,6 +225,60 @@ def test_tf_matches_pose_and_latched_topics_reach_late_joiners(client):
     # robot_description: a URDF whose links are the body and its two disks
     (description,) = descriptions
     assert_urdf(description.data, 'twodisk_body', static)
+
+
+def call(executor, client, parameter):
+    request = SetParameters.Request(parameters=[parameter.to_parameter_msg()])
+    future = client.call_async(request)
+    assert spin_until(executor, future.done), 'service call timed out'
+    (result,) = future.result().results
+    return result
+
+
+def _check_changes(executor, node, poses, tfs, statics, descriptions):
+    """Changes at run time re-send what they alter and nothing else (``statics`` and
+    ``descriptions`` hold the one latched message each so far)."""
+    setter = node.create_client(SetParameters, '/roller/set_parameters')
+    assert setter.wait_for_service(timeout_sec=STARTED)
+
+    # friction alters neither: after 10 more samples, nothing was re-sent
+    assert call(executor, setter, Parameter('friction', value=0.8)).successful
+    count = len(poses)
+    assert spin_until(executor, lambda: len(poses) >= count + 10)
+    assert (len(statics), len(descriptions)) == (1, 1)
+
+    # delta moves the disk centres (±delta e2) and changes the URDF
+    assert call(executor, setter, Parameter('delta', value=0.06)).successful
+    assert spin_until(executor, lambda: len(statics) == 2 and len(descriptions) == 2)
+    static = static_frames(statics[-1])
+    np.testing.assert_array_equal(static['twodisk_body_disk_a'][1], [0.0, -0.06, 0.0])
+    np.testing.assert_array_equal(static['twodisk_body_disk_b'][1], [0.0, 0.06, 0.0])
+    assert descriptions[-1].data != descriptions[0].data
+
+    # body_frame renames the child on /tf, the static parents and the URDF's links
+    assert call(executor, setter, Parameter('body_frame', value='oloid')).successful
+    assert spin_until(executor, lambda: len(statics) == 3 and len(descriptions) == 3)
+    assert set(static_frames(statics[-1])) == {'oloid_disk_a', 'oloid_disk_b'}
+    assert_urdf(descriptions[-1].data, 'oloid', static_frames(statics[-1]))
+    # (/tf sent before the change may still be queued here: from the first renamed one on)
+    tfs.clear()
+    children = lambda: [m.transforms[0].child_frame_id for m in tfs]  # noqa: E731
+
+    def renamed():
+        return 'oloid' in children() and len(tfs) - children().index('oloid') >= 5
+    assert spin_until(executor, renamed)
+    assert set(children()[children().index('oloid'):]) == {'oloid'}
+
+    # refused at run time, one line each: a bad body_frame, following /clock
+    for parameter, words in ((Parameter('body_frame', value='world'), 'frame_id'),
+                             (Parameter('body_frame', value='a b'), 'spaces'),
+                             (Parameter('use_sim_time', value=True), 'use_sim_time')):
+        result = call(executor, setter, parameter)
+        assert not result.successful and words in result.reason, result.reason
+        assert '\n' not in result.reason
+    count = len(poses)
+    assert spin_until(executor, lambda: len(poses) >= count + 10)   # still running
+    assert len(statics) == 3
 
 
 def assert_urdf(text, body_frame, static=None, mass=1.0):
@@ -244,72 +311,8 @@ def assert_urdf(text, body_frame, static=None, mass=1.0):
     return robot
 
 
-# -- changes at run time ---------------------------------------------------------------------
-
-def call(executor, client, parameter):
-    request = SetParameters.Request(parameters=[parameter.to_parameter_msg()])
-    future = client.call_async(request)
-    assert spin_until(executor, future.done), 'service call timed out'
-    (result,) = future.result().results
-    return result
-
-
-def test_changes_resend_what_they_alter_and_nothing_else(client):
-    node, executor = client
-    poses, tfs, statics, descriptions = [], [], [], []
-    node.create_subscription(PoseStamped, 'pose', poses.append, 1000)
-    node.create_subscription(TFMessage, '/tf', tfs.append, 1000)
-    node.create_subscription(TFMessage, '/tf_static', statics.append, LATCHED)
-    node.create_subscription(String, 'robot_description', descriptions.append, LATCHED)
-    process = start_roller('-p', f'rate:={RATE}', *body_params())
-    try:
-        assert spin_until(executor, lambda: statics and descriptions and len(poses) >= 5)
-        setter = node.create_client(SetParameters, '/roller/set_parameters')
-        assert setter.wait_for_service(timeout_sec=STARTED)
-
-        # friction alters neither: after 10 more samples, nothing was re-sent
-        assert call(executor, setter, Parameter('friction', value=0.8)).successful
-        count = len(poses)
-        assert spin_until(executor, lambda: len(poses) >= count + 10)
-        assert (len(statics), len(descriptions)) == (1, 1)
-
-        # delta moves the disk centres (±delta e2) and changes the URDF
-        assert call(executor, setter, Parameter('delta', value=0.06)).successful
-        assert spin_until(executor, lambda: len(statics) == 2 and len(descriptions) == 2)
-        static = static_frames(statics[-1])
-        np.testing.assert_array_equal(static['twodisk_body_disk_a'][1], [0.0, -0.06, 0.0])
-        np.testing.assert_array_equal(static['twodisk_body_disk_b'][1], [0.0, 0.06, 0.0])
-        assert descriptions[-1].data != descriptions[0].data
-
-        # body_frame renames the child on /tf, the static parents and the URDF's links
-        assert call(executor, setter, Parameter('body_frame', value='oloid')).successful
-        assert spin_until(executor, lambda: len(statics) == 3 and len(descriptions) == 3)
-        assert set(static_frames(statics[-1])) == {'oloid_disk_a', 'oloid_disk_b'}
-        assert_urdf(descriptions[-1].data, 'oloid', static_frames(statics[-1]))
-        tfs.clear()
-        assert spin_until(executor, lambda: len(tfs) >= 5)
-        assert all(m.transforms[0].child_frame_id == 'oloid' for m in tfs[1:])
-
-        # refused at run time, one line each: a bad body_frame, following /clock
-        for parameter, words in ((Parameter('body_frame', value='world'), 'frame_id'),
-                                 (Parameter('body_frame', value='a b'), 'spaces'),
-                                 (Parameter('use_sim_time', value=True), 'use_sim_time')):
-            result = call(executor, setter, parameter)
-            assert not result.successful and words in result.reason, result.reason
-            assert '\n' not in result.reason
-        count = len(poses)
-        assert spin_until(executor, lambda: len(poses) >= count + 10)   # still running
-        assert len(statics) == 3
-    finally:
-        code, err = stop(process)
-    assert code == 0 and 'Traceback' not in err, err
-
-
 # -- bad input -------------------------------------------------------------------------------
 
-#: Real processes: body_frame:=12 is refused by the argument check (before rclpy),
-#: use_sim_time:=true by the node (after rclpy.init).
-FRAMES_IN_A_PROCESS = ('body_frame:=12', 'use_sim_time:=true')
 
 
 @pytest.mark.parametrize('arguments, words', [
@@ -325,15 +328,13 @@ FRAMES_IN_A_PROCESS = ('body_frame:=12', 'use_sim_time:=true')
 ], ids=['empty', 'space', 'slash', 'frame_id', 'both', 'disk-frame', 'integer', 'sim-time',
         'frame_id-slash'])
 def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words, monkeypatch, capfd):
-    """Two cases as real processes (one refused before rclpy, one by the node); the others
-    through the same entry function in this process (tests/roller_here.py)."""
+    """Through the entry function in this process (tests/roller_here.py): body_frame:=12 is
+    refused by the argument check (before rclpy), use_sim_time:=true by the node (after
+    rclpy.init); refusals at both places as real processes are in test_node_reliability.py."""
     params = [arg for argument in arguments for arg in ('-p', argument)]
     args = ('-p', 'realtime:=false', '-p', 'duration:=0.1', *params)
-    if arguments[-1] in FRAMES_IN_A_PROCESS:
-        code, err = stop(start_roller(*args), sig=None, timeout=STARTED)
-    else:
-        code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *args),
-                                    monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', *args),
+                                monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
     lines = err.strip().splitlines()
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith('roller: ') and words in lines[0], err
@@ -341,17 +342,19 @@ def test_bad_frames_or_sim_time_exit_2_with_one_line(arguments, words, monkeypat
 
 # -- the recording -----------------------------------------------------------------------------
 
-def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
+def test_recording_holds_tf_tf_static_and_robot_description(tmp_path, monkeypatch, capfd):
     """As rosbag2 records them: /tf per sample, /tf_static and robot_description once,
-    transient local in their offered QoS; read by rosbags and by mcap-ros2-support."""
+    transient local in their offered QoS; read by rosbags and by mcap-ros2-support. The
+    node's batch run through its entry function in this process (the claim is the file)."""
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
     from twodisk_ros.recordings import read_recording
     target = tmp_path / 'frames.mcap'
-    process = start_roller('-p', 'realtime:=false', '-p', 'duration:=2.0', '-p', 'rate:=100.0',
-                           '-p', 'frame_id:=odom', '-p', 'body_frame:=oloid',
-                           '-p', f'record:={target}', *body_params())
-    code, err = stop(process, sig=None, timeout=60.0)
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'realtime:=false',
+                                 '-p', 'duration:=2.0', '-p', 'rate:=100.0',
+                                 '-p', 'frame_id:=odom', '-p', 'body_frame:=oloid',
+                                 '-p', f'record:={target}', *body_params()),
+                                monkeypatch, capfd, domain=DOMAIN, cwd=REPO)
     assert code == 0 and 'Traceback' not in err, err
     store = get_typestore(Stores.ROS2_JAZZY)
     got = {}
@@ -386,19 +389,19 @@ def test_recording_holds_tf_tf_static_and_robot_description(tmp_path):
     assert '/clock' not in qos                               # published, not recorded
 
 
-def test_an_unwritable_mesh_cache_leaves_a_urdf_without_meshes(tmp_path):
-    """The motion does not need the meshes: a warning, and the URDF keeps links and joints."""
+def test_an_unwritable_mesh_cache_leaves_a_urdf_without_meshes(tmp_path, monkeypatch, capfd):
+    """The motion does not need the meshes: a warning, and the URDF keeps links and joints.
+    Through the entry function in this process (the cache directory is read from the
+    environment at each build)."""
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
     blocker = tmp_path / 'a_file'
     blocker.write_text('not a directory')
     target = tmp_path / 'no_meshes.mcap'
-    process = subprocess.Popen(
-        [sys.executable, '-m', 'twodisk_ros.roller', '--ros-args', '-p', 'realtime:=false',
-         '-p', 'duration:=0.1', '-p', f'record:={target}'], cwd=REPO,
-        env=dict(node_env(), XDG_CACHE_HOME=str(blocker / 'cache')), stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE, text=True)
-    code, err = stop(process, sig=None, timeout=60.0)
+    monkeypatch.setenv('XDG_CACHE_HOME', str(blocker / 'cache'))
+    code, err = run_roller_main(('-p', 'realtime:=false', '-p', 'duration:=0.1',
+                                 '-p', f'record:={target}'), monkeypatch, capfd,
+                                domain=DOMAIN, cwd=REPO)
     assert code == 0, err
     warnings = [line for line in err.splitlines() if '[WARN]' in line]
     assert len(warnings) == 1 and 'robot_description without meshes' in warnings[0], err

@@ -37,6 +37,8 @@ from twodisk_ros.physics.stability.equilibria import equilibria  # noqa: E402
 from twodisk_ros.recordings import read_recording  # noqa: E402
 from twodisk_ros.node.roller import Roller  # noqa: E402
 
+from roller_here import run_roller_main  # noqa: E402
+
 pytestmark = pytest.mark.ros
 
 REPO = Path(__file__).resolve().parents[1]
@@ -172,8 +174,15 @@ def check_geometry(got, body, tol=1e-9):
 def oloid_run():
     harness = Harness([Parameter('rate', value=RATE),
                        Parameter('path_length', value=PATH_LENGTH)])
+    def enough():
+        """What the tests below read: 30 poses, the diagnostics, markers, and each path
+        grown to its bound (at 50 Hz, about 0.6 s of the run)."""
+        got = harness.got
+        return (len(got['pose']) >= 30 and got['/diagnostics'] and got['markers']
+                and all(got[topic] and len(got[topic][-1].poses) == PATH_LENGTH
+                        and len(got[topic]) >= 2 for topic in ('path_a', 'path_b', 'path_g')))
     try:
-        harness.spin(1.6)
+        assert harness.spin(10.0, until=enough), {t: len(m) for t, m in harness.got.items()}
         harness.got['samples_dropped'] = harness.node.samples_dropped
         yield harness.got
     finally:
@@ -322,7 +331,8 @@ def test_parameter_changes():
         assert 'delta' in result.reason
         assert harness.node.get_parameter('delta').value == 0.05
         harness.clear()
-        harness.spin(0.5)
+        harness.spin(3.0, until=lambda: min(len(harness.got[t]) for t in (
+            'pose', 'contact_a', 'contact_b', 'rolling_state')) >= 15)
         assert harness.node.simulation is simulation and harness.node.settings is settings
         check_geometry(harness.got, EllipseBody(0.1, 0.1, 0.05))
         stamps = [stamp_ns(m.header) for m in harness.got['pose']]
@@ -342,7 +352,8 @@ def test_parameter_changes():
                 if abs(parse_equilibria(d)[0][3] - equilibria(new_body)[0].height) < 1e-9][-1]
         assert_equilibria_match(diag, new_body)
         harness.clear()
-        harness.spin(0.5)
+        harness.spin(3.0, until=lambda: min(len(harness.got[t]) for t in (
+            'pose', 'contact_a', 'contact_b', 'rolling_state')) >= 15)
         assert harness.node.settings.delta == 0.06
         check_geometry(harness.got, new_body)
     finally:
@@ -485,9 +496,10 @@ def test_subprocess_sigterm_exits_0(client_context):
     node, executor = client_context
     poses = []
     node.create_subscription(PoseStamped, '/pose', poses.append, 1000)
-    # A fast timer is (almost) always ready when the signal arrives: three tries make sure a
-    # signal landing in the middle of publishing still ends cleanly.
-    for _ in range(3):
+    # A fast timer is (almost) always ready when the signal arrives: two tries here (and the
+    # 1 kHz run of test_signal_finishes_the_recording, signalled while it records) make sure
+    # a signal landing in the middle of publishing still ends cleanly.
+    for _ in range(2):
         poses.clear()
         started = time.time_ns()     # poses of this process only (not queued ones of the last)
         process = start_roller('-p', 'rate:=1000.0')
@@ -501,26 +513,28 @@ def test_subprocess_sigterm_exits_0(client_context):
         assert code == 0, stderr
 
 
-def test_subprocess_invalid_start_value_exits_2():
-    result = subprocess.run(
-        roller_command('--params-file', 'config/oloid.yaml', '-p', 'delta:=0.5'),
-        cwd=REPO, env=node_env(), capture_output=True, text=True, timeout=30)
-    assert result.returncode == 2, result.stderr
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
+# The refusals below and the batch recording run the entry function in this process
+# (tests/roller_here.py): the same refusals as real processes (one by the node after
+# rclpy.init, one by the recorder) are in test_node_reliability.py.
+
+def test_invalid_start_value_exits_2(monkeypatch, capfd):
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', 'delta:=0.5'),
+                                monkeypatch, capfd, domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 2, err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
     assert 'delta' in lines[0]
-    assert 'Traceback' not in result.stderr
+    assert 'Traceback' not in err
 
 
-def test_subprocess_batch_recording(tmp_path):
+def test_batch_recording(tmp_path, monkeypatch, capfd):
     target = tmp_path / 'x.mcap'
-    result = subprocess.run(
-        roller_command('--params-file', 'config/oloid.yaml', '-p', f'rate:={RATE}',
-                       '-p', 'realtime:=false', '-p', 'duration:=2.0',
-                       '-p', f'record:={target}'),
-        cwd=REPO, env=node_env(), capture_output=True, text=True, timeout=60)
-    assert result.returncode == 0, result.stderr
-    assert 'Traceback' not in result.stderr
+    code, err = run_roller_main(('--params-file', 'config/oloid.yaml', '-p', f'rate:={RATE}',
+                                 '-p', 'realtime:=false', '-p', 'duration:=2.0',
+                                 '-p', f'record:={target}'), monkeypatch, capfd,
+                                domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 0, err
+    assert 'Traceback' not in err
     assert target.is_file()
     recording = read_recording(target, decode=lambda topic: topic == '/pose')
     assert not recording.truncated
@@ -535,12 +549,14 @@ def test_subprocess_batch_recording(tmp_path):
         assert math.isclose(math.hypot(q.x, q.y, q.z, q.w), 1.0, abs_tol=1e-12)
 
 
-@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
-def test_signal_finishes_the_recording(tmp_path, sig):
+def test_signal_finishes_the_recording(tmp_path):
     """A realtime run stopped by a signal exits 0 and leaves a complete MCAP file.
 
     At 1 kHz the 300 kB of a few chunks are on disk after about 0.6 s of the run (3 s at
-    200 Hz)."""
+    200 Hz). SIGINT here; SIGTERM on a 1 kHz node in test_subprocess_sigterm_exits_0 (both
+    go to one handler, node/stop.py), and both signals end real-time recordings mid-run in
+    test_node_reliability.py, whose recordings the inspector checks."""
+    sig = signal.SIGINT
     target = tmp_path / 'stopped.mcap'
     process = start_roller('-p', 'rate:=1000.0', '-p', f'record:={target}')
     try:
@@ -560,14 +576,14 @@ def test_signal_finishes_the_recording(tmp_path, sig):
     assert 'twodisk_ros' in recording.metadata and 'rosbag2' in recording.metadata
 
 
-def test_unwritable_record_path_exits_2(tmp_path):
+def test_unwritable_record_path_exits_2(tmp_path, monkeypatch, capfd):
     missing = tmp_path / 'no' / 'such' / 'dir' / 'x.mcap'
-    result = subprocess.run(roller_command('-p', f'record:={missing}'), cwd=REPO,
-                            env=node_env(), capture_output=True, text=True, timeout=60)
-    assert result.returncode == 2
-    lines = result.stderr.strip().splitlines()
+    code, err = run_roller_main(('-p', f'record:={missing}'), monkeypatch, capfd,
+                                domain=SUBPROCESS_DOMAIN, cwd=REPO)
+    assert code == 2
+    lines = err.strip().splitlines()
     assert len(lines) == 1 and str(missing.parent) in lines[0]
-    assert 'Traceback' not in result.stderr
+    assert 'Traceback' not in err
     assert not missing.exists()
 
 
