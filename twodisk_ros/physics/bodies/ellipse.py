@@ -172,7 +172,8 @@ class EllipseForms:
 
         Analytic in u (complex-step safe); exact near the turning points u = ±π/2
         (:func:`.ellipse_phase.phase_angles`)."""
-        return phase_angles(u, self._phase_constants)
+        return phase_angles(u, (self.a, self.b, self._eta_max, self.theta_max,
+                                self._cos_eta_max, self._sin_eta_max, self._e_max))
 
     def phase_theta(self, u):
         """θ(u) (rad): tan θ = (b/a) tan η with η = η_max sin u; θ(±π/2) = ±θ_max."""
@@ -340,8 +341,6 @@ class EllipseBody(EllipseForms, RollingBody):
         self._cos_eta_max = math.cos(self._eta_max)
         self._sin_eta_max = math.sin(self._eta_max)
         self._e_max = math.hypot(a * self._cos_eta_max, b * self._sin_eta_max)
-        self._phase_constants = (a, b, self._eta_max, self.theta_max, self._cos_eta_max,
-                                 self._sin_eta_max, self._e_max)
 
     def __repr__(self):
         return f'EllipseBody(a={self.a!r}, b={self.b!r}, delta={self.delta!r})'
