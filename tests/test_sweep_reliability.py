@@ -173,6 +173,12 @@ def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(client, reference, f
             for name in reference.data_vars:
                 assert opened[name].attrs['units'] and opened[name].attrs['description']
             assert opened.attrs['package_version'] and opened.attrs['mass_model'] == 'laminae'
+            # the ellipse alone: 2-D, exponent a scalar coordinate, as before the exponent axis
+            assert dict(opened.sizes) == {'b_over_a': 6, 'delta_over_a': 8}, path
+            assert float(opened['exponent']) == 2.0 and opened['exponent'].attrs['units']
+            point = {'b_over_a': 1.0, 'delta_over_a': 0.5, 'method': 'nearest'}
+            assert float(opened.sel(**point)['cycle_advance']) == float(
+                reference.sel(**point)['cycle_advance'])
         _same(read_sweep(path), reference)
     assert np.all(_flags(store) == 1)
     assert not (tmp_path / 'map.nc.parts').exists()
