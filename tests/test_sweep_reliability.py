@@ -77,9 +77,16 @@ def shared(client, monkeypatch):
 
 
 @pytest.fixture(scope='module')
-def reference(client):
-    """The undisturbed sweep, in memory (no output file)."""
-    return run_sweep(_spec(5), client, progress=None).dataset
+def netcdf_run(client, tmp_path_factory):
+    """(file, SweepRun) of the undisturbed sweep written as NetCDF."""
+    out = tmp_path_factory.mktemp('netcdf') / 'map.nc'
+    return out, run_sweep(_spec(5), client, out=out, progress=None, overwrite=False)
+
+
+@pytest.fixture(scope='module')
+def reference(netcdf_run):
+    """The undisturbed sweep, in memory (the Dataset its run built before writing the file)."""
+    return netcdf_run[1].dataset
 
 
 @pytest.fixture(scope='module')
@@ -159,13 +166,11 @@ def test_blocks_cover_the_grid_once_within_the_chunk_size(shape, chunk):
 
 # -- the two formats -------------------------------------------------------------------------
 
-def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(client, reference, finished_store,
-                                                           tmp_path):
+def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(reference, netcdf_run,
+                                                           finished_store):
     import xarray as xr
-    store, zarr_run = finished_store
-    runs = {tmp_path / 'map.nc': run_sweep(_spec(5), client, out=tmp_path / 'map.nc',
-                                           progress=None, overwrite=False),
-            store: zarr_run}
+    (out, netcdf), (store, zarr_run) = netcdf_run, finished_store
+    runs = {out: netcdf, store: zarr_run}
     for path, run in runs.items():
         assert run.computed == len(_spec(5).blocks()) and run.resumed == 0
         assert run.bodies == TOTAL and run.masked == 6 * 1     # the Delta/a = 1 column
@@ -181,8 +186,7 @@ def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(client, reference, f
                 reference.sel(**point)['cycle_advance'])
         _same(read_sweep(path), reference)
     assert np.all(_flags(store) == 1)
-    assert not (tmp_path / 'map.nc.parts').exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ['map.nc']
+    assert sorted(p.name for p in out.parent.iterdir()) == ['map.nc']     # no .parts left
     assert sorted(p.name for p in store.parent.iterdir()) == ['map.zarr']
 
 
