@@ -1,7 +1,8 @@
 """Outputs, runaway requests and --help of ``twodisk-sweep`` and ``twodisk-animate``.
 
-Every command runs as a real entry point in a subprocess (but the sweeps of the test that
-replaces outputs: the command line in this process), most inside a wrapper that makes importing Dask, distributed, xarray and zarr (and, for the early refusals of
+Every command runs as a real entry point in a subprocess (but the runs of the tests that
+replace outputs: the command line in this process), most inside a wrapper that makes
+importing Dask, distributed, xarray and zarr (and, for the early refusals of
 ``twodisk-animate``, scipy and matplotlib) raise: a refusal that still comes out as one line
 with exit 2 was made before any of them was imported (not a timing claim). The runaway
 requests run under an address-space limit (RLIMIT_AS) so that a regression fails with a
@@ -287,13 +288,16 @@ def test_animate_refuses_an_existing_output(tmp_path):
     assert _listing(tmp_path) == ['run.gif']
 
 
-def test_animate_overwrite_replaces_the_output(tmp_path):
+def test_animate_overwrite_replaces_the_output(tmp_path, monkeypatch, capsys):
+    # the command line in this process (its refusals above are the real command)
     from PIL import Image
+    from twodisk_ros.plotting.animate_cli import main
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / 'run.gif'
     out.write_bytes(b'an earlier animation')
-    result, _ = _run(ANIMATE, '-o', out, '--stop', '0.2', '--fps', '10', '--size', '160x120',
-                     '--overwrite', cwd=tmp_path, timeout=120)
-    assert result.returncode == 0, result.stderr
+    status = main(['-o', str(out), '--stop', '0.2', '--fps', '10', '--size', '160x120',
+                   '--overwrite'])
+    assert status == 0, capsys.readouterr().err
     with Image.open(out) as image:
         assert image.format == 'GIF' and image.n_frames == 3 and image.size == (160, 120)
     assert _listing(tmp_path) == ['run.gif']    # no temporary file left

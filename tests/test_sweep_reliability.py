@@ -364,7 +364,7 @@ def test_a_worker_killed_mid_sweep_changes_nothing(client, reference, tmp_path, 
             return real(spec, sweep_client, *args, on_chunk=on_chunk, **kwargs)
 
         monkeypatch.setattr(run, 'run_sweep', hooked)
-        status = main(_argv(store, '--chunk-size', '2', '--scheduler',
+        status = main(_argv(store, '--chunk-size', '5', '--scheduler',
                             client.scheduler.address))
         err = capsys.readouterr().err
         dead = proc.poll()
