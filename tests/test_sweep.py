@@ -362,19 +362,17 @@ def test_bad_input_one_line_exit_2(override, words, capsys, tmp_path):
     assert not (tmp_path / 'x.nc.parts').exists()
 
 
-@pytest.mark.slow
-def test_unreachable_scheduler_exit_2_fast(tmp_path):
+def test_unreachable_scheduler_exit_2_fast(tmp_path, capsys):
+    # the command line in this process (the real command refusing a scheduler address, and
+    # exiting without noise: tests/test_hostile_input.py)
     port = free_port()   # nothing listens there
-    result = subprocess.run(
-        [sys.executable, '-m', 'twodisk_ros.sweep', '--b-over-a', '1', '1', '1',
-         '--delta-over-a', '0.5', '0.5', '1', '--out', str(tmp_path / 'x.nc'),
-         '--scheduler', f'tcp://127.0.0.1:{port}'],
-        env=ENV, cwd=tmp_path, capture_output=True, text=True, timeout=60)   # hang guard
-    assert result.returncode == 2, result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1, result.stderr
-    assert 'cannot reach the Dask scheduler' in result.stderr
-    assert 'ConnectionRefusedError' in result.stderr
-    assert not (tmp_path / 'x.nc.parts').exists()
+    status = main(['--b-over-a', '1', '1', '1', '--delta-over-a', '0.5', '0.5', '1', '--out',
+                   str(tmp_path / 'x.nc'), '--scheduler', f'tcp://127.0.0.1:{port}'])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert len(err.strip().splitlines()) == 1, err
+    assert 'cannot reach the Dask scheduler' in err and 'ConnectionRefusedError' in err
+    assert list(tmp_path.iterdir()) == []        # no output, no resume cache
 
 
 def test_a_refused_connection_is_final_without_a_client(monkeypatch):
