@@ -54,6 +54,19 @@ def wait_for_workers(address, count, timeout=60):
             time.sleep(0.5)
 
 
+def _start_workers(folder, address, count, procs, logs, first=0):
+    """Append ``count`` single-thread ``dask worker --no-nanny`` commands of the scheduler at
+    ``address`` to ``procs`` (their logs, ``folder/worker{k}.log``, to ``logs``)."""
+    for k in range(first, first + count):
+        log = open(Path(folder) / f'worker{k}.log', 'w')
+        logs.append(log)
+        procs.append(subprocess.Popen(
+            [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
+             '--nthreads', '1', '--no-nanny', *NO_DASHBOARD],
+            stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder,
+            start_new_session=True))
+
+
 @contextlib.contextmanager
 def cluster(folder, workers=2):
     """(address, [scheduler, worker...] Popen) of a scheduler and ``workers`` single-thread
@@ -69,16 +82,27 @@ def cluster(folder, workers=2):
         procs.append(subprocess.Popen(
             [DASK, 'scheduler', '--host', '127.0.0.1', '--port', str(port), *NO_DASHBOARD],
             stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder, start_new_session=True))
-        for k in range(workers):
-            log = open(Path(folder) / f'worker{k}.log', 'w')
-            logs.append(log)
-            procs.append(subprocess.Popen(
-                [DASK, 'worker', address, '--host', '127.0.0.1', '--nworkers', '1',
-                 '--nthreads', '1', '--no-nanny', *NO_DASHBOARD],
-                stdout=log, stderr=subprocess.STDOUT, env=ENV, cwd=folder,
-                start_new_session=True))
+        _start_workers(folder, address, workers, procs, logs)
         wait_for_workers(address, workers)
         yield address, procs
+    finally:
+        stop(procs)
+        for log in logs:
+            log.close()
+
+
+@contextlib.contextmanager
+def worker_processes(folder, client, count=1):
+    """[Popen] of ``count`` single-thread ``dask worker --no-nanny`` commands (each in a
+    session of its own, logs in ``folder``) joined to the scheduler of ``client`` (e.g. one on
+    threads of the test process: no scheduler process to start); returns once the scheduler
+    has them all; every one stopped on exit."""
+    procs, logs = [], []
+    try:
+        before = len(client.scheduler_info(n_workers=-1)['workers'])
+        _start_workers(folder, client.scheduler.address, count, procs, logs)
+        client.wait_for_workers(before + count, timeout=60)
+        yield procs
     finally:
         stop(procs)
         for log in logs:

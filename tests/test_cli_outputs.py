@@ -1,7 +1,8 @@
 """Outputs, runaway requests and --help of ``twodisk-sweep`` and ``twodisk-animate``.
 
-Every command runs as a real entry point in a subprocess. Most run inside a wrapper that
-makes importing Dask, distributed, xarray and zarr (and, for the early refusals of
+Every command runs as a real entry point in a subprocess (but the runs of the tests that
+replace outputs: the command line in this process), most inside a wrapper that makes
+importing Dask, distributed, xarray and zarr (and, for the early refusals of
 ``twodisk-animate``, scipy and matplotlib) raise: a refusal that still comes out as one line
 with exit 2 was made before any of them was imported (not a timing claim). The runaway
 requests run under an address-space limit (RLIMIT_AS) so that a regression fails with a
@@ -38,6 +39,9 @@ HEAVY = DASK_LIKE + ('scipy', 'matplotlib')
 #: parameters, and so scipy and the physics, but never these before the grid passed).
 SWEEP_WORK = ('twodisk_ros.sweep.spec', 'twodisk_ros.sweep.quantities',
               'twodisk_ros.sweep.batch', 'twodisk_ros.sweep.general')
+#: The modules that compute bodies (scipy's optimizers and the physics' tables): a worker's,
+#: never imported by the command's client, not even for a sweep it runs on a scheduler.
+BODY_WORK = SWEEP_WORK[1:]
 REFUSED = 'imported before the command line was checked'
 #: Address space for the runaway requests (B): Python with numpy needs ~0.5 GiB here.
 ADDRESS_SPACE = 2 * 2**30
@@ -152,7 +156,8 @@ def test_sweep_typo_exits_2_fast_without_dask(tmp_path, args, words):
 def test_sweep_refuses_an_existing_output(tmp_path):
     out = tmp_path / 'family.nc'
     out.write_bytes(b'an earlier result')
-    result, _ = _run(SWEEP, *ONE_BODY, '--out', out, cwd=tmp_path, blocked=DASK_LIKE)
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', out, cwd=tmp_path,
+                     blocked=DASK_LIKE + BODY_WORK)
     _one_line_exit_2(result, 'family.nc exists', '--overwrite')
     assert out.read_bytes() == b'an earlier result'
     assert _listing(tmp_path) == ['family.nc']        # no resume cache, no temporary file
@@ -177,7 +182,8 @@ def test_sweep_refuses_an_existing_zarr_store_before_dask(tmp_path):
     finish_store(create_store(store, SweepSpec(np.array([1.0]), np.array([0.5]),
                                                chunk_size=1)))
     before = sorted((p, p.stat().st_mtime_ns) for p in store.rglob('*'))
-    result, _ = _run(SWEEP, *ONE_BODY, '--out', store, cwd=tmp_path, blocked=DASK_LIKE)
+    result, _ = _run(SWEEP, *ONE_BODY, '--out', store, cwd=tmp_path,
+                     blocked=DASK_LIKE + BODY_WORK)
     _one_line_exit_2(result, 'family.zarr exists', '--overwrite')
     assert sorted((p, p.stat().st_mtime_ns) for p in store.rglob('*')) == before
     # a directory the sweep did not write is never replaced, not even with --overwrite
@@ -230,11 +236,13 @@ def test_sweep_runaway_grid_refused_with_what_it_needs(tmp_path, grid, words):
 @pytest.mark.slow
 def test_sweep_without_any_computable_body_is_an_error(scheduler, tmp_path):
     # Delta/a = 1e-300 passes the command-line checks, but the body refuses a length below
-    # its range (1e-30 m at a = 1): every point is masked
+    # its range (1e-30 m at a = 1): every point is masked. The bodies are computed by the
+    # scheduler's worker (a thread of this process), never by the command's client, which
+    # therefore runs without the modules that compute them
     result, _ = _run(SWEEP, '--b-over-a', '1', '1', '1', '--delta-over-a', '1e-300',
                      '1e-300', '1', '--out', tmp_path / 'x.nc', '--scheduler', scheduler,
                      '--quiet',
-                     cwd=tmp_path, timeout=120)
+                     cwd=tmp_path, blocked=BODY_WORK, timeout=120)
     _one_line_exit_2(result, 'no body of the grid could be computed', 'nothing written')
     assert _listing(tmp_path) == []       # no file, no resume cache
 
@@ -244,8 +252,8 @@ def test_sweep_overwrite_replaces_outputs_and_still_resumes(scheduler, tmp_path,
     from twodisk_ros.sweep.cli import main
     out, maps = tmp_path / 'family.nc', tmp_path / 'maps'
     command = [*ONE_BODY, '--out', out, '--scheduler', scheduler, '--quiet']
-    # the first sweep (only the outputs to replace) by the command line in this process; the
-    # refusal and the replacing sweep are the real command
+    # the sweeps by the command line in this process (Dask and the maps' matplotlib imported
+    # once, not per command); the refusal, made before Dask, is the real command
     assert main([*map(str, command), '--keep-parts']) == 0, capsys.readouterr().err
     written = out.read_bytes()
     parts = sorted((tmp_path / 'family.nc.parts').iterdir())
@@ -259,9 +267,10 @@ def test_sweep_overwrite_replaces_outputs_and_still_resumes(scheduler, tmp_path,
     assert out.read_bytes() == b'an earlier result'
     assert sorted((tmp_path / 'family.nc.parts').iterdir()) == parts
     # with --overwrite: the cache is resumed (not discarded), the outputs are replaced
-    again, _ = _run(SWEEP, *command, '--plot', maps, '--overwrite', cwd=tmp_path, timeout=120)
-    assert again.returncode == 0, again.stderr
-    assert '0 chunks computed, 1 resumed' in again.stderr
+    capsys.readouterr()
+    assert main([*map(str, command), '--plot', str(maps), '--overwrite']) == 0
+    again = capsys.readouterr().err
+    assert '0 chunks computed, 1 resumed' in again and f'wrote 15 maps to {maps}' in again, again
     assert out.read_bytes() == written          # the resumed result is bitwise the same
     assert (maps / 'barrier.png').read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert len(_listing(maps)) == 15 and not any(n.startswith('.') for n in _listing(maps))
@@ -279,13 +288,16 @@ def test_animate_refuses_an_existing_output(tmp_path):
     assert _listing(tmp_path) == ['run.gif']
 
 
-def test_animate_overwrite_replaces_the_output(tmp_path):
+def test_animate_overwrite_replaces_the_output(tmp_path, monkeypatch, capsys):
+    # the command line in this process (its refusals above are the real command)
     from PIL import Image
+    from twodisk_ros.plotting.animate_cli import main
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / 'run.gif'
     out.write_bytes(b'an earlier animation')
-    result, _ = _run(ANIMATE, '-o', out, '--stop', '0.2', '--fps', '10', '--size', '160x120',
-                     '--overwrite', cwd=tmp_path, timeout=120)
-    assert result.returncode == 0, result.stderr
+    status = main(['-o', str(out), '--stop', '0.2', '--fps', '10', '--size', '160x120',
+                   '--overwrite'])
+    assert status == 0, capsys.readouterr().err
     with Image.open(out) as image:
         assert image.format == 'GIF' and image.n_frames == 3 and image.size == (160, 120)
     assert _listing(tmp_path) == ['run.gif']    # no temporary file left

@@ -8,12 +8,13 @@ itself, or kills a busy worker, right after its k-th finished chunk (a wrapper a
 process a test starts is stopped in a ``finally``.
 """
 
+import contextlib
 import fcntl
 import os
 from pathlib import Path
 import pty
+import signal
 import struct
-import subprocess
 import sys
 import termios
 import time
@@ -21,8 +22,6 @@ import time
 import numpy as np
 import pytest
 
-from dask_helpers import ENV, cluster
-from harsh_start import harshly
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
 from twodisk_ros.sweep.run import SweepSpec, run_sweep
@@ -78,9 +77,24 @@ def shared(client, monkeypatch):
 
 
 @pytest.fixture(scope='module')
-def reference(client):
-    """The undisturbed sweep, in memory (no output file)."""
-    return run_sweep(_spec(5), client, progress=None).dataset
+def netcdf_run(client, tmp_path_factory):
+    """(file, SweepRun) of the undisturbed sweep written as NetCDF."""
+    out = tmp_path_factory.mktemp('netcdf') / 'map.nc'
+    return out, run_sweep(_spec(5), client, out=out, progress=None, overwrite=False)
+
+
+@pytest.fixture(scope='module')
+def reference(netcdf_run):
+    """The undisturbed sweep, in memory (the Dataset its run built before writing the file)."""
+    return netcdf_run[1].dataset
+
+
+@pytest.fixture(scope='module')
+def finished_store(client, tmp_path_factory):
+    """(store, SweepRun) of the undisturbed sweep written as a Zarr store (a test that needs a
+    finished store of the sweep copies it)."""
+    store = tmp_path_factory.mktemp('finished') / 'map.zarr'
+    return store, run_sweep(_spec(5), client, out=store, progress=None, overwrite=False)
 
 
 def _same(x, y):
@@ -152,21 +166,28 @@ def test_blocks_cover_the_grid_once_within_the_chunk_size(shape, chunk):
 
 # -- the two formats -------------------------------------------------------------------------
 
-def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(client, reference, tmp_path):
+def test_zarr_and_netcdf_are_the_sweep_and_open_with_xarray(reference, netcdf_run,
+                                                           finished_store):
     import xarray as xr
-    runs = {suffix: run_sweep(_spec(5), client, out=tmp_path / f'map{suffix}', progress=None,
-                              overwrite=False) for suffix in ('.nc', '.zarr')}
-    for suffix, run in runs.items():
+    (out, netcdf), (store, zarr_run) = netcdf_run, finished_store
+    runs = {out: netcdf, store: zarr_run}
+    for path, run in runs.items():
         assert run.computed == len(_spec(5).blocks()) and run.resumed == 0
         assert run.bodies == TOTAL and run.masked == 6 * 1     # the Delta/a = 1 column
-        with xr.open_dataset(tmp_path / f'map{suffix}') as opened:   # engine auto-detected
+        with xr.open_dataset(path) as opened:   # engine auto-detected
             for name in reference.data_vars:
                 assert opened[name].attrs['units'] and opened[name].attrs['description']
             assert opened.attrs['package_version'] and opened.attrs['mass_model'] == 'laminae'
-        _same(read_sweep(tmp_path / f'map{suffix}'), reference)
-    assert np.all(_flags(tmp_path / 'map.zarr') == 1)
-    assert not (tmp_path / 'map.nc.parts').exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ['map.nc', 'map.zarr']
+            # the ellipse alone: 2-D, exponent a scalar coordinate, as before the exponent axis
+            assert dict(opened.sizes) == {'b_over_a': 6, 'delta_over_a': 8}, path
+            assert float(opened['exponent']) == 2.0 and opened['exponent'].attrs['units']
+            point = {'b_over_a': 1.0, 'delta_over_a': 0.5, 'method': 'nearest'}
+            assert float(opened.sel(**point)['cycle_advance']) == float(
+                reference.sel(**point)['cycle_advance'])
+        _same(read_sweep(path), reference)
+    assert np.all(_flags(store) == 1)
+    assert sorted(p.name for p in out.parent.iterdir()) == ['map.nc']     # no .parts left
+    assert sorted(p.name for p in store.parent.iterdir()) == ['map.zarr']
 
 
 def test_a_block_killed_mid_write_is_computed_again(client, reference, tmp_path):
@@ -251,47 +272,51 @@ def test_the_flags_are_written_after_every_variable(tmp_path, monkeypatch):
 
 # -- interrupted and resumed -----------------------------------------------------------------
 
-#: The sweep's command line with a hook after the client's k-th finished chunk (argv[2]):
-#: SIGINT, the client signals itself (a real SIGINT through Python's handler, which the
-#: script installs first: a suite started in the background or under nohup hands its
-#: children SIGINT ignored, and then Python installs none).
-_HOOKED_CLI = """
-import signal, sys
-signal.signal(signal.SIGINT, signal.default_int_handler)
-import twodisk_ros.sweep.run as run
-real, action, after = run.run_sweep, sys.argv[1], int(sys.argv[2])
-assert action == 'SIGINT', action
-def hooked(spec, client, *args, **kwargs):
-    def on_chunk(index, computed):
-        if computed == after:
-            signal.raise_signal(signal.SIGINT)
-            sys.exit('SIGINT raised nothing')
-    return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
-run.run_sweep = hooked
-from twodisk_ros.sweep.cli import main
-sys.exit(main(sys.argv[3:]))
-"""
-
-
-def _hooked(action, after, argv, timeout=180):
-    return subprocess.run(harshly([sys.executable, '-c', _HOOKED_CLI, action, str(after), *argv]),
-                          env=ENV, capture_output=True, text=True, timeout=timeout,
-                          start_new_session=True)
+@contextlib.contextmanager
+def _sigint_raises_keyboardinterrupt():
+    """Python's own SIGINT handler within (a suite started in the background or under nohup
+    runs with SIGINT ignored, and the command line's script installs the handler the same
+    way: tests/test_sweep.py runs it as a command); the handler and the levels of the loggers
+    that an interrupted command line quiets for the rest of its process restored at exit."""
+    import logging
+    levels = {name: logging.getLogger(name).level for name in logging.root.manager.loggerDict}
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        for name, level in levels.items():
+            logging.getLogger(name).setLevel(level)
 
 
 @pytest.mark.slow
 def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, reference, shared,
-                                                                tmp_path, capsys):
-    # the interrupted command runs on the module's cluster (no LocalCluster of its own to
-    # start), then the rerun: the command line in this process, on the same cluster
+                                                                tmp_path, capsys,
+                                                                monkeypatch):
+    # the command line in this process, on the module's cluster: a real SIGINT (the process
+    # signals itself right after the client's 5th finished chunk), then the rerun
+    import twodisk_ros.sweep.run as run
     store = tmp_path / 'map.zarr'
     argv = _argv(store, '--chunk-size', '2')
     blocks = len(SweepSpec(np.linspace(0.5, 1.5, 6), np.linspace(0.3, 1.0, 8),
                            chunk_size=2).blocks())
     assert blocks == TOTAL // 2
-    stopped = _hooked('SIGINT', 5, [*argv, '--scheduler', client.scheduler.address])
-    assert stopped.returncode == 130, stopped.stderr
-    assert stopped.stderr.strip().splitlines() == [
+    real = run.run_sweep
+
+    def hooked(spec, sweep_client, *args, **kwargs):
+        def on_chunk(index, computed):
+            if computed == 5:
+                signal.raise_signal(signal.SIGINT)
+                raise AssertionError('SIGINT raised nothing')
+        return real(spec, sweep_client, *args, on_chunk=on_chunk, **kwargs)
+
+    capsys.readouterr()
+    with monkeypatch.context() as patch, _sigint_raises_keyboardinterrupt():
+        patch.setattr(run, 'run_sweep', hooked)
+        status = main(argv)
+    err = capsys.readouterr().err
+    assert status == 130, err
+    assert err.strip().splitlines() == [
         f'twodisk-sweep: interrupted; finished chunks are kept in {store} - run the same '
         'command again to resume']
     _wait_until_idle(client)    # a cancelled task still finishes on its worker
@@ -300,7 +325,6 @@ def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, referenc
     assert 5 <= finished < blocks
     kept = {p: v for p, v in _tree(store).items() if '/computed/c/' in str(p)}
     assert len(kept) == finished
-    capsys.readouterr()
     assert main([*argv, '--quiet']) == 0
     last = capsys.readouterr().err.strip().splitlines()[-1]
     assert f'{blocks - finished} chunks computed, {finished} resumed' in last, last
@@ -311,36 +335,43 @@ def test_interrupted_zarr_sweep_resumes_only_the_missing_chunks(client, referenc
 
 
 @pytest.mark.slow
-def test_a_worker_killed_mid_sweep_changes_nothing(reference, tmp_path, capsys, monkeypatch):
-    # the command line runs in this process; its hook kills one busy `dask worker` command
-    import signal
+def test_a_worker_killed_mid_sweep_changes_nothing(client, reference, tmp_path, capsys,
+                                                  monkeypatch):
+    # the command line runs in this process on the module's scheduler, joined by one
+    # `dask worker` command; the hook kills that worker while it is busy (the module's two
+    # worker threads finish the sweep)
     import twodisk_ros.sweep.run as run
+    from dask_helpers import worker_processes
     store = tmp_path / 'map.zarr'
     real = run.run_sweep
 
-    def hooked(spec, client, *args, **kwargs):
-        def on_chunk(index, computed):
-            if computed != 3:
-                return
-            busy = [address for address, keys in client.processing().items() if keys]
-            assert busy, 'no worker busy'
-            pid = client.run(os.getpid, workers=busy[:1])[busy[0]]
-            group = os.getpgid(pid)
-            # only a group that the test's cluster started in a session of its own
-            assert group != os.getpgid(0) and os.getsid(group) == group, pid
-            os.killpg(group, signal.SIGKILL)
-            print('killed a busy worker after 3 chunks', file=sys.stderr)
-        return real(spec, client, *args, on_chunk=on_chunk, **kwargs)
+    with worker_processes(tmp_path, client) as procs:
+        (proc,) = procs
 
-    monkeypatch.setattr(run, 'run_sweep', hooked)
-    with cluster(tmp_path, workers=2) as (address, procs):
-        status = main(_argv(store, '--chunk-size', '1', '--scheduler', address))
+        def hooked(spec, sweep_client, *args, **kwargs):
+            def on_chunk(index, computed):
+                if computed != 3:
+                    return
+                address = next(a for a, pid in sweep_client.run(os.getpid).items()
+                               if pid == proc.pid)
+                # wait for the event (a task on the worker), never a sleep of a guessed length
+                deadline = time.monotonic() + 60
+                while not sweep_client.processing(workers=[address])[address]:
+                    assert time.monotonic() < deadline, 'the worker command never got a task'
+                    time.sleep(0.01)
+                proc.kill()         # SIGKILL: one process (no nanny), nothing it started
+                print('killed a busy worker after 3 chunks', file=sys.stderr)
+            return real(spec, sweep_client, *args, on_chunk=on_chunk, **kwargs)
+
+        monkeypatch.setattr(run, 'run_sweep', hooked)
+        status = main(_argv(store, '--chunk-size', '5', '--scheduler',
+                            client.scheduler.address))
         err = capsys.readouterr().err
-        dead = [p for p in procs[1:] if p.poll() is not None]
+        dead = proc.poll()
     assert status == 0, err
     lines = err.strip().splitlines()
     assert lines[0] == 'killed a busy worker after 3 chunks', lines
-    assert len(dead) == 1 and dead[0].returncode == -9       # one `dask worker` is gone
+    assert dead == -9                                       # the `dask worker` is gone
     assert f'({TOTAL} bodies, 6 masked; ' in lines[-1] and 'Traceback' not in err
     _same(read_sweep(store), reference)
     assert np.all(_flags(store) == 1)
@@ -359,12 +390,12 @@ def _fails_in_one_line(argv, capsys, *words):
 
 
 @pytest.mark.slow
-def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, shared, tmp_path,
-                                                           capsys):
+def test_an_existing_zarr_store_is_refused_unless_overwrite(reference, finished_store, shared,
+                                                           tmp_path, capsys):
+    import shutil
     store = tmp_path / 'map.zarr'
+    shutil.copytree(finished_store[0], store)       # the finished store of this sweep
     argv = _argv(store, '--chunk-size', '5', '--workers', '1', '--quiet')
-    assert main(argv) == 0
-    capsys.readouterr()
     before = _tree(store)
     _fails_in_one_line(argv, capsys, 'map.zarr exists', '--overwrite')
     assert _tree(store) == before

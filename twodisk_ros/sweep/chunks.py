@@ -12,10 +12,8 @@ import time
 
 import numpy as np
 
-from .batch import batch_quantities
-from .general import general_body_quantities
-from .quantities import VARIABLES, body_quantities
 from .request import ELLIPSE_EXPONENT
+from .variables import VARIABLES
 
 __all__ = ['chunk_quantities', 'timed_chunk']
 
@@ -50,13 +48,18 @@ def chunk_quantities(b_values, delta_values, mass_model='laminae', reference_spe
         :data:`~twodisk_ros.sweep.quantities.VARIABLES`, and ``failure`` → list of
         str, all of the length of the inputs.
     """
+    # the paths (scipy and the physics) imported here: on the workers, never by a client that
+    # only submits timed_chunk
     if exponent != ELLIPSE_EXPONENT or body_factory is not None:
+        from .general import general_body_quantities
         return _body_by_body(b_values, delta_values, lambda b, d: general_body_quantities(
             b, d, exponent, mass_model, reference_speed, timings, body_factory, mass_factory))
     if method == 'batch':
+        from .batch import batch_quantities
         return batch_quantities(b_values, delta_values, mass_model, reference_speed, timings)
     if method != 'scalar':
         raise ValueError(f"method must be 'batch' or 'scalar', got {method!r}")
+    from .quantities import body_quantities
     return _body_by_body(b_values, delta_values, lambda b, d: body_quantities(
         b, d, mass_model, reference_speed, timings))
 

@@ -156,13 +156,13 @@ def _exponents(args):
 
 def _plot_names():
     """The files ``--plot DIR`` writes: one PNG per float variable of the Dataset."""
-    from .quantities import VARIABLES    # numpy/scipy only
+    from .variables import VARIABLES    # plain data
     return [f'{name}.png' for name in VARIABLES]
 
 
 def _checked(args):
     """Everything of the command line checked, nothing allocated or imported beyond numpy and
-    the names of the quantities (scipy; the spec is built only once the grid's size passed);
+    the names of the quantities (the spec is built only once the grid's size passed);
     returns (SweepSpec, format, workers).
 
     Raises _Usage, SweepError or OutputError (one line each)."""
@@ -203,7 +203,7 @@ def _checked(args):
     if fmt == 'zarr' and args.keep_parts:
         raise _Usage('--keep-parts is for a .nc output only (a .zarr store is its own resume '
                      'state)')
-    from .spec import SweepSpec     # (the names of the quantities: scipy, no Dask)
+    from .spec import SweepSpec     # (numpy and the names of the quantities, no Dask)
     spec = SweepSpec(linspace_grid('--b-over-a', *b), linspace_grid('--delta-over-a', *d),
                      args.mass_model, speed, chunk, exponents)
     if fmt == 'zarr':

@@ -19,8 +19,7 @@ import numpy as np
 import xarray as xr
 
 from ..outputs import replacing
-from .general import GENERAL_FAMILIES, GENERAL_MEANINGS
-from .quantities import FAMILIES, VARIABLES
+from .variables import FAMILIES, GENERAL_FAMILIES, GENERAL_MEANINGS, VARIABLES
 
 __all__ = ['build_dataset', 'template_dataset', 'write_netcdf', 'read_netcdf', 'read_sweep',
            'COMPUTED']

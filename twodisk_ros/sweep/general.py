@@ -38,34 +38,10 @@ import numpy as np
 
 from ..physics.motion.dynamics import RollingDynamics
 from ..physics.stability.equilibria import NEUTRAL, STABLE
+from .variables import GENERAL_FAMILIES, GENERAL_MEANINGS
 
 __all__ = ['GENERAL_FAMILIES', 'GENERAL_MEANINGS', 'superellipse_body', 'lamina_mass',
            'general_body_quantities', 'axis_inertia', 'symmetric_family']
-
-#: stable_family value → the stable equilibria, on the general path (2: both families).
-GENERAL_FAMILIES = {1: 'theta=0 and turning points', -1: 'theta=+-pi/2', 0: 'neutral',
-                    2: 'both (flat vertices)'}
-
-#: name → what the variable means on the per-body path (exponent n != 2), where it differs.
-GENERAL_MEANINGS = {
-    'stability_margin': 'exponent != 2: NaN. b^2 - 2 a^2 + 2 Delta^2 is the ellipse criterion; '
-                        'for n > 2 the vertices are flat (zero curvature) and no quadratic '
-                        'criterion exists: stable_family says which symmetric equilibria are '
-                        'stable',
-    'stable_family': 'exponent != 2: from the closed-form stability of the symmetric '
-                     'equilibria of any lamina: +1 theta = 0 and the turning points, -1 the '
-                     'side vertices (theta = +-pi/2), 2 both (flat vertices, n > 2), 0 neutral, '
-                     'NaN neither',
-    'barrier': 'exponent != 2: height_max - height_min over every equilibrium of the cycle '
-               '(the deepest well to the highest equilibrium)',
-    'oscillation_period': 'exponent != 2: the dynamics\' period about the lowest stable '
-                          'equilibrium; NaN where it has none: on a flat vertex (n > 2) V is '
-                          'not twice differentiable, the period depends on the amplitude',
-    'rollover_speed': 'exponent != 2: sqrt(2 M g barrier / I_AB), I_AB the moment of inertia '
-                      'about the contact line AB at the lowest stable equilibrium (the n = 2 '
-                      'definition without the phase rate omega_u, which vanishes at flat '
-                      'vertices)',
-}
 
 
 def superellipse_body(b_over_a, delta_over_a, exponent):

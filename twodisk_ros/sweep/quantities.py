@@ -30,54 +30,14 @@ from ..physics.motion.dynamics import RollingDynamics
 from ..physics.stability.equilibria import NEUTRAL, STABLE
 from ..physics.mass.models import mass_properties
 from .request import ELLIPSE_EXPONENT
+from .variables import FAMILIES, MASS_MODELS, VARIABLES
 
 __all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities', 'run_stages',
            'shape_failure', 'contact_length_range', 'cycle_time', 'one_line']
 
-#: name → (units, description), in the order of the output; units with a = g = M = 1.
-VARIABLES = {
-    'theta_max': ('rad', 'largest contact angle |theta| on a disk (turning point of theta)'),
-    'stability_margin': ('a^2', 'b^2 - 2 a^2 + 2 Delta^2: > 0 theta = 0 stable, < 0 '
-                                'theta = +-pi/2 stable, 0 neutral'),
-    'stable_family': ('1', 'which equilibria are stable: +1 theta = 0 and the turning points, '
-                           '-1 theta = +-pi/2, 0 neutral (height of G constant)'),
-    'height_min': ('a', 'lowest height of the centre of mass G over a cycle'),
-    'height_max': ('a', 'highest height of the centre of mass G over a cycle'),
-    'barrier': ('a', 'potential barrier per unit weight: height_max - height_min, the rise '
-                     'of G from the stable equilibrium to the highest unstable one'),
-    'rollover_speed': ('sqrt(g/a)', 'angular speed |omega| at the stable equilibrium that '
-                                    'just carries the body over the barrier: '
-                                    '1/2 m(u*) du/dt^2 = M g barrier, |omega| = |omega_u(u*)| '
-                                    'du/dt (0 when neutral)'),
-    'oscillation_period': ('sqrt(a/g)', 'period of small oscillations about the stable '
-                                        'equilibrium, 2 pi sqrt(m(u*) / V\'\'(u*)) '
-                                        '(NaN when neutral)'),
-    'cycle_advance': ('a', 'distance the body (G) advances per rolling cycle, '
-                           '|displacement.shift|'),
-    'cycle_heading': ('rad', 'turn of the heading per rolling cycle, displacement.turn '
-                             '(2 pi: the body rolls straight on average)'),
-    'cycle_time': ('sqrt(a/g)', 'duration of one cycle at the kinematic speed |omega| = 1 '
-                                'sqrt(g/a): integral of |omega_u| du over one cycle'),
-    'contact_length_min': ('a', 'shortest distance |AB| between the contact points over a '
-                                'cycle'),
-    'contact_length_max': ('a', 'longest distance |AB| between the contact points over a '
-                                'cycle'),
-    'liftoff_speed': ('sqrt(g/a)', 'kinematic angular speed |omega| above which a contact '
-                                   'lifts off (inf: never; 0: already at rest)'),
-    'mu_required': ('1', 'friction coefficient needed to roll without slipping at the '
-                         'reference kinematic speed, max over a cycle (inf above the lift-off '
-                         'speed)'),
-}
-
-#: stable_family value → the stable equilibria.
-FAMILIES = {1: 'theta=0 and turning points', -1: 'theta=+-pi/2', 0: 'neutral'}
-
 #: Stages of one body, in order; a failing stage leaves its quantities and the later ones NaN.
 STAGES = ('body', 'cycle', 'equilibria', 'cycle_time', 'contact_length', 'contact_tables',
           'liftoff_speed', 'mu_required')
-
-MASS_MODELS = ('laminae', 'solid')
-
 
 def one_line(text, limit=200):
     """``text`` on one line, at most ``limit`` characters (a ``failure`` value)."""

@@ -44,7 +44,7 @@ from .dataset import build_dataset, write_netcdf
 from .parts import PartsCache, parts_folder
 from .progress import SweepProgress
 from .chunks import timed_chunk
-from .quantities import VARIABLES
+from .variables import VARIABLES
 from .request import DEFAULT_CHUNK_SIZE, SweepError, linspace_grid, output_format, store_plan
 from .spec import SweepSpec
 

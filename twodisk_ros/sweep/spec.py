@@ -11,8 +11,9 @@ Dask task and, in a Zarr store, one chunk of every variable, so that no two task
 the same chunk (what makes the workers' parallel writes safe). Every block has the same shape
 except at the far edges of the grid (Zarr's regular chunk grid).
 
-No Dask, no xarray here (numpy, and the names of the quantities): the command line builds the
-spec and compares it with the manifest of an existing store before Dask is started.
+No Dask, no xarray, no physics here (numpy, and the names of the quantities): the command
+line builds the spec and compares it with the manifest of an existing store before Dask is
+started.
 """
 
 from dataclasses import dataclass, field
@@ -21,7 +22,7 @@ import math
 import numpy as np
 
 from .. import __version__
-from .quantities import MASS_MODELS, VARIABLES
+from .variables import MASS_MODELS, VARIABLES
 from .request import DEFAULT_CHUNK_SIZE, ELLIPSE_EXPONENT, SweepError, exponent_values
 
 __all__ = ['SweepSpec', 'MANIFEST_FORMAT', 'block_shape']

@@ -35,7 +35,7 @@ import numpy as np
 
 from .dataset import COMPUTED, template_dataset
 from .chunks import timed_chunk
-from .quantities import VARIABLES
+from .variables import VARIABLES
 from .request import STORE_MANIFEST, STORE_STATE
 
 __all__ = ['create_store', 'remove_store', 'complete_blocks', 'write_block', 'finish_store',
