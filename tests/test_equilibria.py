@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
@@ -45,8 +45,18 @@ ANGLE_ATOL = 4e-13
 #: θ-family curvature against the paper's V″(0), V″(π/2): docs ≤ 1.4e-14; measured 1.4e-14.
 THETA_CURVATURE_RTOL = 5e-14
 #: Turning-point curvature (coordinate ψ) against V″(0) (disk-swap symmetry): the code divides
-#: its spectral d²z_G/du² by (dψ/du)²; docs ≤ 7.4e-12, measured 7.4e-12.
+#: its spectral d²z_G/du² by (dψ/du)²; docs ≤ 7.4e-12, measured 7.4e-12 over 1000 random
+#: shapes. In the corner of thick-and-close bodies (b/a ≥ 12, Δ/a ≤ 0.1: docs ≤ 6e-11) more:
+#: hypothesis found 3.3e-11 at (1, 18.87, 0.0117); a scan of 3000 shapes and a grid there
+#: measured ≤ 5.9e-11, every shape above 7.4e-12 inside that corner.
 TURNING_CURVATURE_RTOL = 3e-11
+TURNING_CURVATURE_CORNER_RTOL = 1e-10
+
+
+def _turning_rtol(shape):
+    a, b, delta = shape
+    corner = b / a >= 12 and delta / a <= 0.1
+    return TURNING_CURVATURE_CORNER_RTOL if corner else TURNING_CURVATURE_RTOL
 #: d²z_G/du² (``phase_curvature``), against closed forms: V″(θ*)·(dθ/du)² at θ* = 0, ±π/2
 #: (V′ = 0 there), and z_G′(θ_max)·d²θ/du² at the turning points (dθ/du = 0 there, and z_G(θ)
 #: is smooth through θ_max); dθ/du from the phase's definition. Measured ≤ 2.6e-11.
@@ -164,7 +174,7 @@ def _check_equilibria(shape):
     for e, family in zip(found, [0, 1, None, 1, 0, 1, None, 1]):
         if family is None:
             # disk swap: the turning point in ψ is the θ = 0 equilibrium of the other disk
-            assert_allclose(e.curvature, v2[0], rtol=_rtol(shape, TURNING_CURVATURE_RTOL))
+            assert_allclose(e.curvature, v2[0], rtol=_rtol(shape, _turning_rtol(shape)))
         else:
             assert_allclose(e.curvature, v2[family], rtol=_rtol(shape, THETA_CURVATURE_RTOL))
     # d²z_G/du²: V″·(dθ/du)² with dθ/du = (dθ/dη)(dη/du), dθ/dη = b/a at θ = 0 and a/b at
@@ -194,6 +204,7 @@ def test_equilibria_named(shape):
 
 @settings(max_examples=40, deadline=None)
 @given(SHAPES)
+@example((1.0, 2.9375, 0.01171875))   # b/a = e^2.9375 = 18.87: found by hypothesis (the corner)
 def test_equilibria_across_shapes(drawn):
     shape = _shape(drawn)
     margin = shape[1] ** 2 - 2 * shape[0] ** 2 + 2 * shape[2] ** 2

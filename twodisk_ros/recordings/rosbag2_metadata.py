@@ -48,9 +48,17 @@ def _scalar(value):
     if isinstance(value, int):
         return str(value)
     text = str(value)
-    if _PLAIN.fullmatch(text) and not text.endswith(' ') and yaml.safe_load(text) == text:
+    if _PLAIN.fullmatch(text) and not text.endswith(' ') and _reads_back(text):
         return text
     return _quoted(text)
+
+
+def _reads_back(text):
+    """True if ``text`` written plain is read as the same string (``...`` ends a document)."""
+    try:
+        return yaml.safe_load(text) == text
+    except yaml.YAMLError:
+        return False
 
 
 def _lines(value, indent):
