@@ -1,4 +1,4 @@
-"""Motions of any RollingBody (physics/motion/sundman.py) against the ellipse's own motions.
+"""Motions of any RollingBody (physics/motion/integrate.py, closed_forms.py) against the ellipse's own motions.
 
 The reference body is an ellipse seen through another phase (tests/reparametrised_body.py),
 smooth or degenerate (the body does not turn in u at v = 0, π: m = 0, u̇ infinite there). Its

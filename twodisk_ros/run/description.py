@@ -145,13 +145,13 @@ class RunDescription:
 
     def stream(self):
         """A new :class:`~twodisk_ros.physics.motion.simulate.MotionStream` of the run from t = 0
-        (started from w0 for any body but the ellipse, as :func:`~twodisk_ros.physics.simulate`
-        does: u̇0 is infinite where the body does not turn in u)."""
+        (started from w0, as :func:`~twodisk_ros.physics.simulate` does: u̇0 is infinite where
+        the body does not turn in u)."""
         s = self.settings
         start = self.start()
-        speed = start.angular_speed if self.dynamics.general else None
         return MotionStream(self.dynamics, start.phase, start.phase_rate, mode=s.mode,
-                            method=s.method, tolerance=s.tolerance, angular_speed=speed)
+                            method=s.method, tolerance=s.tolerance,
+                            angular_speed=start.angular_speed)
 
     def metadata(self):
         """{key: text}: the recording's ``twodisk_ros`` metadata of the run.

@@ -121,8 +121,8 @@ class SceneMotion:
         The drive in force and its command (:func:`scene_of`; None: none yet).
     start : PhaseState
         (u (rad), u̇ (rad/s), w (rad/s)) at the stretch's t = 0
-        (:class:`~twodisk_ros.physics.motion.dynamics.PhaseState`; a body other than the ellipse
-        starts from w, finite also where it stops turning in u).
+        (:class:`~twodisk_ros.physics.motion.dynamics.PhaseState`; the stretch starts from w,
+        finite also where the body stops turning in u).
     carry : (float, float, float), optional
         (W, W_d, E₀) (J) at the stretch's start: the work done before it and the energy
         balance's constant; None for the start of a run.
@@ -133,7 +133,6 @@ class SceneMotion:
     def __init__(self, dynamics, settings, model, *, drive=None, command=None, start,
                  carry=None, terms=None):
         u0, u_dot0, speed = (float(x) for x in start)
-        general = dynamics.general
         self.scene = scene = scene_of(settings, drive, command, speed)
         if terms is None or (terms.scene.slope, terms.scene.heading0) != (scene.slope,
                                                                           scene.heading0):
@@ -142,16 +141,14 @@ class SceneMotion:
             terms = copy(terms)
             terms.scene = scene
         self.terms = terms
-        regular = speed if general else None      # the ellipse: the state (u, u̇)
         if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
             self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance,
-                                      angular_speed=regular)
+                                      angular_speed=speed)
         else:
             self.stream = scene_stream(dynamics, scene, u0, u_dot0, method=settings.method,
                                        tolerance=settings.tolerance, terms=terms,
-                                       angular_speed=regular)
-        energy = float(terms.energy_turning(u0, speed) if general
-                       else terms.energy(u0, u_dot0))
+                                       angular_speed=speed)
+        energy = float(terms.energy_turning(u0, speed))
         self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x) for x in carry)
         self.energy0 = self.carry[2]
         self.standing = (True, '')
@@ -169,21 +166,10 @@ class SceneMotion:
         the angular speed about AB (rad/s), finite also where the body stops turning in u."""
         t = np.asarray(t, dtype=float)
         w0, wd0, _ = self.carry
-        if hasattr(self.stream, 'samples'):
-            s = self.stream.samples(t)
-            u, u_dot, u_ddot, speed = (s.phase, s.phase_rate, s.phase_acceleration,
-                                       s.rolling_speed)
-            values = SceneValues(s.energy, s.dissipated + w0, s.drive_work + wd0,
-                                 s.drive_torque, s.power)
-        else:         # the plain MotionStream (flat, free, conservative from here on)
-            u, u_dot, speed = self.stream.sample_with_speed(t)
-            m, v, dm, dv = np.moveaxis(self.terms.energy_jet(u)[..., :4], -1, 0)
-            with np.errstate(divide='ignore', invalid='ignore'):
-                u_ddot = -(0.5 * dm * u_dot**2 + dv) / m
-            energy = (self.terms.energy_turning(u, speed) if self.terms.dynamics.general
-                      else 0.5 * m * u_dot**2 + v)
-            zero = np.zeros(t.shape)
-            values = SceneValues(energy, zero + w0, zero + wd0, zero, zero)
+        s = self.stream.samples(t)
+        u, u_dot, u_ddot, speed = s.phase, s.phase_rate, s.phase_acceleration, s.rolling_speed
+        values = SceneValues(s.energy, s.dissipated + w0, s.drive_work + wd0, s.drive_torque,
+                             s.power)
         return u, u_dot, u_ddot, speed, values, self.terms.poses(u)
 
     def forces(self, u, u_dot, u_ddot, speed=None):
@@ -270,13 +256,9 @@ class FlatMotion:
         return self.stream.solver
 
     def sample(self, t):
-        """(u, u̇, None, w or None, None, (G, A, B, q)) at times t (s, increasing), as
-        :meth:`SceneMotion.sample`: no ü or scene values; w (rad/s) for a body other than the
-        ellipse (finite where u̇ is not), None for the ellipse (|ω_u| u̇, read where needed)."""
-        if self.dynamics.general:
-            u, u_dot, speed = self.stream.sample_with_speed(t)
-        else:
-            (u, u_dot), speed = self.stream.sample(t), None
+        """(u, u̇, None, w, None, (G, A, B, q)) at times t (s, increasing), as
+        :meth:`SceneMotion.sample`: no ü or scene values; w (rad/s) finite where u̇ is not."""
+        u, u_dot, speed = self.stream.sample_with_speed(t)
         poses = self.dynamics.cycle.poses(u)
         return (u, u_dot, None, speed, None,
                 (poses.position_g, poses.contact_a, poses.contact_b, poses.quaternion))
@@ -287,9 +269,7 @@ class FlatMotion:
     def forces(self, u, u_dot, u_ddot, speed):
         """The contact forces (:class:`~twodisk_ros.physics.forces.contact.ContactForces`)
         at the states of :meth:`sample`: the motor's at the constant |omega0| in kinematic
-        mode, else the free motion's from (u, u̇) (the ellipse) or (u, w)."""
+        mode, else the free motion's from (u, w), finite also where u̇ is not."""
         if self.kinematic:
             return self.model.kinematic(u, self.angular_speed0)
-        if speed is None:
-            return self.model.dynamic(u, u_dot)
         return self.model.dynamic(u, angular_speed=speed)

@@ -256,21 +256,15 @@ class Simulation:
         return 'energy', energy, abs(energy - self.energy0) / self.dynamics.energy_scale
 
     def angular_speed(self, sample, i):
-        """w (rad/s, signed as u̇) at sample i: the angular speed about AB (the ellipse's
-        samples carry none: |ω_u| u̇ there, |ω_u| > 0 everywhere)."""
-        if sample.angular_speed is None:
-            return (float(self.dynamics.angular_speed_per_phase(sample.phase[i]))
-                    * float(sample.phase_rate[i]))
+        """w (rad/s, signed as u̇) at sample i: the angular speed about AB."""
         return float(sample.angular_speed[i])
 
     def energy(self, sample, i):
-        """E (J) at sample i: ½ m u̇² + V for the ellipse, ½ J w² + V for any other body (the
-        regular chart: finite and exact also where it stops turning in u)."""
+        """E (J) at sample i: ½ J w² + V (the regular chart: finite and exact also where the
+        body stops turning in u)."""
         if sample.scene is not None:
             return float(sample.scene.energy[i])
-        if self.dynamics.general:
-            return float(self.dynamics.energy_turning(sample.phase[i], sample.angular_speed[i]))
-        return float(self.dynamics.energy(sample.phase[i], sample.phase_rate[i]))
+        return float(self.dynamics.energy_turning(sample.phase[i], sample.angular_speed[i]))
 
     def rotation(self, sample, i):
         """R body → world (3 × 3) at sample i, from its quaternion."""

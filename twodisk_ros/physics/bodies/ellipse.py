@@ -315,6 +315,10 @@ class EllipseBody(EllipseForms, RollingBody):
     0.75
     """
 
+    #: RollingBody: |ω_u| > 0 at every phase (an ellipse has no flat vertex: its curvature is
+    #: at least min(a, b)/max(a, b)² > 0, so the body turns as the contacts move)
+    turns_everywhere = True
+
     def __init__(self, a, b, delta):
         a = _check_parameter('a', a, 0.0, math.inf, '> 0 (metres)')
         b = _check_parameter('b', b, 0.0, math.inf, '> 0 (metres)')

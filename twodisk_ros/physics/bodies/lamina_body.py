@@ -313,6 +313,12 @@ class LaminaBody(RollingBody):
         base = np.where(theta < 0, -1.0, 1.0) * np.arctan2(p, q)
         return np.where(branch > 0, base, np.pi - base)
 
+    @property
+    def turns_everywhere(self):
+        """RollingBody: True if no contact ever sits on a flat vertex of the lamina, the only
+        phases where the body stops turning in u (:meth:`flat_vertex_phases` is empty)."""
+        return not len(self.flat_vertex_phases())
+
     def flat_vertex_phases(self):
         """The phases u ∈ [0, 2π) (rad, sorted) where a contact sits on a flat vertex of its
         lamina (zero curvature: a superellipse's four vertices for n > 2), exact to rounding.

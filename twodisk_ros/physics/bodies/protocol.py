@@ -123,6 +123,11 @@ class RollingBody(abc.ABC):
     def contact_angle_psi(self, theta, branch=1):
         """ψ(θ) (rad) on a branch."""
 
+    #: True if the body turns in u at every phase (|ω_u| > 0 over the whole cycle), so that u
+    #: is a regular chart of every motion (physics/motion/integrate.py). False unless the body
+    #: knows it (a body that may stop turning is stepped in the regularised time).
+    turns_everywhere = False
+
     def flat_vertex_phases(self):
         """The phases u ∈ [0, 2π) (rad, sorted) where a contact sits on a flat vertex of the
         lamina (zero curvature): the body does not turn there (|ω_u| = 0) and z_G is flat to

@@ -21,7 +21,6 @@ import numpy as np
 from ..numerics.analytic import complex_step
 from ..bodies.cycle import RollingCycle, TWO_PI
 from ..stability.equilibria import equilibria, NEUTRAL, STABLE
-from ..bodies.ellipse import EllipseBody
 from ..mass.models import MassProperties
 from ..bodies.protocol import check_rolling_body
 from ..numerics.spectral import spectral_derivative
@@ -77,8 +76,6 @@ class RollingDynamics:
         self.mass = mass_properties
         self.gravity = gravity
         self.cycle = cycle if cycle is not None else RollingCycle(body)
-        #: True for any body but the ellipse (whose closed forms keep the (u, u̇) path)
-        self._general = not isinstance(body, EllipseBody)
         self._feature_width = body.feature_width
         self._build_tables(4 * self.cycle.resolution)
         self._equilibria = None
@@ -148,6 +145,8 @@ class RollingDynamics:
         self._potential = HermiteTable.periodic(v, dv, second[:, 1])
         self.table_size = n
         self.potential_range = (float(v.min()), float(v.max()))
+        #: max |ω_u| over the table's nodes (rad per rad of u)
+        self.peak_turn_rate = float(w.max())
 
     def tabulated_inertia(self, u, derivative=0):
         """J(u) (kg m², :meth:`contact_line_inertia`) or J′(u) from a periodic table (built on
@@ -168,18 +167,9 @@ class RollingDynamics:
                         -1, 0)
         return j[2], (j[0] - 8 * j[1] + 8 * j[3] - j[4]) / (12 * h)
 
-    @property
-    def general(self):
-        """True for any body but the ellipse: the motion is integrated in the regularised
-        time of :class:`~twodisk_ros.physics.motion.solvers.SundmanSolution` where no closed form
-        applies, and wells about an equilibrium where the body does not turn in u have none."""
-        return self._general
-
     def regular_centre(self, u_star):
         """False if the body does not turn in u at the equilibrium u* (|ω_u| = 0) or z_G is
         not quadratic there: no libration model in u (the ODE in τ is used instead)."""
-        if not self._general:
-            return True
         for eq, _ in self.equilibria_with_periods():
             if abs(math.remainder(u_star - eq.phase, TWO_PI)) < 1e-9:
                 return eq.order == 2.0 and eq.phase_curvature != 0.0
@@ -209,9 +199,9 @@ class RollingDynamics:
     def equilibria_with_periods(self):
         """[(Equilibrium, small-oscillation period in s or None)] for all the equilibria.
 
-        T = 2π √(m(u*) / V″(u*)) at the stable ones (coordinate-free: both in u); for a body
-        other than the ellipse T = 2π √(J(u*) / (M g d²z_G/dγ²)) in the body's turn γ
-        (:meth:`contact_line_inertia`), which holds also where the body does not turn in u
+        T = 2π √(J(u*) / (M g d²z_G/dγ²)) at the stable ones, in the body's turn γ about AB
+        (:meth:`contact_line_inertia`): the same as 2π √(m(u*) / V″(u*)) in u where the body
+        turns in u (m = J |ω_u|², V″ = M g |ω_u|² d²z_G/dγ²), and it holds also where it does not
         (m = V″ = 0 there). None where z_G − z* ~ |γ|^q with q < 2 (a flat vertex): the
         period then depends on the amplitude (docs/physics.md#equilibria-of-any-body).
         Computed once per dynamics object.
@@ -220,16 +210,10 @@ class RollingDynamics:
             result = []
             for eq in equilibria(self.body):
                 period = None
-                if self._general:
-                    stiffness = self.mass.mass * self.gravity * eq.gamma_curvature
-                    if eq.has_linear_period and stiffness > 0:
-                        period = TWO_PI * math.sqrt(
-                            float(self.contact_line_inertia(eq.phase)) / stiffness)
-                else:
-                    stiffness = self.mass.mass * self.gravity * eq.phase_curvature
-                    if eq.stability == STABLE and stiffness > 0:
-                        period = TWO_PI * math.sqrt(float(self.effective_mass(eq.phase))
-                                                    / stiffness)
+                stiffness = self.mass.mass * self.gravity * eq.gamma_curvature
+                if eq.has_linear_period and stiffness > 0:
+                    period = TWO_PI * math.sqrt(
+                        float(self.contact_line_inertia(eq.phase)) / stiffness)
                 result.append((eq, period))
             self._equilibria = result
         return list(self._equilibria)

@@ -347,6 +347,35 @@ class SceneStream:
         return np.where(w != 0, np.sign(w), held)
 
 
+class FreeSceneStream(MotionStream):
+    """The flat, free, conservative scene's motion: the level ground's
+    :class:`~twodisk_ros.physics.motion.simulate.MotionStream` (its closed forms, or DOP853 in
+    t or τ), sampled also as a scene (:meth:`samples`, as :class:`SceneStream`)."""
+
+    rest_time = math.nan
+
+    def __init__(self, dynamics, scene, u0, u_dot0, *, terms=None, **kwargs):
+        super().__init__(dynamics, u0, u_dot0, mode='dynamic', **kwargs)
+        self.scene, self._terms = scene, terms
+
+    @property
+    def terms(self):
+        """The scene's :class:`~twodisk_ros.physics.scenes.terms.SceneTerms` (built on first
+        use: :meth:`sample` does not need them)."""
+        if self._terms is None:
+            self._terms = SceneTerms(self.dynamics, self.scene)
+        return self._terms
+
+    def samples(self, t):
+        """:class:`SceneSamples` at times t (s, increasing, not before earlier calls)."""
+        t = np.asarray(t, dtype=float)
+        u, _, w = self.sample_with_speed(t)
+        jet = self.terms.energy_jet(u)
+        w_tau = -(0.5 * jet[..., 8] * w**2 + jet[..., 3]) / jet[..., 7]
+        zero = np.zeros(t.shape)
+        return samples_from(self.terms, t, u, w, w_tau, jet[..., 4], zero, zero, zero)
+
+
 class ClosedSceneStream:
     """The motion of a conservative scene in closed form (:mod:`~twodisk_ros.physics.
     scenes.closed`): ``sample``/``samples`` as :class:`SceneStream`, no time stepping."""
@@ -408,7 +437,8 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
     ``angular_speed`` w0 = |ω_u(u0)| u̇0 (rad/s) replaces u̇0 if given: the one form of the
     start where the body stops turning in u (u̇0 infinite).
 
-    * flat, free, conservative (``Scene()``): the plain dynamic MotionStream, bit for bit;
+    * flat, free, conservative (``Scene()``): the level ground's dynamic MotionStream, bit
+      for bit, with the scene's samples (:class:`FreeSceneStream`);
     * speed drive whose command equals the initial speed (Ω₀ = w0, to 1e-12): the
       motion is the plain kinematic MotionStream on any slope and with any dissipation (u(t)
       is then kinematic; only the drive torque depends on the scene);
@@ -422,12 +452,9 @@ def scene_stream(dynamics, scene, u0, u_dot0, *, method='table', tolerance=1e-10
     rate0 = float(dynamics.angular_speed_per_phase(u0))
     omega0 = float(angular_speed) if angular_speed is not None else float(u_dot0) * rate0
     if angular_speed is not None:
-        if dynamics.general:
-            kwargs['angular_speed'] = omega0
-        else:                   # the ellipse turns everywhere: the state (u, u̇)
-            u_dot0 = omega0 / rate0
+        kwargs['angular_speed'] = omega0
     if scene.flat_free:
-        return MotionStream(dynamics, u0, u_dot0, mode='dynamic', **kwargs)
+        return FreeSceneStream(dynamics, scene, u0, u_dot0, terms=terms, **kwargs)
     if scene.drive == 'speed':
         if abs(omega0 - scene.command) <= 1e-12 * max(abs(omega0), abs(scene.command)) \
                 and omega0 != 0:

@@ -194,11 +194,14 @@ def _ellipse_equilibria(body, neutral_tolerance):
             theta = float(geo.theta)
             curvature = float(body.height_second_derivative(theta))
             phase_curv = curvature * float(body.phase_angles_with_rates(u)[2]) ** 2
+        # the body turns in u everywhere (|ω_u| > 0): d²z_G/dγ² = (d²z_G/du²) / |ω_u|²
+        rate = float(np.linalg.norm(body.phase_angular_velocity(u)))
         found.append(Equilibrium(
             name=f'{label} (branch {branch:+d})', phase=u, theta=float(geo.theta),
             psi=float(geo.psi), branch=branch, height=float(geo.height), coordinate=coordinate,
             curvature=curvature, phase_curvature=phase_curv,
-            stability=_classify(curvature, neutral)))
+            stability=_classify(curvature, neutral), gamma_curvature=phase_curv / rate**2,
+            rotation_rate=rate))
     return found
 
 
