@@ -170,6 +170,13 @@ class RollingBody(abc.ABC):
         (:meth:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody.about`)."""
         return 0.0
 
+    def centred_on(self, center_of_mass):
+        """(body, centre of mass from its origin): the body whose origin is ``center_of_mass``
+        (m, body frame, from this body's origin) when it can move there. Here the body itself
+        and the centre of mass as given: a body whose origin is its centre of mass by its
+        symmetries (the ellipses' G, to rounding); LaminaBody moves (``about``)."""
+        return self, center_of_mass
+
     def resolution_cause(self):
         """What sets the resolution of the body's tables, for the start-up notice of an
         extreme body (:mod:`~twodisk_ros.physics.motion.startup`): its feature width."""

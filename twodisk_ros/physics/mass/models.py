@@ -41,6 +41,7 @@ import weakref
 import numpy as np
 
 from ..bodies.contact_solver import ARRANGEMENTS
+from ..bodies.protocol import check_rolling_body
 from .hull import unit_hull_moments
 from .hull_laminae import general_hull_moments
 from ..laminae.shapes import Ellipse, Lamina
@@ -404,12 +405,13 @@ def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
 def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
     """(body, mass properties) whose body-frame origin is the centre of mass.
 
-    For a :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` the body is moved by the
-    centre of mass's e2 coordinate (``body.about``, sharing its tables) and the returned
-    centre of mass is exactly zero (its e1 and e3 parts vanish by the mirror symmetries;
-    more than 1e-12 of the size there is refused). Any other body (the ellipse's
-    EllipseBody, centre of mass at G by its symmetries) is returned as it is, with its
-    properties. Arguments as in :func:`mass_properties_of`.
+    The body decides (``body.centred_on``): a
+    :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` is moved by the centre of
+    mass's e2 coordinate (``body.about``, sharing its tables) and the returned centre of mass
+    is exactly zero (its e1 and e3 parts vanish by the mirror symmetries; more than 1e-12 of
+    the size there is refused); the ellipse's EllipseBody, centre of mass at G by its
+    symmetries, is returned as it is, with its properties. ``body``: a RollingBody; other
+    arguments as in :func:`mass_properties_of`.
 
     Returns
     -------
@@ -417,13 +419,8 @@ def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
         Ready for :class:`~twodisk_ros.physics.motion.dynamics.RollingDynamics`.
     """
     props = mass_properties_of(model, body, mass, principal_moments, rtol)
-    com = props.center_of_mass
-    if not hasattr(body, 'about'):
-        return body, props
-    if max(abs(com[0]), abs(com[2])) > 1e-12 * body.size:
-        raise ValueError(f'the centre of mass {com.tolist()} m is off the common axis e2: '
-                         'the body cannot be moved onto it along e2')
-    return body.about(float(com[1])), dataclasses.replace(props, center_of_mass=np.zeros(3))
+    body, com = check_rolling_body(body).centred_on(props.center_of_mass)
+    return body, dataclasses.replace(props, center_of_mass=com)
 
 
 def _properties_of(model, body, mass, principal_moments, rtol):
