@@ -184,7 +184,6 @@ SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'sol', 'candidate'}
 KNOWN_SWITCHES = sorted([
     ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's plates: closed-form rims
     ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's hull: its contact traces
-    ('physics/mass/models.py', "type() ['Ellipse']"),      # the ellipse's closed-form mass models
     ('physics/motion/dynamics.py', "isinstance ['EllipseBody']"),   # (u, u̇) or (u, w)
     ('physics/stability/equilibria.py', "isinstance ['EllipseBody']"),  # closed-form roots
     ('run/scene_simulation.py', 'hasattr(stream, samples)'),       # MotionStream or a scene's
