@@ -182,8 +182,6 @@ SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'sol', 'candidate'}
 #: The switches still in the package, each (module, what): the aim is none. Removing one
 #: shrinks this list; adding one fails the test.
 KNOWN_SWITCHES = sorted([
-    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's plates: closed-form rims
-    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's hull: its contact traces
     ('physics/motion/dynamics.py', "isinstance ['EllipseBody']"),   # (u, u̇) or (u, w)
     ('physics/stability/equilibria.py', "isinstance ['EllipseBody']"),  # closed-form roots
     ('run/scene_simulation.py', 'hasattr(stream, samples)'),       # MotionStream or a scene's

@@ -12,7 +12,7 @@ x axis along the common axis pointing away from G, towards the disk's far tip (w
 θ = 0, resp. ψ = 0); y completes the right-handed frame. The contact angle of the disk is
 the polar angle from x towards y. For ellipses the rim is x²/a² + y²/b² = 1, z = 0, on both
 disks, so the contact point is ρ (cos ∠, sin ∠, 0) with ρ = ab/D(∠); for any lamina
-(:mod:`~twodisk_ros.model.outline`) disk 1's lamina point (x, y) is (−y, x, 0) in its frame
+(:mod:`~twodisk_ros.physics.bodies.outline`) disk 1's lamina point (x, y) is (−y, x, 0) in its frame
 and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
 
 ``{body_frame}_disk_a`` — disk 1, which carries the contact point A (angle θ):
@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from .outline import DEFAULT_TOLERANCE, body_shape, frame_rims
+from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE, body_shape, frame_rims
 
 __all__ = ['DiskFrame', 'disk_frames', 'disk_rims', 'check_frame_id', 'DISK_SUFFIXES']
 
@@ -103,7 +103,7 @@ def disk_frames(body, body_frame='twodisk_body'):
     Parameters
     ----------
     body : EllipseBody, LaminaBody or ContactSolver
-        Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.model.outline.body_shape`).
+        Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.physics.bodies.outline.body_shape`).
     body_frame : str
         The parent frame's name (see :func:`check_frame_id`).
 

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contact_solver import ContactSolver
+from .rulings import Drawable
 
 __all__ = ['PhaseGeometry', 'RollingBody', 'check_rolling_body']
 
@@ -56,7 +57,7 @@ class PhaseGeometry:
     tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
 
-class RollingBody(abc.ABC):
+class RollingBody(Drawable, abc.ABC):
     """A rigid body of two congruent laminae in perpendicular planes rolling on a plane.
 
     Attributes (read-only)

@@ -33,11 +33,12 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.contact_solver import ARRANGEMENTS
 
-__all__ = ['BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
+__all__ = ['ARRANGEMENTS', 'BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
            'frame_rims', 'lamina_outline', 'resolution_tolerance']
 
+#: Disk 2's orientation: σ, the sign of its lamina y along e2 (bodies/contact_solver.py).
+ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
 #: Default polygon error of a drawn outline, as a fraction of the lamina's size: below a
 #: pixel for a body 500 pixels wide; a circle gets 64 vertices (error 1.2e-3), as the
 #: markers had before.
