@@ -125,7 +125,7 @@ def disk_frames(body, body_frame='twodisk_body'):
     return tuple(frames)
 
 
-def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
+def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True):
     """Both rims in the body frame (m, from the body's origin G or P): (rim of disk 1, rim of disk 2), arrays
     (N + 1, 3) with the last point the first (``closed``) or (N, 3).
 
@@ -133,7 +133,7 @@ def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
     disk 1, +e2 for disk 2) and reaches the near tip at index N/2.
     """
     rims = []
-    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance, outline)):
+    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance)):
         local = np.zeros((len(rim), 3))
         local[:, :2] = rim
         points = local @ frame.axes.T + frame.translation

@@ -391,9 +391,8 @@ class EllipseBody(EllipseForms, RollingBody):
     # -- drawing (model/mesh.py): closed forms -----------------------------------------------
     def plate_rims(self, resolution):
         """Both rims at the eccentric anomalies 2πk/n, (a cos, b sin), exact on the axes."""
-        angle = 2 * np.pi * np.arange(resolution) / resolution
-        rim = np.stack([self.a * np.cos(angle), self.b * np.sin(angle)], axis=-1)
-        a, b = self.a, self.b
+        a, b, angle = self.a, self.b, 2 * np.pi * np.arange(resolution) / resolution
+        rim = np.stack([a * np.cos(angle), b * np.sin(angle)], axis=-1)
         rim[np.arange(0, resolution, resolution // 4)] = [[a, 0.0], [0.0, b], [-a, 0.0], [0.0, -b]]
         return rim, rim
 

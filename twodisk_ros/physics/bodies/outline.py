@@ -137,12 +137,12 @@ def body_shape(body):
                      centroid)
 
 
-def frame_rims(body, tolerance=DEFAULT_TOLERANCE, outline=None):
+def frame_rims(body, tolerance=DEFAULT_TOLERANCE):
     """The two rims in their disk frames (frames.py): arrays (N, 2) (m), counterclockwise
     about the frame's z (so a fan (centre, p_k, p_k+1) faces +z), each starting at the
-    disk's far tip (frame x > 0). ``outline``: the lamina polygon, if already sampled."""
+    disk's far tip (frame x > 0)."""
     shape = body_shape(body)
-    points = lamina_outline(shape.lamina, tolerance) if outline is None else outline
+    points = lamina_outline(shape.lamina, tolerance)
     x, y = points[:, 0], points[:, 1]
     # disk 1: (−y, x) turns the lamina by +90°: counterclockwise, starting at the tip −y
     rim_1 = np.stack([-y, x], axis=-1)

@@ -172,10 +172,8 @@ class RollingBody(Drawable, abc.ABC):
         return 0.0
 
     def centred_on(self, center_of_mass):
-        """(body, centre of mass from its origin): the body whose origin is ``center_of_mass``
-        (m, body frame, from this body's origin) when it can move there. Here the body itself
-        and the centre of mass as given: a body whose origin is its centre of mass by its
-        symmetries (the ellipses' G, to rounding); LaminaBody moves (``about``)."""
+        """(body, centre of mass (m) from its origin) for ``center_of_mass`` from this one's:
+        here itself, G being the centre of mass by symmetry (ellipses); LaminaBody moves."""
         return self, center_of_mass
 
     def resolution_cause(self):

@@ -44,14 +44,12 @@ class Drawable:
     geometry; EllipseBody gives both in closed form."""
 
     def plate_rims(self, resolution):
-        """The rims of the mesh's plates at a resolution n (a multiple of 4): (disk 1,
-        disk 2), arrays (N, 2) (m) in their disk frames (:func:`.outline.frame_rims`): the
-        outline polygon whose error is a regular n-gon's (1 − cos(π/n) of the size)."""
+        """The plates' rims at a resolution n, (disk 1, disk 2) (N, 2) in the disk frames (m):
+        the outline polygon of a regular n-gon's error (:func:`.outline.frame_rims`)."""
         return frame_rims(self, resolution_tolerance(resolution))
 
     def hull_surface(self, resolution):
-        """(vertices (k, 3) (m, body frame), faces (f, 3)): the solid hull's closed surface
-        at a resolution n, wound outward: strips between the rulings (:func:`ruled_hull`)."""
+        """The hull's closed surface at a resolution n: :func:`ruled_hull`."""
         return ruled_hull(self, resolution)
 
 

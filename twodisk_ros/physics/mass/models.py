@@ -255,25 +255,30 @@ def mass_properties(model, a, b, delta, mass, principal_moments=None, rtol=1e-9)
     RuntimeError
         If ``'solid'`` cannot reach ``rtol``.
     """
+    _check_model(model)
+    a, b, d = _geometry(a, b, delta)
+    return _by_model(model, mass, principal_moments, lambda: laminae(a, b, d, mass),
+                     lambda: solid_hull(a, b, d, mass, rtol=rtol))
+
+
+def _check_model(model):
     if not isinstance(model, str) or model not in MODELS:
         allowed = ', '.join(repr(name) for name in MODELS)
         raise ValueError(f'model must be one of {allowed}, got {one_line(model)}')
-    a, b, d = _geometry(a, b, delta)
+
+
+def _by_model(model, mass, principal_moments, laminae_model, solid_model):
+    """``model``'s MassProperties once ``principal_moments`` fits it (given for 'custom'
+    only): :func:`custom`, or the call of ``laminae_model`` or ``solid_model``."""
     if model == 'custom':
         if principal_moments is None:
-            raise ValueError(
-                "principal_moments must be given (I1, I2, I3) in kg m**2 for model 'custom', "
-                'got None'
-            )
+            raise ValueError("principal_moments must be given (I1, I2, I3) in kg m**2 for "
+                             "model 'custom', got None")
         return custom(mass, principal_moments)
     if principal_moments is not None:
-        raise ValueError(
-            f"principal_moments must be None unless model is 'custom', got "
-            f'{one_line(principal_moments)} for model {model!r}'
-        )
-    if model == 'laminae':
-        return laminae(a, b, d, mass)
-    return solid_hull(a, b, d, mass, rtol=rtol)
+        raise ValueError(f"principal_moments must be None unless model is 'custom', got "
+                         f'{one_line(principal_moments)} for model {model!r}')
+    return laminae_model() if model == 'laminae' else solid_model()
 
 
 # --------------------------------------------------------------------------- any lamina
@@ -407,13 +412,9 @@ def mass_properties_of(model, body, mass, principal_moments=None, rtol=1e-9):
 def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
     """(body, mass properties) whose body-frame origin is the centre of mass.
 
-    The body decides (``body.centred_on``): a
-    :class:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody` is moved by the centre of
-    mass's e2 coordinate (``body.about``, sharing its tables) and the returned centre of mass
-    is exactly zero (its e1 and e3 parts vanish by the mirror symmetries; more than 1e-12 of
-    the size there is refused); the ellipse's EllipseBody, centre of mass at G by its
-    symmetries, is returned as it is, with its properties. ``body``: a RollingBody; other
-    arguments as in :func:`mass_properties_of`.
+    The body decides (``body.centred_on``): a LaminaBody is moved onto it (``about``; its
+    centre of mass is then exactly zero), an EllipseBody (G by symmetry) returned as it is.
+    ``body``: a RollingBody; other arguments as in :func:`mass_properties_of`.
 
     Returns
     -------
@@ -427,23 +428,13 @@ def centred_on_mass(model, body, mass, principal_moments=None, rtol=1e-9):
 
 def _properties_of(model, body, mass, principal_moments, rtol):
     """:func:`mass_properties_of` about G."""
-    if not isinstance(model, str) or model not in MODELS:
-        allowed = ', '.join(repr(name) for name in MODELS)
-        raise ValueError(f'model must be one of {allowed}, got {one_line(model)}')
+    _check_model(model)
     try:
         lamina, delta, arrangement = body.lamina, body.delta, body.arrangement
     except AttributeError:
         raise ValueError(f'body must be a rolling body with lamina, delta and arrangement '
                          f'(EllipseBody, LaminaBody), got {type(body).__name__}') from None
     _shape(lamina, delta, arrangement)
-    if model == 'custom':
-        if principal_moments is None:
-            raise ValueError("principal_moments must be given (I1, I2, I3) in kg m**2 for "
-                             "model 'custom', got None")
-        return custom(mass, principal_moments)
-    if principal_moments is not None:
-        raise ValueError(f"principal_moments must be None unless model is 'custom', got "
-                         f'{one_line(principal_moments)} for model {model!r}')
-    if model == 'laminae':
-        return laminae_of(lamina, delta, arrangement, mass)
-    return solid_of(lamina, delta, arrangement, mass, rtol=rtol)
+    return _by_model(model, mass, principal_moments,
+                     lambda: laminae_of(lamina, delta, arrangement, mass),
+                     lambda: solid_of(lamina, delta, arrangement, mass, rtol=rtol))
