@@ -182,10 +182,6 @@ SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'sol', 'candidate'}
 #: The switches still in the package, each (module, what): the aim is none. Removing one
 #: shrinks this list; adding one fails the test.
 KNOWN_SWITCHES = sorted([
-    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's plates: closed-form rims
-    ('model/mesh.py', "isinstance ['EllipseBody']"),       # an ellipse's hull: its contact traces
-    ('physics/mass/models.py', "type() ['Ellipse']"),      # the ellipse's closed-form mass models
-    ('physics/mass/models.py', 'hasattr(body, about)'),    # only a LaminaBody moves onto its mass
     ('physics/stability/equilibria.py', "isinstance ['EllipseBody']"),  # closed-form roots
 ])
 

@@ -15,7 +15,7 @@ from rounding import ulps
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.mesh import mesh_parts
 from twodisk_ros.model.frames import disk_rims
-from twodisk_ros.model.outline import DEFAULT_TOLERANCE
+from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE
 from twodisk_ros.physics.bodies.contact_solver import ContactSolver
 from twodisk_ros.physics.laminae.shapes import Superellipse
 from twodisk_ros.physics.laminae.support import Egg

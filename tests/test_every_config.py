@@ -142,7 +142,7 @@ def test_recorded_shapes_are_drawn_touching_the_ground(recordings, name, params)
     """At every recorded sample both drawn rims reach the ground and none goes below it, to
     the rims' polygon error: the recorded pose (of the body's origin: the solid egg's centre
     of mass, 2.7e-3 m off its laminae's centroid) places the laminae where they roll."""
-    from twodisk_ros.model.outline import DEFAULT_TOLERANCE
+    from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE
     from twodisk_ros.runs import recorded_run
     run = recorded_run(recordings(name, *params))
     assert run.settings.shape == ('superellipse' if name == 'rounded_square' else 'egg')

@@ -1,14 +1,14 @@
-"""Drawing any lamina (model/outline.py, model/rulings.py and their users) against references.
+"""Drawing any lamina (physics/bodies/outline.py, physics/bodies/rulings.py and their users) against references.
 
 Independent references: the laminae's own definitions (the superellipse's implicit equation
 |x/b|ⁿ + |y/a|ⁿ = 1, the support function h of laminae/shapes.py, evaluated on a dense circle of
 directions); the placement of the laminae written out here from bodies/contact_solver.py's docstring
 (disk 1's point (x, y) at (x, y − Δ, 0) − G, disk 2's at (0, Δ + σy, x) − G); trimesh (a
 second library) for closedness, winding and volume; scipy.spatial.ConvexHull of densely
-sampled rims (20 001 points of lamina.point per rim, not model/outline.py's polygon: 1e-7
+sampled rims (20 001 points of lamina.point per rim, not physics/bodies/outline.py's polygon: 1e-7
 relative in volume) for the hull's volume; the shoelace area of a polygon.
 
-Accuracy claims checked: model/outline.py's polygon misses the curve by at most the stated
+Accuracy claims checked: physics/bodies/outline.py's polygon misses the curve by at most the stated
 tolerance × the lamina's size in every direction (max over vertices of p·n ≥ h(n) − that),
 its vertices lie on the curve to rounding; model/mesh.py's ruled hull is closed, wound
 outward and converges at second order to the convex hull of the rims (measured |error| n²
@@ -23,7 +23,7 @@ from scipy.spatial import ConvexHull
 from rounding import ulps
 from twodisk_ros.model.frames import disk_frames, disk_rims
 from twodisk_ros.model.mesh import body_mesh, mesh_parts
-from twodisk_ros.model.outline import frame_rims, lamina_outline
+from twodisk_ros.physics.bodies.outline import frame_rims, lamina_outline
 from twodisk_ros.model.stl import cached_stl
 from twodisk_ros.physics import EllipseBody
 from twodisk_ros.physics.bodies.contact_solver import ContactSolver

@@ -14,8 +14,8 @@ import pytest
 
 from twodisk_ros.model.frames import disk_frames
 from twodisk_ros.model.frames import disk_rims
-from twodisk_ros.model.outline import DEFAULT_TOLERANCE
-from twodisk_ros.model.rulings import hull_rulings
+from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE
+from twodisk_ros.physics.bodies.rulings import hull_rulings
 from twodisk_ros.physics.laminae.support import Egg
 from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import centred_on_mass

@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from batch_recording import record
-from twodisk_ros.model.outline import DEFAULT_TOLERANCE
+from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE
 from twodisk_ros.plotting.animation import drawn
 from twodisk_ros.runs import library_run, recorded_run, settings_from
 

@@ -2,7 +2,7 @@
 
 A :class:`Run` holds everything a frame needs, in the world frame (Z up, m, s, N): G, A, B
 and the orientation at increasing times, optionally the ground forces at A and B, and the
-body, whose real outlines it draws (:mod:`~twodisk_ros.model.outline`). It comes from the
+body, whose real outlines it draws (:mod:`~twodisk_ros.physics.bodies.outline`). It comes from the
 physics (:func:`library_run`, the parameters of the node's contract) or from an MCAP
 recording of the node (:func:`recorded_run`), both through the run description
 (:class:`~twodisk_ros.run.description.RunDescription`), so any shape the node runs is
@@ -18,7 +18,7 @@ import numpy as np
 from .recordings.errors import one_line
 from .recordings.reader import read_recording
 from .model.frames import disk_rims
-from .model.outline import DEFAULT_TOLERANCE
+from .physics.bodies.outline import DEFAULT_TOLERANCE
 from .run.parameters import BY_NAME, DEFAULTS
 from .run.params_yaml import ArgumentError, params_file_values
 from .run.scene_simulation import flat_free

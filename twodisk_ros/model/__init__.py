@@ -1,10 +1,9 @@
 """The body as a robot description: disk frames, meshes and a URDF (no ROS, no matplotlib).
 
-Any body: a EllipseBody (ellipses), a LaminaBody or a ContactSolver (any lamina).
+Any body: a EllipseBody (ellipses) or a LaminaBody (any lamina); the frames also a
+ContactSolver. The outlines every drawer takes its rims from and the hull's rulings are the
+bodies' (:mod:`~twodisk_ros.physics.bodies.outline`, :mod:`~twodisk_ros.physics.bodies.rulings`).
 
-- :mod:`~twodisk_ros.model.outline`: the laminae's outlines as polygons of a stated error,
-  where every drawer (meshes, markers, Foxglove, animation) takes its rims;
-- :mod:`~twodisk_ros.model.rulings`: the solid hull of any lamina from its exact rulings;
 - :mod:`~twodisk_ros.model.frames`: the two disk frames relative to the body frame, and the
   rims placed in them (:func:`~twodisk_ros.model.frames.disk_rims`);
 - :mod:`~twodisk_ros.model.mesh`: triangle meshes of the laminae and of the solid hull;

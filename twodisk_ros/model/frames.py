@@ -12,7 +12,7 @@ x axis along the common axis pointing away from G, towards the disk's far tip (w
 θ = 0, resp. ψ = 0); y completes the right-handed frame. The contact angle of the disk is
 the polar angle from x towards y. For ellipses the rim is x²/a² + y²/b² = 1, z = 0, on both
 disks, so the contact point is ρ (cos ∠, sin ∠, 0) with ρ = ab/D(∠); for any lamina
-(:mod:`~twodisk_ros.model.outline`) disk 1's lamina point (x, y) is (−y, x, 0) in its frame
+(:mod:`~twodisk_ros.physics.bodies.outline`) disk 1's lamina point (x, y) is (−y, x, 0) in its frame
 and disk 2's is (σy, −x, 0), σ = ±1 the arrangement:
 
 ``{body_frame}_disk_a`` — disk 1, which carries the contact point A (angle θ):
@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from .outline import DEFAULT_TOLERANCE, body_shape, frame_rims
+from twodisk_ros.physics.bodies.outline import DEFAULT_TOLERANCE, body_shape, frame_rims
 
 __all__ = ['DiskFrame', 'disk_frames', 'disk_rims', 'check_frame_id', 'DISK_SUFFIXES']
 
@@ -103,7 +103,7 @@ def disk_frames(body, body_frame='twodisk_body'):
     Parameters
     ----------
     body : EllipseBody, LaminaBody or ContactSolver
-        Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.model.outline.body_shape`).
+        Uses ``body.delta`` (m) and G's offset (:func:`~twodisk_ros.physics.bodies.outline.body_shape`).
     body_frame : str
         The parent frame's name (see :func:`check_frame_id`).
 
@@ -125,7 +125,7 @@ def disk_frames(body, body_frame='twodisk_body'):
     return tuple(frames)
 
 
-def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
+def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True):
     """Both rims in the body frame (m, from the body's origin G or P): (rim of disk 1, rim of disk 2), arrays
     (N + 1, 3) with the last point the first (``closed``) or (N, 3).
 
@@ -133,7 +133,7 @@ def disk_rims(body, tolerance=DEFAULT_TOLERANCE, closed=True, outline=None):
     disk 1, +e2 for disk 2) and reaches the near tip at index N/2.
     """
     rims = []
-    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance, outline)):
+    for frame, rim in zip(disk_frames(body), frame_rims(body, tolerance)):
         local = np.zeros((len(rim), 3))
         local[:, :2] = rim
         points = local @ frame.axes.T + frame.translation

@@ -2,18 +2,19 @@
 
 Body frame ``G e1 e2 e3`` as in docs/physics.md (metres). Every mesh is closed (each edge is
 shared by exactly two faces) and its faces are wound counter-clockwise seen from outside, so
-their right-hand normals point out. Any body: a EllipseBody (ellipses, closed forms), a
-LaminaBody or a ContactSolver (any lamina, ``body.lamina``).
+their right-hand normals point out. Any RollingBody: a EllipseBody (ellipses, closed forms)
+or a LaminaBody (any lamina); each gives its rims and hull (``plate_rims``, ``hull_surface``).
 
 ``'laminae'`` (and ``'custom'``, whose geometry is the same two disks)
     Each disk as a thin plate: a closed prism over its rim, ``thickness`` thick, centred on
     the disk's plane, with one centre vertex per face. In the disk frames of
     :mod:`~twodisk_ros.model.frames` an ellipse's plate has ``resolution`` rim vertices on
     each face at eccentric anomalies 2πk/resolution, (a cos, b sin, ±thickness/2); any other
-    lamina's rim is the polygon of :func:`~twodisk_ros.model.outline.lamina_outline` whose
-    error is that of a regular ``resolution``-gon in a circle, (1 − cos(π/n)) × the lamina's
-    size. The two plates cross each other along the common axis (each disk's plane cuts the
-    other disk); the mesh keeps them as two closed components, so a volume integral over
+    lamina's rim is the polygon of
+    :func:`~twodisk_ros.physics.bodies.outline.lamina_outline` whose error is that of a
+    regular ``resolution``-gon in a circle, (1 − cos(π/n)) × the lamina's size. The two
+    plates cross each other along the common axis (each disk's plane cuts the other disk);
+    the mesh keeps them as two closed components, so a volume integral over
     the mesh counts the crossing twice, as the ``laminae`` mass model counts two plates of
     mass M/2 each.
 ``'solid'``
@@ -23,8 +24,8 @@ LaminaBody or a ContactSolver (any lamina, ``body.lamina``).
     the hull's rulings (docs/physics.md#mass-models), and the rest of each rim lies inside
     the hull. Their convex hull (scipy's Qhull) is the mesh; its edges follow the rulings.
     For any other lamina the rulings come from the exact contact geometry and the mesh is
-    the strips between consecutive ones (:mod:`~twodisk_ros.model.rulings`); its volume
-    converges at second order to that of scipy's ConvexHull of densely sampled rims
+    the strips between consecutive ones (:mod:`~twodisk_ros.physics.bodies.rulings`); its
+    volume converges at second order to that of scipy's ConvexHull of densely sampled rims
     (3.3e-5 low at n = 256 for a Superellipse(1, 1, 6), 5.8e-5 for an Egg(1, 0.8, 0.06),
     tests/test_model_outline.py).
 
@@ -42,12 +43,9 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.mass.models import MODELS
 
 from .frames import disk_frames
-from .outline import frame_rims, resolution_tolerance
-from .rulings import ruled_hull
 
 __all__ = ['Mesh', 'body_mesh', 'mesh_parts', 'laminae_mesh', 'hull_mesh', 'merge',
            'DEFAULT_RESOLUTION', 'DEFAULT_THICKNESS']
@@ -134,7 +132,7 @@ def body_mesh(body, mass_model='laminae', resolution=DEFAULT_RESOLUTION, thickne
 
     Parameters
     ----------
-    body : EllipseBody, LaminaBody or ContactSolver
+    body : EllipseBody or LaminaBody
     mass_model : str or twodisk_ros.physics.mass.models.MassProperties
         ``'solid'`` gives the convex hull (:func:`hull_mesh`); ``'laminae'`` and ``'custom'``
         the two plates (:func:`laminae_mesh`).
@@ -181,16 +179,8 @@ def _plates(body, resolution, thickness):
         raise ValueError(f'thickness must be a number of metres in (0, size = {body.size!r}), '
                          f'got {thickness!r}')
     half = 0.5 * float(thickness)
-    if isinstance(body, EllipseBody):
-        angle = 2 * np.pi * np.arange(n) / n
-        rim = np.stack([body.a * np.cos(angle), body.b * np.sin(angle)], axis=-1)
-        # exact values where the rim meets the axes (cos, sin of multiples of π/2)
-        quarter = np.arange(0, n, n // 4)
-        rim[quarter] = [[body.a, 0.0], [0.0, body.b], [-body.a, 0.0], [0.0, -body.b]]
-        rims = (rim, rim)
-    else:
-        rims = frame_rims(body, resolution_tolerance(n))
-    return tuple(_prism(rim, half, frame) for rim, frame in zip(rims, disk_frames(body)))
+    return tuple(_prism(rim, half, frame)
+                 for rim, frame in zip(body.plate_rims(n), disk_frames(body)))
 
 
 def _prism(rim, half, frame):
@@ -215,23 +205,6 @@ def _prism(rim, half, frame):
 
 
 def hull_mesh(body, resolution=DEFAULT_RESOLUTION):
-    """The convex hull of the two rims (see the module docstring), body frame (m)."""
-    from scipy.spatial import ConvexHull
-    n = _resolution(resolution)
-    if not isinstance(body, EllipseBody):
-        return Mesh(*ruled_hull(body, n))
-    u = 2 * np.pi * np.arange(n) / n
-    geometry_a = body.phase_geometry(u[(u <= np.pi / 2) | (u >= 3 * np.pi / 2)])
-    geometry_b = body.phase_geometry(u[u <= np.pi])
-    # A sweeps its whole arc while cos u ≥ 0, B while sin u ≥ 0 (the grid holds 0, ±π/2, π)
-    points = np.concatenate([geometry_a.contact_a, geometry_b.contact_b])
-    hull = ConvexHull(points)
-    faces = hull.simplices.copy()
-    corners = points[faces]
-    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    inward = np.einsum('ij,ij->i', cross, hull.equations[:, :3]) < 0
-    faces[inward] = faces[inward][:, ::-1]
-    used = np.unique(faces)
-    index = np.full(len(points), -1)
-    index[used] = np.arange(len(used))
-    return Mesh(points[used], index[faces])
+    """The convex hull of the two rims (see the module docstring), body frame (m): the
+    body's :meth:`~twodisk_ros.physics.bodies.protocol.RollingBody.hull_surface`."""
+    return Mesh(*body.hull_surface(_resolution(resolution)))

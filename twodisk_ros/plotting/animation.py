@@ -1,7 +1,7 @@
 """Animations of a rolling run: GIF (Pillow) or MP4 (ffmpeg), in 3D or seen from above.
 
 Each frame shows the body as its two filled laminae (disk 1 blue, disk 2 orange; the real
-outline of ``run.body.lamina``, :mod:`~twodisk_ros.model.outline`), the
+outline of ``run.body.lamina``, :mod:`~twodisk_ros.physics.bodies.outline`), the
 contact segment AB (green), the traces of A and B so far on the ground, the path of G and,
 optionally, the ground forces on the body at A and B as arrows (length L for M g, L the
 body size). A run on a slope (``run.slope`` β ≠ 0) draws its ground: in 3D the plane

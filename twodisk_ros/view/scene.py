@@ -19,7 +19,7 @@ from foxglove.messages import (ArrowPrimitive, Color, FrameTransform, FrameTrans
                                SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive,
                                Vector3)
 
-from ..model.outline import DEFAULT_TOLERANCE, frame_rims
+from ..physics.bodies.outline import DEFAULT_TOLERANCE, frame_rims
 from ..model import palette
 
 __all__ = ['PART_COLOURS', 'Traces', 'body_update', 'color', 'contact_update', 'force_arrows',
@@ -31,7 +31,7 @@ LINE_WIDTH = 0.01
 SHAFT_DIAMETER, HEAD_DIAMETER, HEAD_LENGTH = 0.01, 0.02, 0.03
 #: Opacity of the body's mesh (the rims and the contact segment stay opaque).
 MESH_ALPHA = 0.55
-#: Polygon error of the drawn rims, as a fraction of the lamina's size (model/outline.py).
+#: Polygon error of the drawn rims, as a fraction of the lamina's size (physics/bodies/outline.py).
 RIM_TOLERANCE = DEFAULT_TOLERANCE
 
 
@@ -109,7 +109,7 @@ def body_update(stamp_ns, body_frame, body, parts, disks):
     Parameters
     ----------
     body : EllipseBody, LaminaBody or ContactSolver
-        For the rims: the real outline of ``body.lamina`` (model/outline.py), to a polygon
+        For the rims: the real outline of ``body.lamina`` (physics/bodies/outline.py), to a polygon
         error of :data:`RIM_TOLERANCE` of its size.
     parts : dict of str to Mesh
         The body's closed parts (``vertices`` (n, 3) in m, body frame; ``faces`` (m, 3)

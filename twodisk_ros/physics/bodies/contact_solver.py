@@ -44,11 +44,11 @@ import math
 import numpy as np
 
 from ..laminae.shapes import Lamina, check_length
+from .outline import ARRANGEMENTS
+from .rulings import Drawable
 
 __all__ = ['ARRANGEMENTS', 'ContactGeometry', 'ContactSolver']
 
-#: Disk 2's orientation: σ, the sign of its lamina y along e2 (see the module docstring).
-ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
 #: Grid on which the turning-point function F must change sign exactly once (a larger count
 #: would mean a family in several pieces, which is refused).
 _CHECK_NODES = 2049
@@ -147,7 +147,7 @@ class ContactGeometry:
     parameter_b: np.ndarray = None  #: B's lamina parameter on disk 2 (rad, in (−π, π])
 
 
-class ContactSolver:
+class ContactSolver(Drawable):
     """Two congruent convex laminae in perpendicular planes, centres at ∓Δ along e2.
 
     Parameters

@@ -43,6 +43,7 @@ from ..numerics.analytic import COMPLEX_STEP, complex_step, complex_step_jet
 from ..laminae.shapes import Ellipse
 from .ellipse_phase import phase_angles
 from .protocol import PhaseGeometry, RollingBody
+from .rulings import convex_surface
 from ..numerics.vectors import cross, vector
 
 __all__ = ['LENGTH_RANGE', 'EllipseForms', 'EllipseBody', 'PhaseGeometry']
@@ -390,6 +391,22 @@ class EllipseBody(EllipseForms, RollingBody):
         if a >= b or a * d >= b * b - a * a:
             return a + d
         return math.sqrt(b * b + d * d + (a * d) ** 2 / (b * b - a * a))
+
+    # -- drawing (model/mesh.py): closed forms -----------------------------------------------
+    def plate_rims(self, resolution):
+        """Both rims at the eccentric anomalies 2πk/n, (a cos, b sin), exact on the axes."""
+        a, b, angle = self.a, self.b, 2 * np.pi * np.arange(resolution) / resolution
+        rim = np.stack([a * np.cos(angle), b * np.sin(angle)], axis=-1)
+        rim[np.arange(0, resolution, resolution // 4)] = [[a, 0.0], [0.0, b], [-a, 0.0], [0.0, -b]]
+        return rim, rim
+
+    def hull_surface(self, resolution):
+        """The convex hull of A and B at n equal steps of u: the ends of the hull's rulings."""
+        u = 2 * np.pi * np.arange(resolution) / resolution
+        # A sweeps its whole arc while cos u ≥ 0, B while sin u ≥ 0 (the grid holds 0, ±π/2, π)
+        return convex_surface(np.concatenate([
+            self.phase_geometry(u[(u <= np.pi / 2) | (u >= 3 * np.pi / 2)]).contact_a,
+            self.phase_geometry(u[u <= np.pi]).contact_b]))
 
     # -- the paper's θ form ------------------------------------------------------------------
     @staticmethod

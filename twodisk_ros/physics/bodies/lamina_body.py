@@ -183,6 +183,15 @@ class LaminaBody(RollingBody):
         state['_offset'] = self._offset + shift
         return moved
 
+    def centred_on(self, center_of_mass):
+        """(this body moved by the centre of mass's e2 part (:meth:`about`), zeros (3,)): its
+        e1 and e3 parts vanish by the mirror symmetries (> 1e-12 of the size is refused)."""
+        com = center_of_mass
+        if max(abs(com[0]), abs(com[2])) > 1e-12 * self.size:
+            raise ValueError(f'the centre of mass {com.tolist()} m is off the common axis e2: '
+                             'the body cannot be moved onto it along e2')
+        return self.about(float(com[1])), np.zeros(3)
+
     # -- construction ------------------------------------------------------------------------
     def _sample(self):
         n = MIN_NODES

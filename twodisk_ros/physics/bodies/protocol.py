@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .contact_solver import ContactSolver
+from .rulings import Drawable
 
 __all__ = ['PhaseGeometry', 'RollingBody', 'check_rolling_body']
 
@@ -56,7 +57,7 @@ class PhaseGeometry:
     tilt: np.ndarray            #: φ (rad), angle between the plane of disk 1 and the ground
 
 
-class RollingBody(abc.ABC):
+class RollingBody(Drawable, abc.ABC):
     """A rigid body of two congruent laminae in perpendicular planes rolling on a plane.
 
     Attributes (read-only)
@@ -174,6 +175,11 @@ class RollingBody(abc.ABC):
         """The body-frame origin's offset from G along e2 (m): 0 unless the body was moved
         (:meth:`~twodisk_ros.physics.bodies.lamina_body.LaminaBody.about`)."""
         return 0.0
+
+    def centred_on(self, center_of_mass):
+        """(body, centre of mass (m) from its origin) for ``center_of_mass`` from this one's:
+        here itself, G being the centre of mass by symmetry (ellipses); LaminaBody moves."""
+        return self, center_of_mass
 
     def resolution_cause(self):
         """What sets the resolution of the body's tables, for the start-up notice of an

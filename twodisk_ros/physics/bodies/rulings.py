@@ -14,7 +14,7 @@ pose and the turning point. A quarter cycle (branch +1, θ ≥ 0) is sampled on 
 parameter p ∈ [0, 1] whose intervals are halved until consecutive rulings' ends A and B are
 each at most a chord 2 sin(π/n) L apart (L the body's size, n the resolution: the side of a
 regular n-gon) and each chord misses its rim by at most (1 − cos(π/n)) × the lamina's size
-(measured with the support function, :func:`~twodisk_ros.model.outline.chord_deviation`).
+(measured with the support function, :func:`~twodisk_ros.physics.bodies.outline.chord_deviation`).
 
 **The other three quarters** follow exactly from the body's two mirror symmetries (every
 lamina is symmetric about the common axis): x1 ↦ −x1 takes θ to −θ on the same branch
@@ -29,14 +29,28 @@ import math
 
 import numpy as np
 
-from .outline import chord_deviation, resolution_tolerance
+from .outline import chord_deviation, frame_rims, resolution_tolerance
 
-__all__ = ['hull_rulings', 'ruled_hull']
+__all__ = ['Drawable', 'convex_surface', 'hull_rulings', 'ruled_hull']
 
 #: Intervals of each chart before refinement; the refinement halves at most this many times.
 _FIRST_INTERVALS, _MAX_LEVELS = 8, 24
 _MIRROR_1 = np.array([-1.0, 1.0, 1.0])     # x1 ↦ −x1: θ ↦ −θ, same branch
 _MIRROR_3 = np.array([1.0, 1.0, -1.0])     # x3 ↦ −x3: branch ↦ −branch, same θ
+
+
+class Drawable:
+    """What model/mesh.py draws of a body (RollingBody, ContactSolver), from its exact
+    geometry; EllipseBody gives both in closed form."""
+
+    def plate_rims(self, resolution):
+        """The plates' rims at a resolution n, (disk 1, disk 2) (N, 2) in the disk frames (m):
+        the outline polygon of a regular n-gon's error (:func:`.outline.frame_rims`)."""
+        return frame_rims(self, resolution_tolerance(resolution))
+
+    def hull_surface(self, resolution):
+        """The hull's closed surface at a resolution n: :func:`ruled_hull`."""
+        return ruled_hull(self, resolution)
 
 
 class _Quarter:
@@ -152,3 +166,19 @@ def ruled_hull(body, resolution):
     if volume < 0:
         faces = faces[:, ::-1]
     return vertices, faces
+
+
+def convex_surface(points):
+    """(vertices, faces) of the convex hull (scipy's Qhull) of ``points`` (k, 3) (m): the
+    points on it in their order and its triangles, wound outward."""
+    from scipy.spatial import ConvexHull
+    hull = ConvexHull(points)
+    faces = hull.simplices.copy()
+    corners = points[faces]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    inward = np.einsum('ij,ij->i', cross, hull.equations[:, :3]) < 0
+    faces[inward] = faces[inward][:, ::-1]
+    used = np.unique(faces)
+    index = np.full(len(points), -1)
+    index[used] = np.arange(len(used))
+    return points[used], index[faces]

@@ -33,11 +33,12 @@ import math
 
 import numpy as np
 
-from twodisk_ros.physics.bodies.contact_solver import ARRANGEMENTS
 
-__all__ = ['BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
+__all__ = ['ARRANGEMENTS', 'BodyShape', 'DEFAULT_TOLERANCE', 'body_shape', 'chord_deviation', 'disk_rims',
            'frame_rims', 'lamina_outline', 'resolution_tolerance']
 
+#: Disk 2's orientation: σ, the sign of its lamina y along e2 (bodies/contact_solver.py).
+ARRANGEMENTS = {'parallel': 1.0, 'swapped': -1.0}
 #: Default polygon error of a drawn outline, as a fraction of the lamina's size: below a
 #: pixel for a body 500 pixels wide; a circle gets 64 vertices (error 1.2e-3), as the
 #: markers had before.
@@ -136,12 +137,12 @@ def body_shape(body):
                      centroid)
 
 
-def frame_rims(body, tolerance=DEFAULT_TOLERANCE, outline=None):
+def frame_rims(body, tolerance=DEFAULT_TOLERANCE):
     """The two rims in their disk frames (frames.py): arrays (N, 2) (m), counterclockwise
     about the frame's z (so a fan (centre, p_k, p_k+1) faces +z), each starting at the
-    disk's far tip (frame x > 0). ``outline``: the lamina polygon, if already sampled."""
+    disk's far tip (frame x > 0)."""
     shape = body_shape(body)
-    points = lamina_outline(shape.lamina, tolerance) if outline is None else outline
+    points = lamina_outline(shape.lamina, tolerance)
     x, y = points[:, 0], points[:, 1]
     # disk 1: (−y, x) turns the lamina by +90°: counterclockwise, starting at the tip −y
     rim_1 = np.stack([-y, x], axis=-1)
