@@ -35,7 +35,8 @@ import numpy as np  # noqa: E402
 
 from twodisk_ros.physics.bodies.ellipse import EllipseBody  # noqa: E402
 from twodisk_ros.physics.mass.models import mass_properties  # noqa: E402
-from twodisk_ros.sweep.chunks import chunk_quantities  # noqa: E402
+from twodisk_ros.sweep.chunks import chunk_bodies, quantities  # noqa: E402
+from twodisk_ros.sweep.general import Laminae  # noqa: E402
 from twodisk_ros.sweep.quantities import STAGES  # noqa: E402
 from twodisk_ros.sweep.request import (CORE_SECONDS_PER_BODY, DEFAULT_CHUNK_SIZE,  # noqa: E402
                                        GENERAL_CHUNK_SIZE, GENERAL_CORE_SECONDS_PER_BODY)
@@ -68,8 +69,9 @@ def _timed(b, d, exponent, chunk, factories=None):
     failures = []
     for start in range(0, b.size, chunk):
         part = slice(start, start + chunk)
-        result = chunk_quantities(b[part], d[part], timings=timings, exponent=exponent,
-                                  **(factories or {}))
+        bodies = (Laminae(b[part], d[part], exponent, *factories) if factories
+                  else chunk_bodies(b[part], d[part], exponent))
+        result = quantities(bodies, timings=timings)
         failures.extend(result['failure'])
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     failed = [f for f in failures if f]
@@ -79,8 +81,8 @@ def _timed(b, d, exponent, chunk, factories=None):
 def measure(quick=False, log=print):
     """{'ellipse': {...}, 'general': {...}} per-body costs (s) and rates (bodies/s)."""
     found = {}
-    chunk_quantities([1.0], [0.5])                                # first calls apart
-    ellipse = {'body_factory': _ellipse_body, 'mass_factory': _ellipse_mass}
+    quantities(chunk_bodies([1.0], [0.5]))                        # first calls apart
+    ellipse = (_ellipse_body, _ellipse_mass)
     for key, exponent, shape, chunk, factories in (
             ('ellipse', 2.0, (8, 4) if quick else ELLIPSE_GRID, DEFAULT_CHUNK_SIZE, None),
             ('scalar', 2.0, (2, 1) if quick else GENERAL_GRID, GENERAL_CHUNK_SIZE, ellipse),

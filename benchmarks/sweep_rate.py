@@ -40,10 +40,10 @@ if __name__ == '__main__':   # --help answers before the heavy imports below
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.sweep.batch import BATCH_STAGES  # noqa: E402
+from twodisk_ros.sweep.batch import BATCH_STAGES, Ellipses  # noqa: E402
 from twodisk_ros.sweep.parts import PartsCache  # noqa: E402
-from twodisk_ros.sweep.chunks import chunk_quantities, timed_chunk  # noqa: E402
-from twodisk_ros.sweep.quantities import STAGES  # noqa: E402
+from twodisk_ros.sweep.chunks import quantities, timed_chunk  # noqa: E402
+from twodisk_ros.sweep.quantities import STAGES, body_quantities  # noqa: E402
 from twodisk_ros.sweep.run import DEFAULT_CHUNK_SIZE, SweepSpec, dask_client  # noqa: E402
 from twodisk_ros.sweep.worker import SweepWorkerSetup  # noqa: E402
 
@@ -72,6 +72,16 @@ def _noop(x):
     return x
 
 
+def _per_body(b, d, timings=None):
+    """The per-body path (the scalar reference) over paired b/a and Δ/a."""
+    return [body_quantities(bk, dk, timings=timings) for bk, dk in zip(b, d)]
+
+
+def _batched(b, d, timings=None):
+    """The batched path, as a task of exponent 2 runs it."""
+    return quantities(Ellipses(b, d), timings=timings)
+
+
 def _cpu_clock():
     return time.perf_counter(), time.process_time()
 
@@ -80,17 +90,17 @@ def serial_costs(shape=SIDE_GRID):
     """{path: (wall per body, CPU per body, {stage: wall per body})} (s), same bodies."""
     spec = SweepSpec(*_grid(shape))
     _, b, d = spec.points()       # (exponent 2 alone: the ellipse)
-    chunk_quantities(b[:8], d[:8])                                     # first calls apart
+    _batched(b[:8], d[:8])                                             # first calls apart
     found = {}
-    for label, method, chunk in (('per-body', 'scalar', DEFAULT_CHUNK_SIZE),
-                                 (f'batched, chunks of {DEFAULT_CHUNK_SIZE}', 'batch',
-                                  DEFAULT_CHUNK_SIZE),
-                                 (f'batched, chunks of {BATCH_CHUNK}', 'batch', BATCH_CHUNK)):
+    for label, path, chunk in (('per-body', _per_body, DEFAULT_CHUNK_SIZE),
+                               (f'batched, chunks of {DEFAULT_CHUNK_SIZE}', _batched,
+                                DEFAULT_CHUNK_SIZE),
+                               (f'batched, chunks of {BATCH_CHUNK}', _batched, BATCH_CHUNK)):
         timings = {}
         wall, cpu = _cpu_clock()
         for start in range(0, spec.size, chunk):
             part = slice(start, start + chunk)
-            chunk_quantities(b[part], d[part], timings=timings, method=method)
+            path(b[part], d[part], timings)
         wall, cpu = (x / spec.size for x in np.subtract(_cpu_clock(), (wall, cpu)))
         found[label] = (wall, cpu, {k: v / spec.size for k, v in timings.items()})
     return spec.size, found
@@ -104,7 +114,7 @@ def task_overhead(client):
 
 
 def client_cost_per_chunk():
-    result = chunk_quantities([1.0] * BATCH_CHUNK, [0.5] * BATCH_CHUNK)
+    result = _batched([1.0] * BATCH_CHUNK, [0.5] * BATCH_CHUNK)
     with tempfile.TemporaryDirectory() as folder:
         cache = PartsCache(folder + '/x.parts', {'benchmark': 1})
         start = time.perf_counter()
@@ -130,7 +140,7 @@ def serial_rate():
     _, b, d = spec.points()       # (exponent 2 alone: the ellipse)
     wall, cpu = _cpu_clock()
     for part in spec.chunks():
-        chunk_quantities(b[part], d[part])
+        _batched(b[part], d[part])
     return tuple(x / spec.size for x in np.subtract(_cpu_clock(), (wall, cpu)))
 
 
@@ -163,8 +173,8 @@ def scalar_on_two_workers():
         client.register_plugin(SweepWorkerSetup())
         client.run(_import_physics)
         start = time.perf_counter()
-        futures = [client.submit(chunk_quantities, b[part], d[part], method='scalar',
-                                 pure=False) for part in spec.chunks()]
+        futures = [client.submit(_per_body, b[part], d[part], pure=False)
+                   for part in spec.chunks()]
         client.gather(futures)
         return (time.perf_counter() - start) / spec.size
 

@@ -50,7 +50,7 @@ if __name__ == '__main__':
 
 import numpy as np  # noqa: E402
 
-from twodisk_ros.sweep.chunks import chunk_quantities  # noqa: E402
+from twodisk_ros.sweep.chunks import timed_chunk  # noqa: E402
 from twodisk_ros.sweep.request import BYTES_PER_TASK, DEFAULT_STORE_CHUNK_SIZE  # noqa: E402
 from twodisk_ros.sweep.spec import SweepSpec  # noqa: E402
 
@@ -77,9 +77,9 @@ def per_body_cost(shape=(6, 8)):
     b = np.linspace(*B_RANGE, shape[0])
     d = np.linspace(*D_RANGE, shape[1])
     bb, dd = (x.ravel() for x in np.meshgrid(b, d, indexing='ij'))
-    chunk_quantities(bb[:2], dd[:2])            # imports and first-call caches apart
+    timed_chunk(bb[:2], dd[:2])                 # imports and first-call caches apart
     start, cpu = time.perf_counter(), time.process_time()
-    result = chunk_quantities(bb, dd)
+    result = timed_chunk(bb, dd)[0]
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     return wall / bb.size, cpu / bb.size, len(pickle.dumps(result)) / bb.size
 

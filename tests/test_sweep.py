@@ -29,7 +29,7 @@ from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.physics.motion.simulate import simulate_phase
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_netcdf
-from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.chunks import timed_chunk
 from twodisk_ros.sweep.quantities import VARIABLES
 from twodisk_ros.sweep.run import SweepSpec, dask_client, parts_folder, run_sweep
 
@@ -204,7 +204,7 @@ def test_chunk_of_a_neutral_body_is_the_library_scalar_path():
     import xarray as xr
     b = [math.sqrt(2 - 2 * 0.5**2), 2.0]
     d = [0.5, 0.3]
-    result = chunk_quantities(b, d)
+    result = timed_chunk(b, d)[0]
     for k in range(2):
         point = xr.Dataset({name: ((), result[name][k]) for name in VARIABLES}
                            | {'failure': ((), result['failure'][k])})

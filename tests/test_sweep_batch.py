@@ -1,4 +1,5 @@
-"""The batched sweep path (twodisk_ros.sweep.batch) against the library's scalar path.
+"""The batched sweep path (twodisk_ros.sweep.batch.Ellipses through sweep.chunks.quantities)
+against the library's scalar path.
 
 Reference: :func:`~twodisk_ros.sweep.quantities.body_quantities`, the library's scalar calls
 made body by body (one call per quantity), never the batch's own formulas; the oscillation
@@ -21,8 +22,8 @@ from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.motion.dynamics import RollingDynamics
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.sweep import batch
-from twodisk_ros.sweep.batch import batch_quantities
-from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.batch import Ellipses
+from twodisk_ros.sweep.chunks import chunk_bodies, quantities
 from twodisk_ros.sweep.quantities import VARIABLES, body_quantities
 
 #: Every quantity against the scalar path, relative (the issue's bound). Measured ≤ 5e-12
@@ -108,7 +109,7 @@ def test_batch_equals_the_scalar_path_on_a_sample(mass_model):
     b, d = _sample()
     b = np.concatenate([b, [m[0] for m in MASKED]])
     d = np.concatenate([d, [m[1] for m in MASKED]])
-    result = batch_quantities(b, d, mass_model)
+    result = quantities(Ellipses(b, d), mass_model)
     assert set(result) == set(VARIABLES) | {'failure'}
     assert all(result[name].dtype == np.float64 and result[name].shape == b.shape
                for name in VARIABLES)
@@ -125,7 +126,7 @@ def test_batch_equals_the_scalar_path_on_a_sample(mass_model):
 @pytest.mark.parametrize('mass_model, edges', [('laminae', EDGES), ('solid', SOLID_EDGES)])
 def test_batch_equals_the_scalar_path_at_the_edges(mass_model, edges):
     b, d = np.array(edges).T
-    _check(batch_quantities(b, d, mass_model), b, d, mass_model, edge=True)
+    _check(quantities(Ellipses(b, d), mass_model), b, d, mass_model, edge=True)
 
 
 def test_near_the_neutral_line_the_period_is_the_papers():
@@ -133,7 +134,7 @@ def test_near_the_neutral_line_the_period_is_the_papers():
     d = 0.3
     margins = np.array([1e-3, 1e-5, 1e-8, -1e-8, -1e-5, -1e-3])
     b = np.sqrt(2.0 - 2.0 * d * d + margins)
-    result = batch_quantities(b, np.full(b.size, d))
+    result = quantities(Ellipses(b, np.full(b.size, d)))
     assert np.all(result['stable_family'] == np.sign(margins))
     for k in range(b.size):
         assert _agree(result['oscillation_period'][k], _paper_period(b[k], d, 'laminae'),
@@ -153,13 +154,13 @@ def test_near_the_neutral_line_the_scalar_period_is_the_papers_too():
 
 
 def test_results_do_not_depend_on_the_batch():
-    # a body's bits are the same alone, in any chunk, and through chunk_quantities
+    # a body's bits are the same alone, in any chunk, and in a task's batch (exponent 2)
     b = np.array([0.5, 1.0, 1.5, 2.5, 0.3, 1.2])
     d = np.array([0.25, 0.5, 0.75, 0.9, 0.2, 0.6])
-    whole = chunk_quantities(b, d)
+    whole = quantities(chunk_bodies(b, d))
     for size in (1, 4):
         for start in range(0, b.size, size):
-            part = batch_quantities(b[start:start + size], d[start:start + size])
+            part = quantities(Ellipses(b[start:start + size], d[start:start + size]))
             for name in VARIABLES:
                 np.testing.assert_array_equal(part[name], whole[name][start:start + size],
                                               err_msg=name)
@@ -178,7 +179,7 @@ def test_a_body_the_batch_cannot_finish_goes_through_the_scalar_path(monkeypatch
 
     monkeypatch.setattr(batch, '_block', spoiled)
     timings = {}
-    result = batch_quantities([1.0, 2.0], [0.5, 0.3], timings=timings)
+    result = quantities(Ellipses([1.0, 2.0], [0.5, 0.3]), timings=timings)
     values, failure = body_quantities(1.0, 0.5)
     assert result['failure'][0] == failure == ''
     assert all(result[name][0] == values[name] or math.isnan(values[name])
@@ -219,7 +220,7 @@ def test_a_block_that_raises_goes_through_the_scalar_path(monkeypatch):
         raise FloatingPointError('a numpy error in the block')
 
     monkeypatch.setattr(batch, '_block', broken)
-    result = batch_quantities([1.0, 1.0], [0.5, 2.0])
+    result = quantities(Ellipses([1.0, 1.0], [0.5, 2.0]))
     values, failure = body_quantities(1.0, 0.5)
     assert result['failure'] == ['', body_quantities(1.0, 2.0)[1]] and failure == ''
     assert all(result[name][0] == values[name] for name in VARIABLES

@@ -24,10 +24,11 @@ import pytest
 from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.mass.models import mass_properties
 from twodisk_ros.sweep import general
-from twodisk_ros.sweep.batch import batch_quantities
+from twodisk_ros.sweep.batch import Ellipses
 from twodisk_ros.sweep.cli import main
 from twodisk_ros.sweep.dataset import read_sweep
-from twodisk_ros.sweep.chunks import chunk_quantities
+from twodisk_ros.sweep.chunks import quantities, timed_chunk
+from twodisk_ros.sweep.general import Laminae
 from twodisk_ros.sweep.quantities import VARIABLES
 from twodisk_ros.sweep.request import EXPONENT_RANGE, SweepError, exponent_values
 from twodisk_ros.sweep.run import SweepSpec, run_sweep
@@ -81,13 +82,13 @@ def _spec(exponents, chunk=3):
 
 
 def _today(spec):
-    """The n = 2 grid as today's tasks computed it: batch_quantities on each block."""
+    """The n = 2 grid as today's tasks computed it: the ellipse batch of each block."""
     out = {name: np.full(spec.shape[1:], np.nan) for name in VARIABLES}
     out['failure'] = np.full(spec.shape[1:], '', dtype=object)
     for block in spec.blocks():
         if spec.block_exponent(block) != 2.0:
             continue
-        result = batch_quantities(*spec.block_points(block))
+        result = quantities(Ellipses(*spec.block_points(block)))
         plane = block[1:]
         for name in out:
             out[name][plane] = np.asarray(result[name]).reshape(out[name][plane].shape)
@@ -206,19 +207,19 @@ def test_zarr_sweep_of_several_exponents_resumes_bitwise(client, fake_factories,
 
 
 def test_general_path_on_an_ellipse_is_the_batched_path():
-    """chunk_quantities with an injected factory (no Dask): both families and the neutral
+    """Laminae with an injected factory (no Dask): both families and the neutral
     line b² = 2(a² − Δ²), where stable_family is 0 and the barrier and speed are 0."""
     b = np.array([0.5, 1.5, math.sqrt(2 - 2 * 0.5**2), 1.0])
     d = np.array([0.25, 0.75, 0.5, 0.9])
-    reference = batch_quantities(b, d)
-    got = chunk_quantities(b, d, exponent=3.0, body_factory=fake_body, mass_factory=fake_mass)
+    reference = quantities(Ellipses(b, d))
+    got = quantities(Laminae(b, d, 3.0, body_factory=fake_body, mass_factory=fake_mass))
     assert got['failure'] == reference['failure'] == [''] * 4
     for name in set(VARIABLES) - OWN_MEANING:
         np.testing.assert_allclose(got[name], reference[name], rtol=GENERAL_RTOL, atol=0.0,
                                    err_msg=name)
     assert got['stable_family'].tolist() == [-1.0, 1.0, 0.0, 1.0]
-    # the same body by the same call at n = 2 without a factory is the batched path itself
-    same = chunk_quantities(b, d)
+    # the same bodies in a task's batch at n = 2 are the batched path itself
+    same = timed_chunk(b, d)[0]
     for name in VARIABLES:
         np.testing.assert_array_equal(same[name], reference[name], err_msg=name)
 
@@ -226,8 +227,8 @@ def test_general_path_on_an_ellipse_is_the_batched_path():
 def test_a_body_the_general_path_cannot_build_is_masked_in_one_line():
     def broken(b, d, n):
         raise ValueError(f'no superellipse with n = {n}\nsecond line')
-    got = chunk_quantities([1.0, 1.0], [0.5, 1.0], exponent=5.0, body_factory=broken,
-                           mass_factory=fake_mass)
+    got = quantities(Laminae([1.0, 1.0], [0.5, 1.0], 5.0, body_factory=broken,
+                             mass_factory=fake_mass))
     assert got['failure'][0] == 'body: ValueError: no superellipse with n = 5.0 second line'
     assert got['failure'][1].startswith('body: delta/a = 1.0 >= 1')
     assert all(np.isnan(got[name]).all() for name in VARIABLES)
@@ -281,7 +282,7 @@ def _superellipse_plate_moments(b, n):
 def test_a_real_superellipse_n4_body():
     """n = 4, b/a = 1, Δ/a = 0.5 through LaminaBody."""
     b, d, n = 1.0, 0.5, 4.0
-    got = chunk_quantities([b], [d], exponent=n)
+    got = timed_chunk([b], [d], exponent=n)[0]
     failure = got['failure'][0]
     assert failure == ''      # LaminaBody is on main: a failing body is a failure, no skip
     from twodisk_ros.physics.stability.symmetric import symmetric_equilibria

@@ -1,9 +1,10 @@
 """Parameter sweeps over the family of bodies, on Dask: ``twodisk-sweep`` and its library.
 
-- :mod:`~twodisk_ros.sweep.quantities`: what is computed for one body (no Dask);
-- :mod:`~twodisk_ros.sweep.chunks`: one task, a chunk of bodies on the path that fits it (the
-  batched ellipse, :mod:`~twodisk_ros.sweep.batch`, or the per-body general path,
-  :mod:`~twodisk_ros.sweep.general`);
+- :mod:`~twodisk_ros.sweep.chunks`: one task, :func:`~twodisk_ros.sweep.chunks.quantities` of
+  a batch of bodies (no Dask), which batches what it can (the ellipse,
+  :mod:`~twodisk_ros.sweep.batch`) and computes the rest one by one
+  (:mod:`~twodisk_ros.sweep.quantities`, the ellipse's scalar reference;
+  :mod:`~twodisk_ros.sweep.general`, any other lamina);
 - :mod:`~twodisk_ros.sweep.spec`: the grid, the options and the blocks (one task each);
 - :mod:`~twodisk_ros.sweep.run`: the Dask tasks, results, progress and resume;
 - :mod:`~twodisk_ros.sweep.store`: the Zarr store, written by the workers, its own resume state;
@@ -18,5 +19,5 @@ Units: a = 1, g = 1, M = 1, so lengths are in a, times in √(a/g) and angular s
 (docs/sweeps.md). Dask and xarray are imported only by the modules that need them.
 """
 
-__all__ = ['quantities', 'chunks', 'spec', 'run', 'store', 'worker', 'parts', 'dataset', 'progress',
-           'request', 'cli']
+__all__ = ['chunks', 'quantities', 'batch', 'general', 'spec', 'run', 'store', 'worker', 'parts',
+           'dataset', 'progress', 'request', 'cli']

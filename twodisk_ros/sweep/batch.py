@@ -1,8 +1,9 @@
 """The sweep's quantities for many bodies at once: arrays over a batch axis, no Dask, no files.
 
-:func:`batch_quantities` computes what :func:`~twodisk_ros.sweep.quantities.body_quantities`
-computes (the reference, one body and one library call per quantity), for a whole chunk of
-bodies as array operations (docs/sweeps.md, "The batched path"):
+:class:`Ellipses`, the batch of a task of exponent n = 2, computes in
+:meth:`Ellipses.batched` what :func:`~twodisk_ros.sweep.quantities.body_quantities` computes
+(the reference, one body and one library call per quantity), for a whole chunk of bodies as
+array operations (docs/sweeps.md, "The batched path"):
 
 1. each body is checked and its mass model built one by one, as the scalar path does
    (microseconds each; a body the scalar path refuses at these stages goes through it, so
@@ -19,7 +20,8 @@ bodies as array operations (docs/sweeps.md, "The batched path"):
    μ_required (its 2048 phases are table nodes);
 4. a body whose batched values are not all finite where the scalar path's are (or that has
    no stable equilibrium although not neutral), and every body of a block that raised, is
-   recomputed by the scalar path, which then gives its values or its one-line failure.
+   left to :meth:`Ellipses.one`, the scalar path, which then gives its values or its
+   one-line failure (:func:`~twodisk_ros.sweep.chunks.quantities` calls it).
 
 Every quantity agrees with the scalar path to ≤ 1e-10 relative, except where the scalar
 path itself is less accurate (the oscillation period within ~1e-3 a² of the neutral line
@@ -41,15 +43,15 @@ from ..physics.bodies.cycle import TWO_PI, displacement_from_rates, required_res
 from ..physics.stability.equilibria import equilibria_batch
 from ..physics.mass.models import mass_properties
 from ..physics.numerics.spectral import node_sum
-from .quantities import VARIABLES, body_quantities
+from .quantities import body_quantities
 
-__all__ = ['POINTS', 'BATCH_STAGES', 'batch_quantities']
+__all__ = ['POINTS', 'BATCH_STAGES', 'Ellipses']
 
 #: Nodes × bodies evaluated at once (a block): ~150 B of temporaries per point, so a block
 #: stays within a few tens of MiB (benchmarks/sweep_batch.py measured 2^15 … 2^18 within
 #: a few % of each other).
 POINTS = 2**16
-#: Stages of :func:`batch_quantities`, the keys of its ``timings``.
+#: Stages of :class:`Ellipses`, the keys of its ``timings``.
 BATCH_STAGES = ('bodies', 'resolution', 'samples', 'cycle', 'equilibria', 'cycle_time',
                 'contact_length', 'contact_tables', 'liftoff_speed', 'mu_required', 'scalar')
 #: Newton steps of the refinements of the extremes of |AB| (from a node, converged in ~4).
@@ -184,40 +186,35 @@ def _block(bodies, inertia, nodes, reference_speed, clock):
     return values, good
 
 
-def batch_quantities(b_values, delta_values, mass_model='laminae', reference_speed=0.5,
-                     timings=None):
-    """:func:`~twodisk_ros.sweep.quantities.body_quantities` of many bodies, as arrays.
+class Ellipses:
+    """The ellipse bodies (a, b, Δ) = (1, b/a, Δ/a) of a task of exponent n = 2, as arrays.
 
     Parameters
     ----------
     b_values, delta_values : array_like
         b/a and Δ/a of the bodies (paired, flattened), a = 1.
-    mass_model : str
-        'laminae' or 'solid'.
-    reference_speed : float
-        Kinematic |ω| (√(g/a)) of ``mu_required``.
-    timings : dict, optional
-        Wall time per stage of :data:`BATCH_STAGES` (s), added to ``timings[stage]``.
-
-    Returns
-    -------
-    dict
-        name → float64 array for every name of
-        :data:`~twodisk_ros.sweep.quantities.VARIABLES`, and ``failure`` → list of str ('' or
-        the scalar path's one line), all of the length of the inputs.
     """
-    b_values = np.asarray(b_values, dtype=float).ravel()
-    delta_values = np.asarray(delta_values, dtype=float).ravel()
-    size = b_values.size
-    out = {name: np.full(size, math.nan) for name in VARIABLES}
-    failures = [''] * size
-    clock = _Clock(timings)
-    with clock('bodies'):
-        chosen, inertia = _checked_bodies(b_values, delta_values, mass_model, out)
-    scalar = sorted(set(range(size)) - set(chosen.tolist()))
-    if chosen.size:
+
+    def __init__(self, b_values, delta_values):
+        self.b = np.asarray(b_values, dtype=float).ravel()
+        self.delta = np.asarray(delta_values, dtype=float).ravel()
+
+    def __len__(self):
+        return self.b.size
+
+    def batched(self, out, mass_model, reference_speed, timings):
+        """Fill ``out`` (name → array, :func:`~twodisk_ros.sweep.chunks.quantities`) with
+        the bodies the closed forms compute as arrays (module docstring); the indices of the
+        bodies left to :meth:`one`. ``timings``: wall time per stage of :data:`BATCH_STAGES`
+        (s), added to ``timings[stage]``."""
+        clock = _Clock(timings)
+        with clock('bodies'):
+            chosen, inertia = _checked_bodies(self.b, self.delta, mass_model, out)
+        left = sorted(set(range(len(self))) - set(chosen.tolist()))
+        if not chosen.size:
+            return left
         with clock('resolution'):
-            everyone = EllipseBodies(1.0, b_values[chosen], delta_values[chosen])
+            everyone = EllipseBodies(1.0, self.b[chosen], self.delta[chosen])
             resolution = required_resolutions(everyone, POINTS)
         for r in np.unique(resolution):
             group = np.flatnonzero(resolution == r)
@@ -231,16 +228,15 @@ def batch_quantities(b_values, delta_values, mass_model='laminae', reference_spe
                         values, good = _block(everyone.subset(part), inertia[part], nodes,
                                               reference_speed, clock)
                 except Exception:  # noqa: BLE001 (never lose a chunk: the scalar path)
-                    scalar.extend(chosen[part].tolist())
+                    left.extend(chosen[part].tolist())
                     continue
                 for name, array in values.items():
                     out[name][chosen[part]] = array
-                scalar.extend(chosen[part[~good]].tolist())
-    with clock('scalar'):
-        for k in sorted(scalar):
-            values, failures[k] = body_quantities(b_values[k], delta_values[k], mass_model,
-                                                  reference_speed)
-            for name, value in values.items():
-                out[name][k] = value
-    out['failure'] = failures
-    return out
+                left.extend(chosen[part[~good]].tolist())
+        return sorted(left)
+
+    def one(self, k, mass_model, reference_speed, timings):
+        """(values, failure) of body ``k`` by the scalar reference
+        :func:`~twodisk_ros.sweep.quantities.body_quantities`, timed as the stage 'scalar'."""
+        with _Clock(timings)('scalar'):
+            return body_quantities(self.b[k], self.delta[k], mass_model, reference_speed)

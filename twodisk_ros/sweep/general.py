@@ -12,7 +12,8 @@ and :class:`~twodisk_ros.physics.forces.contact.ContactForceModel`. The stages a
 lines are those of :func:`~twodisk_ros.sweep.quantities.body_quantities`.
 
 Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exponent axis";
-:data:`GENERAL_MEANINGS` is written into each variable's ``general_path`` attribute):
+:data:`~twodisk_ros.sweep.variables.GENERAL_MEANINGS` is written into each variable's
+``general_path`` attribute):
 
 - ``stability_margin`` is NaN: b² − 2a² + 2Δ² is the ellipse's criterion; a superellipse with
   n > 2 has flat vertices (zero curvature) where no quadratic criterion exists;
@@ -27,9 +28,11 @@ Quantities whose ellipse definition does not carry over (docs/sweeps.md "The exp
   |ω| = |ω_u| u̇) written without the phase, whose rate ω_u vanishes where a contact crosses
   a flat vertex.
 
-The body and its mass model are made by two callables that a caller may replace
-(``body_factory(b, delta, exponent)`` and ``mass_factory(model, body)``), so that this path is
-also tested with the ellipse's closed forms standing in for the lamina body.
+:class:`Laminae` is the batch of a task (:func:`~twodisk_ros.sweep.chunks.quantities`): it
+has nothing to batch, every body goes through :meth:`Laminae.one`. The body and
+its mass model are made by two callables that a caller may replace (``body_factory(b, delta,
+exponent)`` and ``mass_factory(model, body)``), so that this path is also tested with the
+ellipse's closed forms standing in for the lamina body.
 """
 
 import math
@@ -38,10 +41,52 @@ import numpy as np
 
 from ..physics.motion.dynamics import RollingDynamics
 from ..physics.stability.equilibria import NEUTRAL, STABLE
-from .variables import GENERAL_FAMILIES, GENERAL_MEANINGS
+from .quantities import run_stages, shape_failure
+from .variables import VARIABLES
 
-__all__ = ['GENERAL_FAMILIES', 'GENERAL_MEANINGS', 'superellipse_body', 'lamina_mass',
-           'general_body_quantities', 'axis_inertia', 'symmetric_family']
+__all__ = ['Laminae', 'superellipse_body', 'lamina_mass', 'axis_inertia', 'symmetric_family']
+
+
+class Laminae:
+    """A batch of bodies of exponent n (a = 1; module docstring), computed one by one.
+
+    ``b_values``, ``delta_values``: b/a and Δ/a (paired, flattened); ``body_factory(b, Δ, n)``
+    → RollingBody and ``mass_factory(model, body)`` → MassProperties with M = 1 (default
+    :func:`superellipse_body` and :func:`lamina_mass`).
+    """
+
+    def __init__(self, b_values, delta_values, exponent, body_factory=None, mass_factory=None):
+        self.b = np.asarray(b_values, dtype=float).ravel()
+        self.delta = np.asarray(delta_values, dtype=float).ravel()
+        self.exponent, self.factories = float(exponent), (body_factory, mass_factory)
+
+    def __len__(self):
+        return self.b.size
+
+    def batched(self, out, mass_model, reference_speed, timings):
+        """No closed forms to batch: every index is left to :meth:`one`."""
+        return range(len(self))
+
+    def one(self, k, mass_model, reference_speed, timings):
+        """(values, failure) of body ``k`` (M = g = 1), as
+        :func:`~twodisk_ros.sweep.quantities.body_quantities`: the same stages and failure
+        lines (:func:`~twodisk_ros.sweep.quantities.run_stages`, wall times in ``timings``)."""
+        body_factory = self.factories[0] or superellipse_body
+        mass_factory = self.factories[1] or lamina_mass
+        values = dict.fromkeys(VARIABLES, math.nan)
+        b, d, n = float(self.b[k]), float(self.delta[k]), self.exponent
+        failure = shape_failure(b, d)
+        if failure:
+            return values, failure
+
+        def body_stage(state, values):
+            state['body'] = body = body_factory(b, d, n)
+            values['theta_max'] = float(body.theta_max)
+
+        return run_stages(values, body_stage,
+                          lambda state, values: _equilibria_stage(state, values, mass_model,
+                                                                  mass_factory),
+                          reference_speed, timings)
 
 
 def superellipse_body(b_over_a, delta_over_a, exponent):
@@ -73,7 +118,8 @@ def axis_inertia(body, props, u):
 
 
 def symmetric_family(body):
-    """stable_family of ``body`` from its symmetric equilibria (:data:`GENERAL_FAMILIES`):
+    """stable_family of ``body`` from its symmetric equilibria
+    (:data:`~twodisk_ros.sweep.variables.GENERAL_FAMILIES`):
     +1 a tip (θ = 0 or the turning point) stable, −1 the side vertices, 2 both, NaN neither."""
     from ..physics.stability.symmetric import symmetric_equilibria
     first, turning, side = symmetric_equilibria(body.lamina, body.delta, body.arrangement)
@@ -105,31 +151,3 @@ def _equilibria_stage(state, values, mass_model, mass_factory):
     values['oscillation_period'] = (float(period) if period is not None
                                     and math.isfinite(float(period)) else math.nan)
     values['rollover_speed'] = math.sqrt(2.0 * barrier / axis_inertia(body, props, eq.phase))
-
-
-def general_body_quantities(b_over_a, delta_over_a, exponent, mass_model='laminae',
-                            reference_speed=0.5, timings=None, body_factory=None,
-                            mass_factory=None):
-    """All sweep quantities of the body of exponent n (module docstring), M = g = 1.
-
-    Parameters and results as :func:`~twodisk_ros.sweep.quantities.body_quantities`, plus
-    ``exponent`` (n) and the two factories (default :func:`superellipse_body` and
-    :func:`lamina_mass`).
-    """
-    from .quantities import VARIABLES, run_stages, shape_failure
-    body_factory = body_factory or superellipse_body
-    mass_factory = mass_factory or lamina_mass
-    values = dict.fromkeys(VARIABLES, math.nan)
-    b, d, n = float(b_over_a), float(delta_over_a), float(exponent)
-    failure = shape_failure(b, d)
-    if failure:
-        return values, failure
-
-    def body_stage(state, values):
-        state['body'] = body = body_factory(b, d, n)
-        values['theta_max'] = float(body.theta_max)
-
-    return run_stages(values, body_stage,
-                      lambda state, values: _equilibria_stage(state, values, mass_model,
-                                                              mass_factory),
-                      reference_speed, timings)

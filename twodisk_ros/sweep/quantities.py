@@ -5,15 +5,15 @@ of a, times in units of √(a/g), angular speeds in units of √(g/a) (a = 1 m, 
 M = 1 kg in the library calls). In :func:`body_quantities` each quantity is one call of the
 physics library (:mod:`twodisk_ros.physics`): the scalar reference path, which agrees bitwise
 with the same call made directly (docs/sweeps.md lists the variables and their definitions).
-A sweep's tasks (:func:`~twodisk_ros.sweep.chunks.chunk_quantities`) compute the same
-quantities for a whole chunk at once as arrays (:mod:`~twodisk_ros.sweep.batch`), to ≤ 1e-10
-relative of the scalar path.
+A sweep's tasks (:func:`~twodisk_ros.sweep.chunks.quantities`) compute the same
+quantities for a whole chunk at once as arrays (:class:`~twodisk_ros.sweep.batch.Ellipses`),
+to ≤ 1e-10 relative of the scalar path, which computes the bodies the batch cannot finish.
 
 A body that cannot be built or whose computation fails is not an error of the sweep: its
 quantities from the failing stage on are NaN and ``failure`` says why, in one line.
 
 A chunk of exponent n != 2 (superellipse laminae) goes through the per-body general path
-(:mod:`~twodisk_ros.sweep.general`); n = 2 is the ellipse and the paths above, unchanged.
+(:mod:`~twodisk_ros.sweep.general`), which runs the same stages (:func:`run_stages`).
 """
 
 import math
@@ -29,11 +29,10 @@ from ..physics.bodies.cycle import RollingCycle, TWO_PI
 from ..physics.motion.dynamics import RollingDynamics
 from ..physics.stability.equilibria import NEUTRAL, STABLE
 from ..physics.mass.models import mass_properties
-from .request import ELLIPSE_EXPONENT
-from .variables import FAMILIES, MASS_MODELS, VARIABLES
+from .variables import VARIABLES
 
-__all__ = ['VARIABLES', 'FAMILIES', 'STAGES', 'MASS_MODELS', 'body_quantities', 'run_stages',
-           'shape_failure', 'contact_length_range', 'cycle_time', 'one_line']
+__all__ = ['VARIABLES', 'STAGES', 'body_quantities', 'run_stages', 'shape_failure',
+           'contact_length_range', 'cycle_time', 'one_line']
 
 #: Stages of one body, in order; a failing stage leaves its quantities and the later ones NaN.
 STAGES = ('body', 'cycle', 'equilibria', 'cycle_time', 'contact_length', 'contact_tables',

@@ -77,7 +77,7 @@ CORE_SECONDS_PER_BODY = 0.004
 #: at n = 2.0001 on an earlier build), 75-97 % in the certified equilibrium search
 #: (docs/sweeps.md "The exponent axis"); benchmarks/sweep_exponent.py measures it in make bench.
 GENERAL_CORE_SECONDS_PER_BODY = 10.0
-#: The exponent of the ellipse: the batched closed-form path (:mod:`~twodisk_ros.sweep.batch`).
+#: The exponent of the ellipse: its batched closed forms (:mod:`~twodisk_ros.sweep.batch`).
 ELLIPSE_EXPONENT = 2.0
 #: Allowed superellipse exponents n (|x/b|^n + |y/a|^n <= 1), inclusive.
 EXPONENT_RANGE = (2.0, 100.0)

@@ -1,8 +1,8 @@
 """A sweep over the family of bodies on Dask: tasks, results, progress and resume.
 
 The grid is cut into blocks (:class:`~twodisk_ros.sweep.spec.SweepSpec`), each of one
-exponent n; each block is one Dask task on a worker (the batched path for n = 2, the per-body
-general path otherwise: :func:`~twodisk_ros.sweep.chunks.chunk_quantities`). Where the
+exponent n; each block is one Dask task on a worker (:func:`~twodisk_ros.sweep.chunks.quantities`
+of the block's batch: the batched ellipse for n = 2, body by body otherwise). Where the
 results go depends on the output's suffix:
 
 - ``FILE.nc`` (small maps): a task (:func:`~twodisk_ros.sweep.chunks.timed_chunk`) sends
@@ -16,7 +16,7 @@ results go depends on the output's suffix:
   Workers and client must share the file system.
 
 The default chunk holds 128 bodies for NetCDF, ~0.4 s of work on one core with the batched
-path (:mod:`~twodisk_ros.sweep.batch`), and 1024 for Zarr
+path (:class:`~twodisk_ros.sweep.batch.Ellipses`), and 1024 for Zarr
 (far fewer tasks, files and reads on large maps), against ~1 ms of scheduler CPU and a few ms
 of client CPU per task (benchmarks/sweep_scaling.py; docs/sweeps.md "Scaling"). Every
 worker gets the plugin :class:`~twodisk_ros.sweep.worker.SweepWorkerSetup` first, which

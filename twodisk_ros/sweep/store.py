@@ -117,8 +117,7 @@ def write_block(path, block, b_values, delta_values, mass_model, reference_speed
     b_values, delta_values : 1-D arrays
         The grid values of those rows and columns.
     mass_model, reference_speed, exponent
-        As :func:`~twodisk_ros.sweep.chunks.chunk_quantities` (``exponent``: the block's
-        n).
+        As :func:`~twodisk_ros.sweep.chunks.timed_chunk` (``exponent``: the block's n).
 
     Returns
     -------
