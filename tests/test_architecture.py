@@ -179,11 +179,6 @@ PROTOCOLS = {'Lamina', 'SupportLamina', 'RollingBody', 'RollingDynamics', 'Scene
 #: names under which bodies, laminae, scenes, streams and solutions are passed around: a
 #: ``hasattr`` or a defaulted ``getattr`` on them asks what kind of thing it is
 SUBJECTS = {'body', 'lamina', 'scene', 'stream', 'solution', 'sol', 'candidate'}
-#: The switches still in the package, each (module, what): the aim is none. Removing one
-#: shrinks this list; adding one fails the test.
-KNOWN_SWITCHES = sorted([
-    ('physics/stability/equilibria.py', "isinstance ['EllipseBody']"),  # closed-form roots
-])
 
 
 def _kind_classes():
@@ -229,10 +224,9 @@ def type_switches():
     return sorted(found)
 
 
-def test_type_switches_only_shrink():
+def test_no_type_switches():
     """Outside their classes, bodies, laminae, scenes and their motions are not told apart
     by type or by the attributes they happen to have: each kind answers for itself through
-    its methods. The count is going to 0 (issue 29); those left are listed in
-    KNOWN_SWITCHES, and a new one fails here."""
+    its methods (issue 29: the count is 0; a new switch fails here)."""
     assert 'EllipseBody' in _kind_classes() and 'Ellipse' in _kind_classes()
-    assert type_switches() == KNOWN_SWITCHES
+    assert type_switches() == []

@@ -180,6 +180,11 @@ class Roller(Node):
         """The stamp (int ns) of global tick ``tick``."""
         return int(schedule.stamps(self._start_ns, [tick], self.settings.rate)[0])
 
+    @property
+    def motion_start_stamp(self):
+        """The stamp (int ns) of the first sample of the current motion (its last restart)."""
+        return self.stamp_of(self._motion_tick)
+
     def _metadata(self):
         """The recording's metadata: the run's (parameters, a points run's outline)."""
         metadata = self.simulation.run.metadata()

@@ -316,9 +316,11 @@ class EllipseBody(EllipseForms, RollingBody):
     0.75
     """
 
-    #: RollingBody: |ω_u| > 0 at every phase (an ellipse has no flat vertex: its curvature is
-    #: at least min(a, b)/max(a, b)² > 0, so the body turns as the contacts move)
-    turns_everywhere = True
+    turns_everywhere = True     #: RollingBody: |ω_u| > 0 everywhere (no flat vertex)
+
+    def solve_equilibria(self, search, closed_forms):
+        """RollingBody: eight equilibria at fixed angles (θ = 0, ±π/2, ±θ_max), closed forms."""
+        return closed_forms(self)
 
     def __init__(self, a, b, delta):
         a = _check_parameter('a', a, 0.0, math.inf, '> 0 (metres)')

@@ -129,6 +129,12 @@ class RollingBody(Drawable, abc.ABC):
     #: knows it (a body that may stop turning is stepped in the regularised time).
     turns_everywhere = False
 
+    def solve_equilibria(self, search, closed_forms):
+        """The equilibria by the solver that applies to this body: ``search(self)``, the roots
+        of dz_G/du with a certificate that none is missed (any body; stability/equilibria.py).
+        A body whose equilibria sit at known phases returns ``closed_forms(self)`` instead."""
+        return search(self)
+
     def flat_vertex_phases(self):
         """The phases u ∈ [0, 2π) (rad, sorted) where a contact sits on a flat vertex of the
         lamina (zero curvature): the body does not turn there (|ω_u| = 0) and z_G is flat to

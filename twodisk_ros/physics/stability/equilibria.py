@@ -13,7 +13,6 @@ import math
 import numpy as np
 
 from ..numerics.analytic import complex_step
-from ..bodies.ellipse import EllipseBody
 from .certified import (certified_roots, classify_root, max_rotation_rate,
                                  root_series_curvatures)
 from ..bodies.protocol import check_rolling_body
@@ -127,11 +126,10 @@ def equilibria(body, neutral_tolerance=NEUTRAL_TOLERANCE, certificate=False):
     list of Equilibrium, or (list, RootCertificate or None)
     """
     check_rolling_body(body)
-    if not isinstance(body, EllipseBody):
-        found, proof = _general_equilibria(body, neutral_tolerance)
-        return (found, proof) if certificate else found
-    found = _ellipse_equilibria(body, neutral_tolerance)
-    return (found, None) if certificate else found
+    found, proof = body.solve_equilibria(
+        lambda searched: _general_equilibria(searched, neutral_tolerance),
+        lambda known: (_ellipse_equilibria(known, neutral_tolerance), None))
+    return (found, proof) if certificate else found
 
 
 def _general_equilibria(body, neutral_tolerance):
