@@ -211,7 +211,7 @@ def report_lines(out):
     if out.get('scenes'):
         w('## Real time by scene\n')
         w('The same real-time run at 1 kHz (recording on, every topic subscribed) in every '
-          'scene, beside the flat free oloid (`config/oloid.yaml`, today\'s closed forms): '
+          'scene, beside the flat free oloid (`config/oloid.yaml`, the level ground\'s closed forms): '
           '`config/slope.yaml` (downhill, damped: DOP853), the same slope across and without '
           'damping (the closed forms of a conservative slope), damping and rolling resistance '
           'on the flat (DOP853), and `config/driven.yaml` under the speed drive and the torque '

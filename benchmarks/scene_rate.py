@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Samples per second of a scene's motion beside today's flat free table method (not a test).
+"""Samples per second of a scene's motion beside the flat free table method (not a test).
 
 Part of ``make bench`` (docs/benchmarks.md, section "Scenes"). The oloid (a = b = 0.1 m,
 Δ = 0.05 m, 1 kg laminae, config/oloid.yaml) from θ0 = 0.3 rad at 3 rad/s, sampled at 1 kHz
@@ -7,7 +7,7 @@ for 10 s of simulated time, in one run, each a fresh stream (its construction in
 scene's tables are built beforehand and their cost reported on its own), best of ``REPEATS``
 (the flat case's best over runs beside every scene):
 
-* the flat free scene: today's ``MotionStream`` (the table method's quadrature);
+* the flat free scene: the level ground's ``MotionStream`` (the table method's quadrature);
 * conservative scenes on a slope through ``scene_stream`` (the closed forms of
   physics/scenes/closed.py): rolling on down a 0.05 rad slope (quadrature with the drift
   composed) and swinging across a 0.2 rad slope (oscillation between turning points);

@@ -1,6 +1,6 @@
 """The roller in scenes: slope, drive, dissipation, commands, reset and pause.
 
-References are independent of the node's scene code: today's MotionStream (flat, free),
+References are independent of the node's scene code: the level ground's MotionStream (flat, free),
 the closed-form body geometry (|ω| = |ω_u(u)| u̇ and the contact points of EllipseBody), the
 rigid-body kinematics of the recorded poses (finite differences) and the documented rules
 (first-order lag of the speed drive, dE/dt = τ|ω| of the torque drive). Batch runs in process
@@ -87,7 +87,7 @@ def speed(u, u_dot):
 
 # -- batch ------------------------------------------------------------------------------------
 
-def test_flat_free_scene_is_todays_motion_bit_for_bit(context, tmp_path):
+def test_flat_free_scene_is_the_level_grounds_motion_bit_for_bit(context, tmp_path):
     explicit = record(context, tmp_path / 'e.mcap', duration=2.0, slope=0.0, heading0=0.0,
                       drive='none', rolling_resistance=0.0, damping=0.0)
     t_ns, u, u_dot = states(explicit)

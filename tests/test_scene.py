@@ -139,7 +139,7 @@ def test_default_scene_is_the_energy_integral():
     assert np.max(np.abs(times - t[checked]) * u_dot[checked]) < 1e-11
 
 
-def test_general_integrator_on_flat_ground_agrees_with_todays_quadrature():
+def test_general_integrator_on_flat_ground_agrees_with_the_quadrature():
     # a second method: DOP853 on the scene's tables against the closed-form quadrature;
     # measured 4e-10 rad over 10 s (u ≈ 30 rad) at rtol 1e-12 (DOP853 in τ on (u, w))
     dynamics = dynamics_of(OLOID)
@@ -152,7 +152,7 @@ def test_general_integrator_on_flat_ground_agrees_with_todays_quadrature():
     assert np.max(np.abs(samples.phase_rate - ref_u_dot)) < 1e-9
 
 
-def test_speed_drive_at_its_command_is_todays_kinematic_motion():
+def test_speed_drive_at_its_command_is_the_kinematic_motion():
     dynamics = dynamics_of(OLOID)
     u0, u_dot0 = start(dynamics)
     omega = u_dot0 * float(dynamics.angular_speed_per_phase(u0))
@@ -176,7 +176,7 @@ def test_energy_on_a_slope_is_conserved_from_poses(shape, slope, heading0, durat
     terms, samples, kin = run(shape, scene, np.linspace(0.01, duration, 30))
     scale = terms.dynamics.energy_scale
     assert np.max(np.abs(kin['energy'] - kin['energy'][0])) < ENERGY_TOL * scale
-    # the energy of a non-flat scene is not today's: the check would fail without the slope
+    # the energy of a non-flat scene is not the level ground's: the check would fail without the slope
     flat = kin['energy'] - MASS * GRAVITY * kin['g'][:, 2] + MASS * GRAVITY * \
         terms.dynamics.body.phase_height(samples.phase[2::5])
     assert np.ptp(flat) > 1e3 * ENERGY_TOL * scale

@@ -2,7 +2,7 @@
 
 References, none of them the code under test:
 
-* today's MotionStream (spectral quadrature of a periodic 1/|u̇|) for the drift quadrature at
+* the level ground's MotionStream (spectral quadrature of a periodic 1/|u̇|) for the drift quadrature at
   zero drift, and DOP853 at rtol 1e-13 (a second method) on a slope;
 * the small-oscillation period 2π √(m/V″) of a rest pose on the slope;
 * the same motion sampled at 10 ms and at 100 ms, by DOP853 and by the closed form: the
@@ -52,7 +52,7 @@ def start(dynamics, theta0=0.3, omega0=3.0):
 
 # ---------------------------------------------------------------------- closed forms
 
-def test_drift_quadrature_without_drift_is_todays_quadrature():
+def test_drift_quadrature_without_drift_is_the_level_grounds_quadrature():
     dynamics = dynamics_of()
     terms = SceneTerms(dynamics, Scene())
     u0, u_dot0 = start(dynamics)

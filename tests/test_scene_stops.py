@@ -13,7 +13,7 @@ References, none of them the module's own energy or forces:
 * the physical laws of the works: damping c |ω|², torque τ |ω|, rolling resistance
   μ_r ρ N |ω| with N from Newton (M (a_G − g)·n) and ρ the distance of G from AB, all from
   poses; the speed drive's first-order lag of |ω|;
-* today's MotionStream on flat ground; the ellipse's own scene motion for the double;
+* the level ground's MotionStream on flat ground; the ellipse's own scene motion for the double;
 * ContactForceModel.forces (its own column indices) for the scene's force coefficients.
 """
 
@@ -155,8 +155,8 @@ def test_speed_drive_follows_the_lag_through_the_stops(name):
 
 
 @pytest.mark.parametrize('name', ['superellipse', 'egg', 'degenerate'])
-def test_flat_scene_through_the_scene_integrator_is_todays_motion(name):
-    # DOP853 in τ on the scene's tables against today's MotionStream (closed-form
+def test_flat_scene_through_the_scene_integrator_is_the_level_grounds_motion(name):
+    # DOP853 in τ on the scene's tables against the level ground's MotionStream (closed-form
     # quadrature or SundmanSolution): G's position over 3 s, both at rtol 1e-12
     dynamics = dynamics_of(name)
     terms = SceneTerms(dynamics, Scene(gravity=GRAVITY))

@@ -2,7 +2,7 @@
 
 References, none of them the code under test:
 
-- n = 2 is today's sweep: its plane equals, bit for bit, the batched path called directly on
+- n = 2 is the batched ellipse sweep: its plane equals, bit for bit, the batched path called directly on
   the same blocks (what a task computed before the axis existed) and a sweep of n = 2 alone;
 - the per-body general path is exercised with a fake body factory (the ellipse EllipseBody
   and its closed-form mass model for every n): its values must then be the ellipse's, which
@@ -81,8 +81,8 @@ def _spec(exponents, chunk=3):
     return SweepSpec(B, D, chunk_size=chunk, exponent=np.array(exponents, dtype=float))
 
 
-def _today(spec):
-    """The n = 2 grid as today's tasks computed it: the ellipse batch of each block."""
+def _batched_reference(spec):
+    """The n = 2 grid as the batched tasks compute it: the ellipse batch of each block."""
     out = {name: np.full(spec.shape[1:], np.nan) for name in VARIABLES}
     out['failure'] = np.full(spec.shape[1:], '', dtype=object)
     for block in spec.blocks():
@@ -150,7 +150,7 @@ def test_bad_exponents_are_one_line_exit_2_before_dask(argv, words, tmp_path, ca
     assert 'Traceback' not in err and list(tmp_path.iterdir()) == []
 
 
-# -- n = 2 is today's sweep; the exponent round trips ---------------------------------------
+# -- n = 2 is the batched ellipse sweep; the exponent round trips ---------------------------------------
 
 @pytest.mark.parametrize('suffix', ['.nc', '.zarr'])
 def test_mixed_sweep_keeps_n2_bitwise_and_round_trips_the_exponent(client, fake_factories,
@@ -162,22 +162,22 @@ def test_mixed_sweep_keeps_n2_bitwise_and_round_trips_the_exponent(client, fake_
     assert dataset['exponent'].values.tolist() == exponents             # bitwise
     assert dataset['theta_max'].dims == ('exponent', 'b_over_a', 'delta_over_a')
     assert dataset['exponent'].attrs['long_name'] == 'n'
-    today = _today(spec)
+    reference = _batched_reference(spec)
     plane = dataset.sel(exponent=2.0)
     for name in (*VARIABLES, 'failure'):
-        np.testing.assert_array_equal(plane[name].values, today[name], err_msg=name)
+        np.testing.assert_array_equal(plane[name].values, reference[name], err_msg=name)
     alone = run_sweep(_spec([2.0]), client, progress=None).dataset
     for name in (*VARIABLES, 'failure'):
-        np.testing.assert_array_equal(alone[name].values[0], today[name], err_msg=name)
+        np.testing.assert_array_equal(alone[name].values[0], reference[name], err_msg=name)
     # an n = 2 grid alone has the variables' attributes of before the axis
     assert 'general_path' not in alone['stable_family'].attrs
     assert np.asarray(alone['stable_family'].attrs['flag_values']).tolist() == [-1, 0, 1]
     # the general path's planes (fake ellipse bodies) hold the ellipse's values
     for n in exponents[1:]:
         other = dataset.sel(exponent=n)
-        np.testing.assert_array_equal(other['failure'].values, today['failure'])
+        np.testing.assert_array_equal(other['failure'].values, reference['failure'])
         for name in set(VARIABLES) - OWN_MEANING:
-            np.testing.assert_allclose(other[name].values, today[name], rtol=GENERAL_RTOL,
+            np.testing.assert_allclose(other[name].values, reference[name], rtol=GENERAL_RTOL,
                                        atol=0.0, err_msg=f'{n} {name}')
         assert np.all(np.isnan(other['stability_margin'].values))
     assert 'NaN' in dataset['stability_margin'].attrs['general_path']
