@@ -1,0 +1,175 @@
+"""The MJCF (MuJoCo's XML) of a rolling body: its plates or hull, mass model, μ and contacts.
+
+Frames: MuJoCo's world is the package's world (Z up, the ground the plane z = 0); the body's
+frame is the package's body frame G e1 e2 e3 (docs/physics.md) with origin G, the centre of
+mass (:func:`~twodisk_ros.physics.mass.models.centred_on_mass`), so a rolling pose is copied
+into MuJoCo's free joint as it is (:mod:`~twodisk_ros.engine.state`).
+
+Geometry: the meshes of :func:`~twodisk_ros.model.mesh.mesh_parts`, one MuJoCo mesh geom per
+part: the two plates (``laminae``, ``custom``: closed prisms ``thickness`` thick over the
+rims) or the convex hull of the rims (``solid``). MuJoCo collides the convex hull of each
+mesh with the ground plane. Mass and inertia are the mass model's (``<inertial>`` about G,
+``inertiafromgeom`` off): the meshes only collide. Contacts are ``condim 3``: Coulomb
+friction μ in the contact plane, no torsional or rolling friction (the ideal body has none).
+
+Contact parameters (:class:`ContactParameters`), defaults from the convergence measurement
+of ``benchmarks/engine_convergence.py`` (the oloid of config/oloid.yaml handed over in an exact
+rolling state, G compared with the package's exact motion over 1 s; docs/physics.md#the-free-
+body-engine):
+
+``timestep`` 5e-4 s, ``time_constant`` 5e-3 s, ``damping_ratio`` 1
+    MuJoCo's soft contact is a damped spring reaching its reference in ``time_constant``
+    (solref); its static penetration is about g (time_constant/2π)²·(1 + …) ≈ 3.5e-5 m here
+    (the spike's 0.02 s default sank the oloid 0.5 mm and put G 2.4 mm off after 1 s).
+    MuJoCo needs time_constant ≥ 2 timestep to stay stable, hence the step.
+``integrator`` implicitfast, ``cone`` elliptic
+    implicitfast was the most accurate of Euler, implicitfast and RK4 at 5e-4 s in the spike
+    (/work/wt/spike31 ell.jsonl: 0.05 mm after 1 s against 0.10 and 0.08 mm); the pyramidal
+    cone let the contacts slip ~20x more (slip 4.8 mm/s against 0.23).
+``resolution`` 256, ``thickness`` 1e-3 of the body's size
+    The polygonal rims roll over their vertices: G's height ripples by size·(1 − cos π/n)
+    (7.5e-6 m for the oloid at n = 256); the plates' faces stand ``thickness``/2 off the
+    disk planes, which lowers G by up to that much where a plate's rim edge touches.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+from twodisk_ros.model.mesh import mesh_parts
+
+__all__ = ['ContactParameters', 'INTEGRATORS', 'CONES', 'engine_xml', 'build_model']
+
+#: MuJoCo integrators accepted (its names).
+INTEGRATORS = ('implicitfast', 'Euler', 'implicit', 'RK4')
+#: Friction cones accepted (its names).
+CONES = ('elliptic', 'pyramidal')
+#: Allowed time steps (s): finer steps are slower than useful, coarser ones unstable for
+#: contacts stiff enough to keep penetration below a tenth of a millimetre.
+TIMESTEP_RANGE = (1e-5, 5e-3)
+
+
+def _number(name, value, low, high, unit):
+    if isinstance(value, (bool, str, bytes)) or not np.isscalar(value):
+        raise ValueError(f'{name} must be a number of {unit} in [{low:g}, {high:g}], '
+                         f'got {value!r}')
+    value = float(value)
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ValueError(f'{name} must be a number of {unit} in [{low:g}, {high:g}], '
+                         f'got {value!r}')
+    return value
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """The engine's contact and integration settings (defaults: module docstring).
+
+    Attributes
+    ----------
+    mu : float
+        Coulomb friction coefficient (> 0, ≤ 10), the same as the rolling model's μ.
+    timestep : float
+        Integration step (s), in :data:`TIMESTEP_RANGE`.
+    time_constant : float
+        The soft contact's time constant (s, MuJoCo's solref[0]), ≥ 2 × timestep.
+    damping_ratio : float
+        Its damping ratio (MuJoCo's solref[1]; 1 critical), in (0, 10].
+    integrator, cone : str
+        One of :data:`INTEGRATORS` and :data:`CONES`.
+    resolution : int
+        Mesh resolution n of :func:`~twodisk_ros.model.mesh.mesh_parts` (multiple of 4, ≥ 8).
+    thickness : float
+        Plate thickness as a fraction of the body's size, in (0, 0.1].
+    """
+
+    mu: float = 0.5
+    timestep: float = 5e-4
+    time_constant: float = 5e-3
+    damping_ratio: float = 1.0
+    integrator: str = 'implicitfast'
+    cone: str = 'elliptic'
+    resolution: int = 256
+    thickness: float = 1e-3
+
+    def __post_init__(self):
+        if isinstance(self.mu, (bool, str, bytes)) or not np.isscalar(self.mu) \
+                or not (math.isfinite(float(self.mu)) and 0 < float(self.mu) <= 10):
+            raise ValueError(f'mu must be a friction coefficient in (0, 10], got {self.mu!r}')
+        step = _number('timestep', self.timestep, *TIMESTEP_RANGE, 's')
+        _number('time_constant', self.time_constant, 2 * step, 10.0, 's')
+        _number('damping_ratio', self.damping_ratio, 1e-3, 10.0, '(1 is critical)')
+        _number('thickness', self.thickness, 1e-6, 0.1, 'body sizes')
+        if self.integrator not in INTEGRATORS:
+            raise ValueError(f'integrator must be one of {", ".join(INTEGRATORS)}, '
+                             f'got {self.integrator!r}')
+        if self.cone not in CONES:
+            raise ValueError(f'cone must be one of {", ".join(CONES)}, got {self.cone!r}')
+        n = self.resolution
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) \
+                or n < 8 or n % 4 or n > 4096:
+            raise ValueError(f'resolution must be an integer multiple of 4 in [8, 4096], '
+                             f'got {n!r}')
+
+
+def _fmt(values):
+    return ' '.join(f'{x:.17g}' for x in np.ravel(values))
+
+
+def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
+    """The MJCF of ``body`` on the ground plane, as a string.
+
+    Parameters
+    ----------
+    body : RollingBody
+        Its body frame's origin must be the centre of mass (as from
+        :func:`~twodisk_ros.physics.mass.models.centred_on_mass`).
+    mass_properties : MassProperties
+        Mass (kg) and inertia about G (kg m², body frame); its ``model`` picks the geometry
+        (``solid``: the hull; otherwise the two plates).
+    gravity : float
+        g (m/s²), ≥ 0.
+    parameters : ContactParameters, optional
+        Defaults if None.
+
+    Returns
+    -------
+    str
+        The body is ``<body name="body">`` with one free joint ``free``; the plates are the
+        geoms ``disk_a``, ``disk_b`` (or the one geom ``hull``); the ground is ``ground``.
+    """
+    p = ContactParameters() if parameters is None else parameters
+    if not isinstance(p, ContactParameters):
+        raise ValueError(f'parameters must be a ContactParameters, got {type(p).__name__}')
+    gravity = _number('gravity', gravity, 0.0, 1e3, 'm/s^2')
+    if np.max(np.abs(mass_properties.center_of_mass)) > 1e-9 * body.size:
+        raise ValueError('mass_properties.center_of_mass must be G, the body-frame origin '
+                         '(use centred_on_mass)')
+    parts = mesh_parts(body, mass_properties, p.resolution, p.thickness * body.size)
+    meshes = ''.join(f'<mesh name="{name}" vertex="{_fmt(mesh.vertices)}"/>'
+                     for name, mesh in parts.items())
+    geoms = ''.join(f'<geom name="{name}" type="mesh" mesh="{name}"/>' for name in parts)
+    i = mass_properties.inertia
+    full = _fmt([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]])
+    return f"""<mujoco model="twodisk">
+  <compiler inertiafromgeom="false" angle="radian"/>
+  <option timestep="{p.timestep!r}" integrator="{p.integrator}" cone="{p.cone}"
+          gravity="0 0 {-gravity!r}"/>
+  <default><geom condim="3" friction="{float(p.mu)!r} 0 0"
+    solref="{p.time_constant!r} {p.damping_ratio!r}" margin="0"/></default>
+  <asset>{meshes}</asset>
+  <worldbody>
+    <geom name="ground" type="plane" size="0 0 1"/>
+    <body name="body">
+      <freejoint name="free"/>
+      <inertial pos="0 0 0" mass="{mass_properties.mass!r}" fullinertia="{full}"/>
+      {geoms}
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def build_model(body, mass_properties, gravity=9.81, parameters=None):
+    """MuJoCo's compiled ``MjModel`` of :func:`engine_xml` (same arguments)."""
+    import mujoco
+    return mujoco.MjModel.from_xml_string(engine_xml(body, mass_properties, gravity, parameters))

@@ -1,0 +1,110 @@
+"""Stepping the engine from a state, sampled at given times, with each disk's contact status.
+
+Contacts are attributed to the disks by where they are on the body: a contact point p (body
+frame) belongs to disk 1 (contact A, plane x3 = 0) if |p·e3| ≤ |p·e1|, else to disk 2
+(contact B, plane x1 = 0) — the same rule for the plates and for the hull, whose contacts
+are at the rims' vertices. Per sample and disk: whether it touches, its total normal force
+(N, MuJoCo's contact force) and the largest slip speed (m/s) of the body's material at its
+contact points along the ground (NaN where it does not touch).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import build_model
+from .state import quaternion_matrix
+
+__all__ = ['Engine', 'EngineSamples']
+
+
+@dataclass(frozen=True)
+class EngineSamples:
+    """The engine's motion at the sample times (arrays over samples first).
+
+    time (s); qpos (n, 7), qvel (n, 6) (:mod:`~twodisk_ros.engine.state`); touching (n, 2)
+    bool, normal_force (n, 2) N, slip_speed (n, 2) m/s (NaN where not touching), for
+    (disk 1 / A, disk 2 / B).
+    """
+
+    time: np.ndarray
+    qpos: np.ndarray
+    qvel: np.ndarray
+    touching: np.ndarray
+    normal_force: np.ndarray
+    slip_speed: np.ndarray
+
+
+class Engine:
+    """MuJoCo's free body of one body, mass model, g and :class:`ContactParameters`.
+
+    Parameters as in :func:`~twodisk_ros.engine.model.engine_xml`.
+    """
+
+    def __init__(self, body, mass_properties, gravity=9.81, parameters=None):
+        import mujoco
+        self._mujoco = mujoco
+        self.model = build_model(body, mass_properties, gravity, parameters)
+        self.data = mujoco.MjData(self.model)
+        self.timestep = float(self.model.opt.timestep)
+        self._ground = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, 'ground')
+
+    def set_state(self, qpos, qvel, time=0.0):
+        """Start from the free joint's (qpos, qvel) at ``time`` (s); the solver's warm start
+        is cleared (a state from outside has none)."""
+        d = self.data
+        d.qpos[:] = qpos
+        d.qvel[:] = qvel
+        d.time = float(time)
+        d.qacc_warmstart[:] = 0.0
+        self._mujoco.mj_forward(self.model, d)
+
+    def contacts(self):
+        """(touching (2,), normal force (2,) N, slip speed (2,) m/s) now (module docstring)."""
+        mujoco, d = self._mujoco, self.data
+        touching = np.zeros(2, dtype=bool)
+        force = np.zeros(2)
+        slip = np.full(2, np.nan)
+        rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
+        g, v, omega = d.qpos[:3], d.qvel[:3], rotation @ d.qvel[3:6]
+        f6 = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.efc_address < 0:       # excluded or beyond the margin: no force
+                continue
+            mujoco.mj_contactForce(self.model, d, i, f6)
+            p = rotation.T @ (c.pos - g)
+            disk = 0 if abs(p[2]) <= abs(p[0]) else 1
+            frame = c.frame.reshape(3, 3)            # rows: normal, two tangents (world)
+            velocity = v + np.cross(omega, c.pos - g)
+            tangential = velocity - (velocity @ frame[0]) * frame[0]
+            touching[disk] = True
+            force[disk] += f6[0]
+            speed = float(np.linalg.norm(tangential))
+            slip[disk] = speed if np.isnan(slip[disk]) else max(slip[disk], speed)
+        return touching, force, slip
+
+    def sample(self, times):
+        """Step to each of ``times`` (s, non-decreasing, ≥ the current time), sampling there.
+
+        Each sample is taken at the last step not after its time (steps of ``timestep``).
+
+        Returns
+        -------
+        EngineSamples
+        """
+        times = np.asarray(times, dtype=float)
+        if times.ndim != 1 or np.any(np.diff(times) < 0) \
+                or (times.size and times[0] < self.data.time - 0.5 * self.timestep):
+            raise ValueError('times must be a non-decreasing 1-D array from the current time on')
+        mujoco, d, m = self._mujoco, self.data, self.model
+        n = times.size
+        qpos, qvel = np.empty((n, 7)), np.empty((n, 6))
+        touching, force, slip = np.empty((n, 2), dtype=bool), np.empty((n, 2)), np.empty((n, 2))
+        for k, t in enumerate(times):
+            steps = int(np.floor((t - d.time) / self.timestep + 1e-9))
+            for _ in range(max(steps, 0)):
+                mujoco.mj_step(m, d)
+            qpos[k], qvel[k] = d.qpos, d.qvel
+            touching[k], force[k], slip[k] = self.contacts()
+        return EngineSamples(times, qpos, qvel, touching, force, slip)
