@@ -13,23 +13,28 @@ mesh with the ground plane. Mass and inertia are the mass model's (``<inertial>`
 friction μ in the contact plane, no torsional or rolling friction (the ideal body has none).
 
 Contact parameters (:class:`ContactParameters`), defaults from the convergence measurement
-of ``benchmarks/engine_convergence.py`` (the oloid of config/oloid.yaml handed over in an exact
-rolling state, G compared with the package's exact motion over 1 s; docs/physics.md#the-free-
-body-engine):
+of ``benchmarks/engine_convergence.py`` (the oloid of config/oloid.yaml handed over in its
+exact rolling state at θ0 = 0.3 rad, ω0 = 3 rad/s, G compared with the package's exact motion
+over 1 s, one parameter changed at a time; docs/physics.md#the-free-body-engine). With the
+defaults G ends 2.9 mm off the exact path (of 0.23 m travelled), almost all of it a lag along
+the path: the polygonal plates lose energy at each vertex they roll over (2.7 mJ of 0.78 J
+after 1 s), so the error falls slowly with n (64: 14 mm, 128: 6.2, 256: 3.6, 512: 2.9,
+1024: 2.2, 2048: 1.5) and hardly with the step (5e-4 → 1e-4 s: 3.6 → 3.2 mm at n = 256).
 
+``resolution`` 512
+    Mesh resolution n of the plates' rims: the limiting parameter (above); 512 is the
+    largest n that costs < 0.1 s of engine per simulated second (0.06 s measured).
 ``timestep`` 5e-4 s, ``time_constant`` 5e-3 s, ``damping_ratio`` 1
     MuJoCo's soft contact is a damped spring reaching its reference in ``time_constant``
-    (solref); its static penetration is about g (time_constant/2π)²·(1 + …) ≈ 3.5e-5 m here
-    (the spike's 0.02 s default sank the oloid 0.5 mm and put G 2.4 mm off after 1 s).
-    MuJoCo needs time_constant ≥ 2 timestep to stay stable, hence the step.
+    (solref); G sinks 1.4e-5 m into the ground. Softer contacts are worse (1e-2 s: 6.4 mm,
+    2e-2 s, MuJoCo's default: 8.4 mm at n = 256); stiffer ones need a finer step (MuJoCo
+    needs time_constant ≥ 2 timestep) and gain little (2.5e-4 s, 1e-3 s: 4.3 mm).
 ``integrator`` implicitfast, ``cone`` elliptic
-    implicitfast was the most accurate of Euler, implicitfast and RK4 at 5e-4 s in the spike
-    (/work/wt/spike31 ell.jsonl: 0.05 mm after 1 s against 0.10 and 0.08 mm); the pyramidal
-    cone let the contacts slip ~20x more (slip 4.8 mm/s against 0.23).
-``resolution`` 256, ``thickness`` 1e-3 of the body's size
-    The polygonal rims roll over their vertices: G's height ripples by size·(1 − cos π/n)
-    (7.5e-6 m for the oloid at n = 256); the plates' faces stand ``thickness``/2 off the
-    disk planes, which lowers G by up to that much where a plate's rim edge touches.
+    Euler and RK4 differ by < 0.2 mm (RK4 7x slower); the pyramidal cone lets the contacts
+    creep 3x faster (slip 2.3 mm/s against 0.8).
+``thickness`` 1e-3 of the body's size
+    The plates' faces stand ``thickness``/2 off the disk planes (G lower by up to that
+    where a rim edge touches); 1e-2 … 1e-4 change the error by < 0.9 mm.
 """
 
 from dataclasses import dataclass
@@ -89,7 +94,7 @@ class ContactParameters:
     damping_ratio: float = 1.0
     integrator: str = 'implicitfast'
     cone: str = 'elliptic'
-    resolution: int = 256
+    resolution: int = 512
     thickness: float = 1e-3
 
     def __post_init__(self):
