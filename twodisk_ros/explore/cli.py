@@ -118,7 +118,11 @@ def _values(pairs):
             raise _Refusal(f'-p {pair}: the node has no parameter {name!r}')
         if BY_NAME[name].read_only:
             raise _Refusal(f'-p {pair}: {name} is not used by the page')
-        values[name] = parse_value(text, name, f'-p {pair}').value
+        value = parse_value(text, name, f'-p {pair}')
+        if BY_NAME[name].kind is float and type(value.value) is int:   # as the node says it
+            raise _Refusal(f'-p {pair}: {name} is a double: write {float(value.value)!r}, not '
+                           f'{value.text} (a double needs a decimal point)')
+        values[name] = value.value
     return values
 
 
