@@ -59,8 +59,9 @@ class Chromium:
                 if pages or time.monotonic() > deadline:
                     break
                 time.sleep(0.05)
-            self.socket = connect(pages[0]['webSocketDebuggerUrl'], max_size=None,
-                                  open_timeout=timeout, proxy=None)
+            self._connection = connect(pages[0]['webSocketDebuggerUrl'], max_size=None,
+                                       open_timeout=timeout, proxy=None)
+            self.socket = self._connection.__enter__()
             self.next_id = 0
             self.width, self.height = width, height
             self.call('Emulation.setDeviceMetricsOverride', width=width, height=height,
@@ -142,9 +143,10 @@ class Chromium:
             % int(1000 * seconds), timeout=seconds + 30)
 
     def close(self):
-        socket = getattr(self, 'socket', None)
-        if socket is not None:
-            socket.close()
+        connection = getattr(self, '_connection', None)
+        if connection is not None:
+            self._connection = None
+            connection.__exit__(None, None, None)
         if self.process.poll() is None:
             os.killpg(self.process.pid, 15)     # its own session: the browser's every process
             try:

@@ -51,7 +51,7 @@ def slider_range(name, settings):
               'damping': (0.0, 10 * settings.mass * size ** 2),
               'rolling_resistance': (0.0, 0.2), 'friction': (0.0, 2.0)}
     p = BY_NAME[name]
-    low, high = ranges.get(name, (p.low, p.high))
+    low, high = (float(f'{x:.12g}') for x in ranges.get(name, (p.low, p.high)))
     steps = {'a': step, 'b': step, 'delta': step, 'exponent': 0.1, 'damping': high / 200}
     return low, high, steps.get(name, 0.01 if high - low <= 7 else 0.1)
 
@@ -75,6 +75,7 @@ class Explorer:
         self.shown = None            #: the last Frame drawn
         self.shown_time = None       #: time.monotonic() when it was sent
         self.refused = None          #: the last refusal (the node's one line)
+        self.attempted = None        #: (name, value) of the last change tried
         self.frames = 0
         server.scene.set_up_direction('+z')
         self.scene = Scene3D(server, motion)
@@ -204,7 +205,7 @@ class Explorer:
         with self.lock:
             old = self.motion.settings
             reason = self.motion.change(name, value)
-            self.refused = reason
+            self.refused, self.attempted = reason, (name, value)
             if reason is None:
                 body_changed = (self.motion.body is not self.scene_body
                                 or old.mass_model != self.motion.settings.mass_model
@@ -250,9 +251,12 @@ class Explorer:
         self.status.content = self._status_text()
 
     # -- the loop --------------------------------------------------------------------------
-    def step(self, wall_dt):
-        """Advance by ``wall_dt`` seconds of the show (× speed) and draw; return the Frame."""
+    def step(self, wall_dt, paused_too=False):
+        """Advance by ``wall_dt`` seconds of the show (× speed) and draw; return the Frame
+        (None if paused, unless ``paused_too``)."""
         with self.lock:
+            if not (self.playing or paused_too):
+                return None
             if self._scene_body is None:
                 self._scene_body = self.motion.body
             dt = wall_dt * self.speed

@@ -122,6 +122,9 @@ class Scene3D:
         # software GL draws the environment map and shadow maps 6x slower (docs/benchmarks.md)
         self.scene.configure_environment_map(None)
         self.scene.configure_default_lights(True, cast_shadow=False)
+        # without the environment map a face turned from the lights is black: an ambient
+        # light keeps both disks' colours on every side
+        self.scene.add_light_ambient('/ambient', intensity=1.2)
         self.world = self.scene.add_frame('/world', show_axes=False)
         self.body_node = None
         self.meshes = []
