@@ -43,9 +43,11 @@ def rotation(q):
                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
-def project(points, camera, width, height):
+def project(points, camera, canvas):
     """Pixel (column, row) of world points through a pinhole camera looking from
-    ``position`` at ``look_at`` with ``up``, vertical field of view ``fov`` (rad)."""
+    ``position`` at ``look_at`` with ``up``, vertical field of view ``fov`` (rad), on a
+    canvas (left, top, width, height) in px."""
+    left, top, width, height = canvas
     position, look_at, up, fov = camera
     forward = (look_at - position) / np.linalg.norm(look_at - position)
     right = np.cross(forward, up)
@@ -54,8 +56,8 @@ def project(points, camera, width, height):
     d = np.asarray(points) - position
     depth = d @ forward
     focal = 0.5 * height / math.tan(0.5 * fov)
-    return np.stack([0.5 * width + focal * (d @ right) / depth,
-                     0.5 * height - focal * (d @ upward) / depth], axis=1)
+    return np.stack([left + 0.5 * width + focal * (d @ right) / depth,
+                     top + 0.5 * height - focal * (d @ upward) / depth], axis=1)
 
 
 def silhouette(triangles_px, width, height, margin=MARGIN):
@@ -78,12 +80,19 @@ def body_triangles(parts, frame, shift):
                            for m in parts.values()])
 
 
-def check_drawn(image, parts, frame, shift, camera, usable, overlay=None):
+def _canvas(browser):
+    """(left, top, width, height) of the scene's canvas (px)."""
+    return browser.evaluate("(() => { const r = document.querySelector('canvas')"
+                            ".getBoundingClientRect(); return [r.left, r.top, r.width, "
+                            "r.height]; })()")
+
+
+def check_drawn(image, parts, frame, shift, camera, canvas, usable, overlay=None):
     """The body's colour fills its projected silhouette and hardly appears elsewhere (the
     silhouette's outline drawn in green over the screenshot at ``overlay``)."""
     height, width = image.shape[:2]
     triangles = body_triangles(parts, frame, shift)
-    px = project(triangles.reshape(-1, 3), camera, width, height).reshape(-1, 3, 2)
+    px = project(triangles.reshape(-1, 3), camera, canvas).reshape(-1, 3, 2)
     hull, grown = silhouette(px, width, height)
     if overlay is not None:
         from PIL import Image
@@ -92,9 +101,13 @@ def check_drawn(image, parts, frame, shift, camera, usable, overlay=None):
         marked[hull & ~binary_erosion(hull)] = (0, 255, 0)
         Image.fromarray(marked).save(overlay)
     seen = body_pixels(image) & usable
-    inside = (seen & grown).sum()
+    # the traces of A and B share the disks' colours: lines a few px wide, which an opening
+    # by a 5 x 5 square removes (the body's projection is wider except where a plate is
+    # seen edge-on, inside the silhouette anyway)
+    from scipy.ndimage import binary_opening
+    bulk = binary_opening(seen, structure=np.ones((5, 5), dtype=bool))
     assert (seen & hull).sum() > 0.9 * (hull & usable).sum(), (seen.sum(), hull.sum())
-    assert inside >= 0.95 * seen.sum(), (inside, seen.sum())
+    assert (bulk & grown).sum() >= 0.98 * bulk.sum(), ((bulk & grown).sum(), bulk.sum())
     return hull, seen
 
 
@@ -165,14 +178,14 @@ def test_the_body_is_drawn_where_its_pose_projects_and_it_moves(live):
     time.sleep(0.8)
     first, frame1, shift1 = _paused_shot(explorer, browser, shots / 'explore_live_1.png')
     usable = _usable(browser, *first.shape[:2])
-    camera = _camera(server)
+    camera, canvas = _camera(server), _canvas(browser)
     parts = explorer.scene.parts
-    hull1, seen1 = check_drawn(first, parts, frame1, shift1, camera, usable,
+    hull1, seen1 = check_drawn(first, parts, frame1, shift1, camera, canvas, usable,
                                shots / 'explore_live_1_projected.png')
     explorer.toggle()
     time.sleep(0.7)
     second, frame2, shift2 = _paused_shot(explorer, browser, shots / 'explore_live_2.png')
-    hull2, seen2 = check_drawn(second, parts, frame2, shift2, camera, usable)
+    hull2, seen2 = check_drawn(second, parts, frame2, shift2, camera, canvas, usable)
     assert frame2.t[-1] > frame1.t[-1] + 0.3
     # it moved: the projected silhouettes differ, and so do the drawn bodies
     assert (hull1 ^ hull2).sum() > 0.05 * hull1.sum()
@@ -233,43 +246,39 @@ def test_a_refused_value_shows_the_nodes_reason_and_the_motion_goes_on(live):
 
 
 def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
-    """The lesson's last frame (its player moved to the end) against the projection of the
-    same frame of the node's run; no request leaves the file."""
+    """The lesson, paused, against the projection of the frame of the node's run that its
+    player shows (frame k is the scene at k / EXPORT_FPS s, its player's time to 1 ms); no
+    request leaves the file."""
     from twodisk_ros.explore.cli import EXPORT_FPS, export
     from twodisk_ros.explore.motion import LiveMotion
-    from twodisk_ros.explore.scene3d import camera_for
+    from twodisk_ros.explore.scene3d import MESH_RESOLUTION, camera_for
+    from twodisk_ros.model.mesh import mesh_parts
     explorer, browser, server, shots = live
     settings = explorer.motion.settings
-    seconds = 2.0
     path = tmp_path / 'lesson.html'
-    export(LiveMotion(settings), path, seconds=seconds)
-    reference = LiveMotion(settings)
-    frames = int(round(seconds * EXPORT_FPS))
-    for _ in range(frames):
-        frame = reference.advance(1.0 / EXPORT_FPS, samples=4)
+    export(LiveMotion(settings), path, seconds=3.0)
     browser.goto(path.as_uri())
-    browser.wait_for("document.querySelector('[role=slider]') !== null")
+    browser.wait_for("document.querySelector('.tabler-icon-player-pause-filled') !== null")
     _dismiss(browser)
+    time.sleep(1.0)
     browser.evaluate("document.querySelector('.tabler-icon-player-pause-filled')"
                      ".closest('button').click()")
-    browser.evaluate("document.querySelector('[role=slider]').focus()")
-    browser.key('End', 'End', 35)
-    browser.wait_for("Number(document.querySelector('[role=slider]')"
-                     f".getAttribute('aria-valuenow')) >= {seconds - 1e-6}")
     time.sleep(0.6)
     image = browser.screenshot(shots / 'explore_lesson.png')
-    size = float(max(settings.a, settings.b))
+    seconds = float(browser.evaluate(          # the player's time (s, to 1 ms)
+        "document.querySelector('.mantine-Slider-root input[type=hidden]').value"))
+    reference = LiveMotion(settings)
+    for _ in range(int(math.floor(seconds * EXPORT_FPS + 1e-9)) + 1):
+        frame = reference.advance(1.0 / EXPORT_FPS, samples=4)
     position, look_at = camera_for(reference.body.size)
     camera = (position, look_at, np.array([0.0, 0.0, 1.0]), math.radians(75.0))
     usable = np.ones(image.shape[:2], dtype=bool)
     usable[-45:] = False                               # the player's bar
     usable[-115:, :70] = False                         # the axes gizmo
-    from twodisk_ros.model.mesh import mesh_parts
-    from twodisk_ros.explore.scene3d import MESH_RESOLUTION
     parts = mesh_parts(reference.body, settings.mass_model, resolution=MESH_RESOLUTION)
     g = frame.position_g[-1]
-    shift = -(g - g[2] * np.array([0.0, 0.0, 1.0]))
-    check_drawn(image, parts, frame, shift, camera, usable)
+    check_drawn(image, parts, frame, -(g - g[2] * np.array([0.0, 0.0, 1.0])), camera,
+                _canvas(browser), usable,
+                shots / 'explore_lesson_projected.png')
     resources = browser.evaluate("performance.getEntriesByType('resource').map(e => e.name)")
     assert all(name.startswith(('file:', 'data:', 'blob:')) for name in resources), resources
-    assert size > 0
