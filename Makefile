@@ -79,9 +79,11 @@ figures: venv
 	$(PY) -m twodisk_ros.plotting.figures --out docs/figures --overwrite
 	$(PY) -m twodisk_ros.plotting.contact_forces --out docs/figures --overwrite
 
-## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
-bench: venv
+## Benchmarks: writes docs/benchmarks.md and the work-precision plot; then the page's section
+## of docs/benchmarks.md (twodisk-explore in headless Chromium).
+bench: venv chromium
 	$(PY) benchmarks/run_all.py --overwrite
+	$(PY) benchmarks/explore_rate.py
 
 clean:
 	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info

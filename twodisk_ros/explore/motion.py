@@ -110,8 +110,9 @@ class LiveMotion:
         return cycle_curve(self.simulation.dynamics)
 
     def equilibria(self):
-        """[(u (rad), z_G (m), stable?)] of the flat ground (the node's list)."""
-        return [(float(eq.phase), float(eq.height), eq.stability == 'stable')
+        """[(u (rad), z_G (m), stability)] of the flat ground (the node's list; stability
+        'stable', 'unstable' or 'neutral')."""
+        return [(float(eq.phase), float(eq.height), eq.stability)
                 for eq, _ in self.simulation.dynamics.equilibria_with_periods()]
 
     # -- changes ---------------------------------------------------------------------------
@@ -209,7 +210,7 @@ class RecordedMotion:
         return cycle_curve(self.description.dynamics)
 
     def equilibria(self):
-        return [(float(eq.phase), float(eq.height), eq.stability == 'stable')
+        return [(float(eq.phase), float(eq.height), eq.stability)
                 for eq, _ in self.description.dynamics.equilibria_with_periods()]
 
     def change(self, name, value):

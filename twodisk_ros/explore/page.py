@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from ..model import palette
-from ..run.parameters import BY_NAME
+from ..run.parameters import BY_NAME, SHAPE_ONLY
 from .motion import CONTROLLED
 from .scene3d import Scene3D, camera_for, rgb255
 
@@ -35,6 +35,8 @@ SPEEDS = ('0.1', '0.25', '0.5', '1', '2', '5', '10')
 TRACE_RATE = 100.0
 #: Seconds of N_A, N_B, μ_required shown.
 WINDOW = 5.0
+#: The equilibria's marks on the z_G curve: stability → colour.
+STABILITY = {'stable': palette.AB, 'unstable': palette.FORCE_PULLING, 'neutral': palette.HULL}
 #: Plots and traces are sent this many times a second.
 PLOT_RATE = 10.0
 
@@ -76,6 +78,8 @@ class Explorer:
         self.shown_time = None       #: time.monotonic() when it was sent
         self.refused = None          #: the last refusal (the node's one line)
         self.attempted = None        #: (name, value) of the last change tried
+        self.changed_at = None       #: time.monotonic() of the last change tried
+        self.restart_shown = None    #: time.monotonic() of the first frame after a restart
         self.frames = 0
         server.scene.set_up_direction('+z')
         self.scene = Scene3D(server, motion)
@@ -93,7 +97,7 @@ class Explorer:
     def _gui(self):
         gui = self.server.gui
         m = self.motion
-        with gui.add_folder('Run'):
+        with gui.add_folder('Run', order=0):
             self.play_button = gui.add_button('Pause')
             self.reset_button = gui.add_button('Reset')
             self.speed_control = gui.add_dropdown('speed (x)', SPEEDS,
@@ -104,8 +108,8 @@ class Explorer:
         self.speed_control.on_update(lambda _: self.set_speed(float(self.speed_control.value)))
         groups = (('Body', CONTROLLED[:8]), ('Motion', CONTROLLED[8:11]),
                   ('Scene', CONTROLLED[11:]))
-        for title, names in groups:
-            with gui.add_folder(title, expand_by_default=title != 'Scene'):
+        for order, (title, names) in enumerate(groups, start=10):
+            with gui.add_folder(title, order=order, expand_by_default=title != 'Scene'):
                 for name in names:
                     self.controls[name] = self._control(name, m.settings)
                 if title == 'Scene':
@@ -115,6 +119,14 @@ class Explorer:
         for name, handle in self.controls.items():
             handle.on_update(lambda _, name=name: self._changed(name))
             handle.disabled = not m.live
+        self._shape_controls()
+
+    def _shape_controls(self):
+        """Show the parameters the shape reads (exponent: superellipse; egg_asymmetry: egg)."""
+        shape = self.motion.settings.shape
+        for name, owner in SHAPE_ONLY.items():
+            if name in self.controls:
+                self.controls[name].visible = shape == owner
 
     def _control(self, name, settings):
         gui, p, value = self.server.gui, BY_NAME[name], getattr(settings, name)
@@ -131,42 +143,46 @@ class Explorer:
         marks = m.equilibria()
         self._u = np.unique(np.concatenate([u, [e[0] for e in marks]]))
         self._z = np.interp(self._u, u, z)
-        self._stable = np.full(len(self._u), np.nan)
-        self._unstable = np.full(len(self._u), np.nan)
-        for phase, height, stable in marks:
+        self._marks = {kind: np.full(len(self._u), np.nan) for kind in STABILITY}
+        for phase, height, stability in marks:
             k = int(np.argmin(abs(self._u - phase)))
-            (self._stable if stable else self._unstable)[k] = height
+            self._marks[stability][k] = height
         point = {'show': True, 'size': 9}
         series = ({'label': 'u (rad)'},
                   {'label': 'z_G (m)', 'stroke': palette.G, 'width': 2},
-                  {'label': 'stable', 'stroke': palette.AB, 'width': 0, 'points': point},
-                  {'label': 'unstable', 'stroke': palette.FORCE_PULLING, 'width': 0,
-                   'points': point},
+                  *({'label': kind, 'stroke': colour, 'width': 0, 'points': point}
+                    for kind, colour in STABILITY.items()),
                   {'label': 'now', 'stroke': palette.B, 'width': 0,
                    'points': {'show': True, 'size': 12}})
         if getattr(self, 'cycle_plot', None) is not None:
             for handle in (self.cycle_plot, self.force_plot, self.mu_plot):
                 handle.remove()
-        self.cycle_plot = gui.add_uplot(self._cycle_data(None), series, aspect=1.8,
-                                        title='z_G over the cycle (flat ground)')
+        low, high = float(z.min()), float(z.max())
+        pad = max(0.1 * (high - low), 0.01 * self.scene.size)
+        self.cycle_plot = gui.add_uplot(
+            self._cycle_data(None), series, aspect=1.8, order=1,
+            scales={'x': {'time': False}, 'y': {'range': [low - pad, high + pad]}},
+            title='z_G over the cycle (flat ground)')
         empty = (np.zeros(2), np.zeros(2), np.zeros(2))
         self.force_plot = gui.add_uplot(
             empty, ({'label': 't (s)'}, {'label': 'N_A (N)', 'stroke': palette.A, 'width': 2},
                     {'label': 'N_B (N)', 'stroke': palette.B, 'width': 2}),
-            aspect=1.8, title='normal forces N_A, N_B')
+            aspect=1.8, order=2, scales={'x': {'time': False}},
+            title='normal forces N_A, N_B')
         self.mu_plot = gui.add_uplot(
             empty, ({'label': 't (s)'}, {'label': 'mu_required', 'stroke': palette.MU,
                                          'width': 2},
                     {'label': 'friction mu', 'stroke': palette.FORCE_PULLING, 'width': 1,
                      'dash': [6, 4]}),
-            aspect=1.8, title='friction needed and available')
+            aspect=1.8, order=3, scales={'x': {'time': False}},
+            title='friction needed and available')
 
     def _cycle_data(self, phase):
         now = np.full(len(self._u), np.nan)
         if phase is not None and math.isfinite(phase):
             k = int(np.argmin(abs(self._u - phase % (2 * math.pi))))
             now[k] = self._z[k]
-        return (self._u, self._z, self._stable, self._unstable, now)
+        return (self._u, self._z, *self._marks.values(), now)
 
     def _status_text(self):
         m = self.motion
@@ -203,6 +219,7 @@ class Explorer:
     def change(self, name, value):
         """Apply a control's value; return None or the node's reason (also shown)."""
         with self.lock:
+            self.changed_at = time.monotonic()
             old = self.motion.settings
             reason = self.motion.change(name, value)
             self.refused, self.attempted = reason, (name, value)
@@ -246,6 +263,8 @@ class Explorer:
         else:
             self.scene.traces.clear()
         self._scene_body = self.motion.body
+        self._shape_controls()
+        self.restart_shown = None
         self._history = None
         self._next_plot = 0.0
         self.status.content = self._status_text()
@@ -270,6 +289,8 @@ class Explorer:
                 self._next_plot = now + 1.0 / PLOT_RATE
                 self._plots(frame)
             self.shown, self.shown_time = frame, time.monotonic()
+            if self.restart_shown is None:
+                self.restart_shown = self.shown_time
             self.frames += 1
             return frame
 
