@@ -113,6 +113,48 @@ def test_the_cycle_curve_has_its_minima_at_the_stable_equilibria(oloid):
                   < (z.max() - z.min()) * (2 * math.pi / (len(u) - 1)) ** 2), k
 
 
+@pytest.fixture(scope='module')
+def served():
+    """A viser server on a free loopback port (no browser)."""
+    from twodisk_ros.explore.cli import _server, stop_server
+    server = _server('127.0.0.1', 0)
+    yield server
+    stop_server(server)
+
+
+def test_the_page_says_the_nodes_words_when_the_model_stops_holding(oloid, served):
+    """friction 0.02: the oloid slips at once; the status line quotes the node's
+    ValidityReport of the same run (its Simulation sampled at the page's times)."""
+    from twodisk_ros.explore.page import Explorer
+    settings = oloid.with_values(friction=0.02).checked()
+    explorer = Explorer(served, LiveMotion(settings))
+    frames = [explorer.step(0.05) for _ in range(4)]
+    node = Simulation(settings)
+    node.sample(np.concatenate([f.t for f in frames]), forces=True)
+    assert node.invalid is not None and 'slip' in node.invalid.reason
+    assert f'outside the rolling model:** {node.invalid.reason}' in explorer.status.content
+    assert explorer.change('friction', 0.5) is None
+    explorer.step(0.05)
+    assert 'outside' not in explorer.status.content
+
+
+@pytest.mark.parametrize('slope', [0.0, 0.3, -0.45])
+def test_the_ground_is_the_nodes_plane(oloid, served, slope):
+    """The drawn ground's normal (its rotation applied to z) is the node's ground normal
+    (sin slope, 0, cos slope), and the shift keeps G's foot on it at the origin."""
+    from twodisk_ros.explore.page import Explorer
+    from twodisk_ros.run.scene_simulation import ground_normal
+    explorer = Explorer(served, LiveMotion(oloid.with_values(slope=slope).checked()))
+    frame = explorer.step(0.1)
+    w, x, y, z = explorer.scene.ground.wxyz
+    normal = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+    assert np.allclose(normal, ground_normal(slope), rtol=0, atol=4e-16)
+    g = frame.position_g[-1]
+    foot = g + explorer.scene.shift(g)
+    assert abs(foot @ ground_normal(slope) - g @ ground_normal(slope)) < 1e-15
+    assert np.allclose(foot, (g @ ground_normal(slope)) * ground_normal(slope), atol=1e-15)
+
+
 def test_help_has_no_side_effects(tmp_path):
     result = _explore('--help', cwd=tmp_path)
     assert result.returncode == 0 and '--export' in result.stdout and not result.stderr
