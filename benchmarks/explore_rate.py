@@ -20,6 +20,7 @@ repository); ``make bench`` runs it after benchmarks/run_all.py.
 
 import argparse
 import json
+import math
 import os
 import re
 import subprocess
@@ -132,6 +133,12 @@ def page_measures(repeats, fps_seconds):
                 _open(browser, url)
                 time.sleep(2.0)
                 result['fps'][f'{width}x{height}'] = browser.fps(fps_seconds)
+                explorer.plots_control.value = False
+                explorer._show_plots()
+                time.sleep(1.0)
+                result['fps'][f'{width}x{height}, plots hidden'] = browser.fps(fps_seconds)
+                explorer.plots_control.value = True
+                explorer._show_plots()
                 if width == 800:
                     result.update(_latencies(browser, explorer, body_pixels, repeats))
             finally:
@@ -167,6 +174,47 @@ def _latencies(browser, explorer, body_pixels, repeats):
             sent.append(explorer.restart_shown - start)
     explorer.change('a', 0.1)
     return {'latency_s': on_screen, 'server_heard_s': heard, 'server_sent_s': sent}
+
+
+#: Changes timed on every body of config/: one of the start, one of the body.
+CHANGES = (('theta0', lambda s: round(0.8 * s.theta0, 6) or 0.1),
+           ('a', lambda s: round(1.1 * s.a, 6)))
+
+
+def restart_times(repeats):
+    """Server side, per config: a control's change to the new motion's first frame drawn
+    (Explorer.change then Explorer.step, no browser), the slowest of ``repeats`` changes
+    back and forth (s): the first builds the new body, later ones find it cached."""
+    import glob
+    from twodisk_ros.explore.cli import _server, stop_server
+    from twodisk_ros.explore.motion import open_motion
+    from twodisk_ros.explore.page import Explorer
+    from twodisk_ros.runs import settings_from
+    server = _server('127.0.0.1', 0)
+    times = {}
+    try:
+        for path in sorted(glob.glob(os.path.join(ROOT, 'config', '*.yaml'))):
+            settings = settings_from(path, realtime=True)
+            explorer = Explorer(server, open_motion(settings=settings))
+            explorer.step(1 / 30)
+            name = os.path.basename(path)[:-5]
+            times[name] = {}
+            for parameter, value in CHANGES:
+                if settings.shape == 'points' and parameter == 'a':
+                    continue
+                runs = []
+                for k in range(repeats):
+                    new = value(settings) if k % 2 == 0 else getattr(settings, parameter)
+                    start = time.perf_counter()
+                    reason = explorer.change(parameter, new)
+                    explorer.step(1 / 30)
+                    runs.append(time.perf_counter() - start if reason is None else math.nan)
+                times[name][parameter] = max(runs)
+            server.scene.reset()
+            server.gui.reset()
+    finally:
+        stop_server(server)
+    return times
 
 
 def lesson_sizes(seconds):
@@ -215,6 +263,16 @@ def section(r):
           f'{v["bytes"] / 1e6:.2f} MB, written in {v["export_s"]:.1f} s | a few MB |'
           for name, v in r['lessons'].items()],
         '',
+        'Server side, a change of a control to the first frame of the new motion '
+        '(`Explorer.change` then one frame, no browser; the slowest of '
+        f'{r["restart_repeats"]} changes back and forth, s): a change of theta0 reuses the '
+        'body\'s tables (the same body, mass model and gravity), a change of a builds a new '
+        'body (its lamina, cycle tables and equilibria: the superellipse of '
+        'rounded_square.yaml takes longest).', '',
+        '| config | theta0 | a |', '| --- | --- | --- |',
+        *[f'| {name} | {v.get("theta0", math.nan):.3f} | {v.get("a", math.nan):.3f} |'
+          for name, v in r['restart_s'].items()],
+        '',
         'Software GL draws the page slowly: the frame rate is that of SwiftShader on the '
         "machine's shared cores, not of a browser with a GPU. The on-screen latency is "
         'measured by screenshots (each one waits for a frame), so it includes at least one '
@@ -246,6 +304,8 @@ def main():
     results = {'load': load}
     results.update(page_measures(2 if args.quick else 5, 1.0 if args.quick else 3.0))
     results.update(server_cpu(3.0 if args.quick else 10.0))
+    results['restart_repeats'] = 2 if args.quick else 4
+    results['restart_s'] = restart_times(results['restart_repeats'])
     results['lesson_seconds'] = 5.0 if args.quick else 20.0
     results['lessons'] = lesson_sizes(results['lesson_seconds'])
     print(json.dumps(results, indent=1))

@@ -38,7 +38,7 @@ WINDOW = 5.0
 #: The equilibria's marks on the z_G curve: stability → colour.
 STABILITY = {'stable': palette.AB, 'unstable': palette.FORCE_PULLING, 'neutral': palette.HULL}
 #: Plots and traces are sent this many times a second.
-PLOT_RATE = 10.0
+PLOT_RATE = 5.0
 
 
 def slider_range(name, settings):
@@ -103,6 +103,10 @@ class Explorer:
             self.speed_control = gui.add_dropdown('speed (x)', SPEEDS,
                                                   initial_value=_speed_text(self.speed))
             self.status = gui.add_markdown(self._status_text())
+            self.plots_control = gui.add_checkbox(
+                'plots', True, hint='show the plots (hidden, software GL draws the page '
+                'about twice as fast: docs/benchmarks.md)')
+        self.plots_control.on_update(lambda _: self._show_plots())
         self.play_button.on_click(lambda _: self.toggle())
         self.reset_button.on_click(lambda _: self.reset())
         self.speed_control.on_update(lambda _: self.set_speed(float(self.speed_control.value)))
@@ -176,6 +180,13 @@ class Explorer:
                      'dash': [6, 4]}),
             aspect=1.8, order=3, scales={'x': {'time': False}},
             title='friction needed and available')
+        if hasattr(self, 'plots_control'):
+            self._show_plots()
+
+    def _show_plots(self):
+        with self.lock:
+            for handle in (self.cycle_plot, self.force_plot, self.mu_plot):
+                handle.visible = bool(self.plots_control.value)
 
     def _cycle_data(self, phase):
         now = np.full(len(self._u), np.nan)
@@ -304,6 +315,9 @@ class Explorer:
         self._history = joined[:, keep]
 
     def _plots(self, frame):
+        self.status.content = self._status_text()
+        if not self.plots_control.value:
+            return
         phase = None if frame.phase is None else float(frame.phase[-1])
         self.cycle_plot.data = self._cycle_data(phase)
         if self._history is not None and self._history.shape[1] >= 2:
@@ -313,7 +327,6 @@ class Explorer:
             line = np.full(len(t), friction if math.isfinite(friction) else np.nan)
             self.force_plot.data = (t, n_a, n_b)
             self.mu_plot.data = (t, finite, line)
-        self.status.content = self._status_text()
 
     def run(self):
         """Show frames at :data:`FPS` until :meth:`stop` (call in a thread)."""

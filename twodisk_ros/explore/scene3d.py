@@ -25,6 +25,9 @@ MESH_RESOLUTION = 128
 TRACE_CHUNK = 64
 #: Widths (× body size, world units) of the contact segment and of the traces.
 SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.008
+#: Width of the traces on screen (px): screen-unit lines skip the world-unit lines' second
+#: antialiasing pass, which software GL pays for at every frame (docs/benchmarks.md).
+TRACE_PX = 2.0
 #: Force arrows: |F| / (M g) × body size long; shaft and head radius, head length (× size).
 SHAFT, HEAD, HEAD_LENGTH = 0.008, 0.02, 0.05
 
@@ -92,7 +95,7 @@ class Traces:
             segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
             self.handles.append(self.scene.add_line_segments(
                 f'/world/trace_{key}/{self.serial}', segments, rgb255(colour),
-                thickness=self.width))
+                thickness=TRACE_PX, thickness_units='screen'))
         count = len(self.current[0])
         if count >= TRACE_CHUNK:
             self.nodes.append((self.handles, count - 1))
@@ -154,7 +157,7 @@ class Scene3D:
         half = 0.5 * s.slope
         self.ground = self.scene.add_grid(
             '/world/ground', width=40 * self.size, height=40 * self.size,
-            cell_size=0.25 * self.size, section_size=self.size, infinite_grid=True,
+            cell_size=0.25 * self.size, section_size=self.size, infinite_grid=False,
             fade_distance=30 * self.size, wxyz=(math.cos(half), 0.0, math.sin(half), 0.0),
             plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
         if self.traces is not None:
