@@ -155,6 +155,54 @@ def test_the_ground_is_the_nodes_plane(oloid, served, slope):
     assert np.allclose(foot, (g @ ground_normal(slope)) * ground_normal(slope), atol=1e-15)
 
 
+def test_serves_prints_its_url_and_stops_on_sigterm():
+    import signal
+    import urllib.request
+    process = subprocess.Popen([sys.executable, '-m', 'twodisk_ros.explore', '-p',
+                                'omega0:=2.0'], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=ENV)
+    try:
+        line = process.stdout.readline()
+        url = re.match(r'twodisk-explore: serving (http://127\.0\.0\.1:\d+/) ', line).group(1)
+        with urllib.request.urlopen(url, timeout=20) as page:
+            assert page.status == 200 and b'<html' in page.read(2000).lower()
+    finally:
+        process.send_signal(signal.SIGTERM)
+        out, err = process.communicate(timeout=30)
+    assert process.returncode == 0, err
+
+
+def test_the_solid_body_is_drawn_as_its_hull(oloid, served):
+    """mass_model solid: one grey hull mesh, closed, its volume the solid model's own
+    (docs/physics.md: the hull mesh's volume within 55 / n^2 of the model at n rulings)."""
+    from twodisk_ros.explore.page import Explorer
+    from twodisk_ros.explore.scene3d import MESH_RESOLUTION
+    explorer = Explorer(served, LiveMotion(oloid))
+    assert sorted(explorer.scene.parts) == ['disk_a', 'disk_b']
+    assert explorer.change('mass_model', 'solid') is None
+    explorer.step(0.05)
+    (name, hull), = explorer.scene.parts.items()
+    assert name == 'hull' and len(explorer.scene.meshes) == 1
+    v = np.asarray(hull.vertices)[np.asarray(hull.faces)]
+    volume = np.einsum('ij,ij->i', v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6
+    expected = _oloid_volume(explorer.motion.settings.a)
+    assert abs(volume / expected - 1) < 55 / MESH_RESOLUTION ** 2, (volume, expected)
+
+
+def _oloid_volume(r):
+    """The Oloid's volume for circles of radius r (Dirnböck and Stachel 1997): 3.0524184 r^3."""
+    return 3.0524184684 * r ** 3
+
+
+def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):
+    from twodisk_ros.explore.page import Explorer
+    explorer = Explorer(served, RecordedMotion(recording))
+    frame = explorer.step(0.5)
+    assert len(frame) >= 2 and all(h.disabled for h in explorer.controls.values())
+    assert 'replay of' in explorer.status.content
+    assert explorer.change('a', 0.2).startswith('a is recorded in')
+
+
 def test_help_has_no_side_effects(tmp_path):
     result = _explore('--help', cwd=tmp_path)
     assert result.returncode == 0 and '--export' in result.stdout and not result.stderr
