@@ -97,6 +97,38 @@ class Chromium:
                     raise RuntimeError(f'{method}: {message["error"]}')
                 return message.get('result', {})
 
+    def send(self, method, **params):
+        """Send one command without waiting for its answer (read later by :meth:`watch`)."""
+        self.next_id += 1
+        self.socket.send(json.dumps({'id': self.next_id, 'method': method, 'params': params}))
+
+    def watch(self, predicate, start, timeout=30.0):
+        """Frames of the page as the compositor makes them (a screencast), until
+        ``predicate(image)`` holds: return the seconds from the wall clock ``start``
+        (time.time()) to that frame's own timestamp, or None after ``timeout`` s. Commands sent
+        with :meth:`send` before are answered in between (their answers are dropped)."""
+        from PIL import Image
+        deadline = time.monotonic() + timeout
+        self.send('Page.startScreencast', format='png', everyNthFrame=1)
+        try:
+            while time.monotonic() < deadline:
+                try:
+                    message = json.loads(self.socket.recv(timeout=max(0.01, deadline
+                                                                      - time.monotonic())))
+                except TimeoutError:
+                    break
+                if message.get('method') != 'Page.screencastFrame':
+                    continue
+                frame = message['params']
+                self.send('Page.screencastFrameAck', sessionId=frame['sessionId'])
+                image = np.asarray(Image.open(io.BytesIO(base64.b64decode(frame['data'])))
+                                   .convert('RGB'))
+                if predicate(image):
+                    return frame['metadata']['timestamp'] - start
+            return None
+        finally:
+            self.call('Page.stopScreencast')
+
     def evaluate(self, expression, timeout=30.0):
         """The value of a JavaScript expression (promises awaited)."""
         result = self.call('Runtime.evaluate', timeout=timeout, expression=expression,

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from twodisk_ros.explore.motion import LiveMotion, RecordedMotion
+from twodisk_ros.explore.motion import CYCLE_POINTS, LiveMotion, RecordedMotion
 from twodisk_ros.run.simulation import Simulation
 from twodisk_ros.runs import settings_from
 
@@ -192,6 +192,24 @@ def test_the_solid_body_is_drawn_as_its_hull(oloid, served):
 def _oloid_volume(r):
     """The Oloid's volume for circles of radius r (Dirnböck and Stachel 1997): 3.0524184 r^3."""
     return 3.0524184684 * r ** 3
+
+
+def test_a_new_body_updates_the_plots_in_place(oloid, served):
+    """delta 0.05 → 0.06 m: the same plot handle gets the new body's z_G along its cycle
+    (the poses of a RunDescription of the new settings, built apart from the page) and one
+    mark per equilibrium."""
+    from twodisk_ros.explore.page import Explorer
+    from twodisk_ros.run.description import RunDescription
+    explorer = Explorer(served, LiveMotion(oloid.with_values(delta=0.05).checked()))
+    plot = explorer.cycle_plot
+    assert explorer.change('delta', 0.06) is None
+    assert explorer.cycle_plot is plot
+    u, z = plot.data[0], plot.data[1]
+    grid = np.linspace(0.0, 2 * math.pi, CYCLE_POINTS)
+    poses = RunDescription(oloid.with_values(delta=0.06).checked()).dynamics.cycle.poses
+    assert np.array_equal(z[np.isin(u, grid)], np.asarray(poses(grid).position_g)[:, 2])
+    marks = np.concatenate([np.isfinite(series) for series in plot.data[2:5]])
+    assert marks.sum() == len(explorer.motion.equilibria())
 
 
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):

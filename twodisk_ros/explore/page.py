@@ -82,6 +82,8 @@ class Explorer:
         self.restart_shown = None    #: time.monotonic() of the first frame after a restart
         self.frames = 0
         server.scene.set_up_direction('+z')
+        # no share button: sharing goes through viser's servers on the internet
+        server.gui.configure_theme(show_share_button=False)
         self.scene = Scene3D(server, motion)
         position, look_at = camera_for(self.scene.size)
         server.initial_camera.position = tuple(position)
@@ -158,11 +160,15 @@ class Explorer:
                     for kind, colour in STABILITY.items()),
                   {'label': 'now', 'stroke': palette.B, 'width': 0,
                    'points': {'show': True, 'size': 12}})
-        if getattr(self, 'cycle_plot', None) is not None:
-            for handle in (self.cycle_plot, self.force_plot, self.mu_plot):
-                handle.remove()
         low, high = float(z.min()), float(z.max())
         pad = max(0.1 * (high - low), 0.01 * self.scene.size)
+        if getattr(self, 'cycle_plot', None) is not None:
+            # a new body: new data and range on the same plots (the client keeps them)
+            with self.server.atomic():
+                self.cycle_plot.scales = {'x': {'time': False},
+                                          'y': {'range': [low - pad, high + pad]}}
+                self.cycle_plot.data = self._cycle_data(None)
+            return
         self.cycle_plot = gui.add_uplot(
             self._cycle_data(None), series, aspect=1.8, order=1,
             scales={'x': {'time': False}, 'y': {'range': [low - pad, high + pad]}},

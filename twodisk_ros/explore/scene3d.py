@@ -131,7 +131,7 @@ class Scene3D:
         self.world = self.scene.add_frame('/world', show_axes=False)
         self.body_node = None
         self.meshes = []
-        self.ground = None
+        self.ground, self._ground_key = None, None
         self.contact = self.forces = None
         self.traces = None
         self.rebuild(motion)
@@ -152,14 +152,18 @@ class Scene3D:
             np.asarray(mesh.faces, dtype=np.uint32), color=rgb255(colours.get(name, palette.HULL)),
             side='double', cast_shadow=False, receive_shadow=False)
             for name, mesh in self.parts.items()]
-        if self.ground is not None:
+        ground = (s.slope, self.size)
+        if self.ground is not None and ground != self._ground_key:
             self.ground.remove()
+            self.ground = None
+        self._ground_key = ground
         half = 0.5 * s.slope
-        self.ground = self.scene.add_grid(
-            '/world/ground', width=40 * self.size, height=40 * self.size,
-            cell_size=0.25 * self.size, section_size=self.size, infinite_grid=False,
-            fade_distance=30 * self.size, wxyz=(math.cos(half), 0.0, math.sin(half), 0.0),
-            plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
+        if self.ground is None:
+            self.ground = self.scene.add_grid(
+                '/world/ground', width=40 * self.size, height=40 * self.size,
+                cell_size=0.25 * self.size, section_size=self.size, infinite_grid=False,
+                fade_distance=30 * self.size, wxyz=(math.cos(half), 0.0, math.sin(half), 0.0),
+                plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
         if self.traces is not None:
             self.traces.clear()
         self.traces = Traces(self.scene, self.size, s.path_length)
