@@ -259,11 +259,11 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     explorer, browser, server, shots = live
     settings = explorer.motion.settings
     path = tmp_path / 'lesson.html'
-    export(LiveMotion(settings), path, seconds=1.5)
+    export(LiveMotion(settings), path, seconds=5.0)     # long enough not to loop
     browser.goto(path.as_uri())
     browser.wait_for("document.querySelector('.tabler-icon-player-pause-filled') !== null")
     _dismiss(browser)
-    time.sleep(0.5)
+    time.sleep(0.3)
     browser.evaluate("document.querySelector('.tabler-icon-player-pause-filled')"
                      ".closest('button').click()")
     time.sleep(0.3)
