@@ -212,12 +212,29 @@ def test_a_new_body_updates_the_plots_in_place(oloid, served):
     assert marks.sum() == len(explorer.motion.equilibria())
 
 
+def test_speed_pause_and_reset(oloid, served):
+    """x10: 0.1 s of the show is 1 s of the run; paused, nothing advances; reset: t = 0."""
+    from twodisk_ros.explore.page import Explorer
+    explorer = Explorer(served, LiveMotion(oloid))
+    explorer.set_speed(10.0)
+    frame = explorer.step(0.1)
+    assert frame.t[-1] == pytest.approx(1.0, rel=1e-12) and len(frame) == 1 + 50
+    explorer.toggle()
+    assert explorer.step(0.1) is None and explorer.motion.t == pytest.approx(1.0, rel=1e-12)
+    explorer.toggle()
+    explorer.reset()
+    assert explorer.motion.t == 0.0 and explorer.step(0.1).t[0] == 0.0
+
+
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):
     from twodisk_ros.explore.page import Explorer
     explorer = Explorer(served, RecordedMotion(recording))
     frame = explorer.step(0.5)
     assert len(frame) >= 2 and all(h.disabled for h in explorer.controls.values())
     assert 'replay of' in explorer.status.content
+    while explorer.motion.restarts == 0:                # to the end, and again from 0
+        frame = explorer.step(0.5)
+    assert frame.t[0] == 0.0 and len(explorer.scene.traces.nodes) == 0
     assert explorer.change('a', 0.2).startswith('a is recorded in')
 
 

@@ -227,7 +227,7 @@ class RecordedMotion:
         starts again at its end."""
         run = self.run
         if self.t >= run.t[-1]:
-            self.t = 0.0
+            self.reset()                 # the replay starts again (its traces too)
         stop = min(self.t + dt, float(run.t[-1]))
         first = int(np.searchsorted(run.t, self.t, side='right'))
         last = max(first + 1, int(np.searchsorted(run.t, stop, side='right')))

@@ -297,7 +297,11 @@ class Explorer:
                 self._scene_body = self.motion.body
             dt = wall_dt * self.speed
             samples = max(1, min(50, int(math.ceil(dt * TRACE_RATE))))
+            restarts = self.motion.restarts
             frame = self.motion.advance(dt, samples)
+            if self.motion.restarts != restarts:        # a replay started again
+                self.scene.traces.clear()
+                self._history = None
             now = time.monotonic()
             publish = now >= self._next_plot
             self.scene.show(frame, traces=publish)
