@@ -10,7 +10,7 @@ export MPLBACKEND := Agg
 # where make demo writes (a test runs it into a temporary directory)
 OUT ?= out
 
-.PHONY: venv foxglove-readers test demo figures bench clean
+.PHONY: venv foxglove-readers chromium test demo figures bench clean
 
 venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
@@ -18,9 +18,10 @@ venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 # code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep`, `twodisk-view`
 # and `twodisk-figures` are in .venv/bin and work from any directory; the parameter files go to
 # .venv/share/twodisk_ros/config, where a colcon install puts them.
-$(VENV)/.installed: requirements.txt setup.py setup.cfg $(wildcard config/*)
+$(VENV)/.installed: requirements.txt requirements-nodeps.txt setup.py setup.cfg $(wildcard config/*)
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps -r requirements-nodeps.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation \
 	    --use-pep517 --editable .
 	install -d $(VENV)/share/twodisk_ros/config
@@ -47,13 +48,20 @@ tests/foxglove/node_modules/.installed: tests/foxglove/package.json tests/foxglo
 	cd tests/foxglove && npm ci --ignore-scripts --no-audit --no-fund --loglevel=error
 	touch $@
 
+## The page's browser tests (tests/test_explore_browser.py) use Debian's chromium; on CI
+## (CI=true) it is installed when missing, elsewhere those tests skip saying how to install it.
+chromium:
+	@if [ "$$CI" = true ] && ! command -v chromium >/dev/null; then \
+	    SUDO=$$(command -v sudo >/dev/null && [ "$$(id -u)" != 0 ] && echo sudo); \
+	    $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq --no-install-recommends chromium; fi
+
 ## Run the whole test suite (what CI runs), one pytest worker per core. A test module stays
 ## on one worker: the modules whose nodes subscribe each use a ROS domain of their own.
 ## The package's bytecode is written first: the suite starts a few hundred Python processes,
 ## and where PYTHONDONTWRITEBYTECODE is set each would compile the package again (~0.2 s of
 ## CPU apiece). PYTEST_ARGS adds options (make bench passes --durations).
 PYTEST_ARGS ?=
-test: venv foxglove-readers
+test: venv foxglove-readers chromium
 	@$(PY) -m compileall -q twodisk_ros tests benchmarks tools
 	$(PY) -m pytest -n auto --dist loadfile $(PYTEST_ARGS)
 
@@ -71,9 +79,11 @@ figures: venv
 	$(PY) -m twodisk_ros.plotting.figures --out docs/figures --overwrite
 	$(PY) -m twodisk_ros.plotting.contact_forces --out docs/figures --overwrite
 
-## Benchmarks: writes docs/benchmarks.md and the work-precision plot.
-bench: venv
+## Benchmarks: writes docs/benchmarks.md and the work-precision plot; then the page's section
+## of docs/benchmarks.md (twodisk-explore in headless Chromium).
+bench: venv chromium
 	$(PY) benchmarks/run_all.py --overwrite
+	$(PY) benchmarks/explore_rate.py
 
 clean:
 	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info

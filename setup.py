@@ -29,6 +29,7 @@ setup(
             'twodisk-animate = twodisk_ros.plotting.animate_cli:main',
             'twodisk-sweep = twodisk_ros.sweep.cli:main',
             'twodisk-view = twodisk_ros.view.cli:main',
+            'twodisk-explore = twodisk_ros.explore.cli:main',
         ],
     },
 )

@@ -1,0 +1,217 @@
+"""The 3D scene of ``twodisk-explore`` on a viser server: body, ground, traces, AB, forces.
+
+World frame ``frame_id`` of the node (Z up against gravity, m). Everything hangs under the
+node ``/world``, which is moved by minus the foot of G on the ground at every frame, so the
+body stays in view while the ground slides under it. The body's meshes
+(:func:`twodisk_ros.model.mesh.mesh_parts`: the plates of the laminae, or the hull for
+``mass_model`` solid) are in the body frame under ``/world/body``, whose pose is the run's
+(G and the quaternion body → world). Colours: :mod:`twodisk_ros.model.palette` (disk 1 and A
+blue, disk 2 and B orange, AB green, G near-black, forces purple, red when pulling). No
+rclpy here.
+"""
+
+import math
+
+import numpy as np
+
+from ..model import palette
+from ..model.mesh import mesh_parts
+
+__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'wxyz']
+
+#: Rim vertices per disk (and hull steps) of the drawn meshes.
+MESH_RESOLUTION = 128
+#: Traces: points per line node before a new node starts (a finished node is never resent).
+TRACE_CHUNK = 64
+#: Widths (× body size, world units) of the contact segment and of the traces.
+SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.008
+#: Width of the traces on screen (px): screen-unit lines skip the world-unit lines' second
+#: antialiasing pass, which software GL pays for at every frame (docs/benchmarks.md).
+TRACE_PX = 2.0
+#: Force arrows: |F| / (M g) × body size long; shaft and head radius, head length (× size).
+SHAFT, HEAD, HEAD_LENGTH = 0.008, 0.02, 0.05
+
+
+def rgb255(colour):
+    """(r, g, b) integers 0..255 of a palette colour ``'#rrggbb'``."""
+    return tuple(int(round(255 * c)) for c in palette.rgb(colour))
+
+
+def wxyz(quaternion):
+    """viser's (w, x, y, z) of a ROS quaternion (x, y, z, w)."""
+    x, y, z, w = (float(c) for c in quaternion)
+    return (w, x, y, z)
+
+
+def camera_for(size):
+    """(position, look_at) (m, in the scene after the follow shift) of the default camera:
+    3.2 body sizes away, from the side of −y and +x, 35° above the ground."""
+    distance = 3.2 * size
+    elevation, azimuth = math.radians(35.0), math.radians(-60.0)
+    look_at = np.array([0.0, 0.0, 0.4 * size])
+    offset = distance * np.array([math.cos(elevation) * math.cos(azimuth),
+                                  math.cos(elevation) * math.sin(azimuth), math.sin(elevation)])
+    return look_at + offset, look_at
+
+
+class Traces:
+    """Traces of A, B and G as line nodes of at most :data:`TRACE_CHUNK` points each; at most
+    ``length`` points per trace are kept (older nodes removed)."""
+
+    KEYS = (('a', palette.A), ('b', palette.B), ('g', palette.G))
+
+    def __init__(self, scene, size, length):
+        self.scene, self.width = scene, TRACE_WIDTH * size
+        self.length = max(2, int(length))
+        self.nodes = []       # [(handles, count)] finished chunks, oldest first
+        self.current = [np.zeros((0, 3)) for _ in self.KEYS]
+        self.handles = None
+        self.serial = 0
+
+    def clear(self):
+        for handles, _ in self.nodes:
+            for h in handles:
+                h.remove()
+        if self.handles is not None:
+            for h in self.handles:
+                h.remove()
+        self.nodes, self.handles = [], None
+        self.current = [np.zeros((0, 3)) for _ in self.KEYS]
+
+    def extend(self, a, b, g):
+        """Append points (n, 3) of A, B and G (m, world) to the current chunk."""
+        self.current = [np.concatenate([c, np.asarray(p, dtype=float)])
+                        for c, p in zip(self.current, (a, b, g))]
+
+    def publish(self):
+        """Send the current chunk; start a new one when it is full; drop the oldest."""
+        if len(self.current[0]) < 2:
+            return
+        if self.handles is not None:
+            for h in self.handles:
+                h.remove()
+        self.handles = []
+        for (key, colour), points in zip(self.KEYS, self.current):
+            segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
+            self.handles.append(self.scene.add_line_segments(
+                f'/world/trace_{key}/{self.serial}', segments, rgb255(colour),
+                thickness=TRACE_PX, thickness_units='screen'))
+        count = len(self.current[0])
+        if count >= TRACE_CHUNK:
+            self.nodes.append((self.handles, count - 1))
+            self.handles = None
+            self.serial += 1
+            self.current = [c[-1:] for c in self.current]
+        kept = sum(n for _, n in self.nodes)
+        while self.nodes and kept - self.nodes[0][1] >= self.length:
+            handles, n = self.nodes.pop(0)
+            kept -= n
+            for h in handles:
+                h.remove()
+
+
+class Scene3D:
+    """The scene nodes of one body on one server (rebuilt when the body changes).
+
+    Parameters
+    ----------
+    server : viser.ViserServer
+    motion : LiveMotion or RecordedMotion
+        Its ``body``, ``settings`` (mass_model, slope, path_length) and ``weight``.
+    """
+
+    def __init__(self, server, motion):
+        self.server, self.scene = server, server.scene
+        # software GL draws the environment map and shadow maps 6x slower (docs/benchmarks.md)
+        self.scene.configure_environment_map(None)
+        self.scene.configure_default_lights(True, cast_shadow=False)
+        # without the environment map a face turned from the lights is black: an ambient
+        # light keeps both disks' colours on every side
+        self.scene.add_light_ambient('/ambient', intensity=1.2)
+        self.world = self.scene.add_frame('/world', show_axes=False)
+        self.body_node = None
+        self.meshes = []
+        self.ground, self._ground_key = None, None
+        self.contact = self.forces = None
+        self.traces = None
+        self.rebuild(motion)
+
+    def rebuild(self, motion):
+        """Draw a (new) body, its ground and empty traces."""
+        s = motion.settings
+        self.size, self.weight = float(motion.body.size), float(motion.weight)
+        self.normal = motion.ground_normal
+        for handle in self.meshes:
+            handle.remove()
+        if self.body_node is None:
+            self.body_node = self.scene.add_frame('/world/body', show_axes=False)
+        self.parts = mesh_parts(motion.body, s.mass_model, resolution=MESH_RESOLUTION)
+        colours = {'disk_a': palette.A, 'disk_b': palette.B, 'hull': palette.HULL}
+        self.meshes = [self.scene.add_mesh_simple(
+            f'/world/body/{name}', np.asarray(mesh.vertices, dtype=np.float32),
+            np.asarray(mesh.faces, dtype=np.uint32), color=rgb255(colours.get(name, palette.HULL)),
+            side='double', cast_shadow=False, receive_shadow=False)
+            for name, mesh in self.parts.items()]
+        ground = (s.slope, self.size)
+        if self.ground is not None and ground != self._ground_key:
+            self.ground.remove()
+            self.ground = None
+        self._ground_key = ground
+        half = 0.5 * s.slope
+        if self.ground is None:
+            self.ground = self.scene.add_grid(
+                '/world/ground', width=40 * self.size, height=40 * self.size,
+                cell_size=0.25 * self.size, section_size=self.size, infinite_grid=False,
+                fade_distance=30 * self.size, wxyz=(math.cos(half), 0.0, math.sin(half), 0.0),
+                plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
+        if self.traces is not None:
+            self.traces.clear()
+        self.traces = Traces(self.scene, self.size, s.path_length)
+
+    def shift(self, position_g):
+        """Minus the foot of G on the ground (m): the translation of ``/world``."""
+        g = np.asarray(position_g, dtype=float)
+        return -(g - float(g @ self.normal) * self.normal)
+
+    def show(self, frame, traces=True):
+        """Draw the last sample of a :class:`~twodisk_ros.explore.motion.Frame`; with
+        ``traces``, also send the traces (else they are only extended)."""
+        i = len(frame) - 1
+        g, q = frame.position_g[i], frame.quaternion[i]
+        a, b = frame.contact_a[i], frame.contact_b[i]
+        with self.server.atomic():
+            self.world.position = self.shift(g)
+            self.body_node.position = tuple(float(x) for x in g)
+            self.body_node.wxyz = wxyz(q)
+            segment = np.array([[a, b]], dtype=np.float32)
+            if self.contact is None:
+                self.contact = self.scene.add_line_segments(
+                    '/world/contact', segment, rgb255(palette.AB),
+                    thickness=SEGMENT_WIDTH * self.size)
+            else:
+                self.contact.points = segment
+            if frame.force_a is not None:
+                self._arrows((a, b), (frame.force_a[i], frame.force_b[i]))
+            self.traces.extend(frame.contact_a, frame.contact_b, frame.position_g)
+            if traces:
+                self.traces.publish()
+
+    def _arrows(self, points, forces):
+        scale = self.size / self.weight if self.weight > 0 else 0.0
+        ends, colours = [], []
+        for point, force in zip(points, forces):
+            force = np.asarray(force, dtype=float)
+            if not np.all(np.isfinite(force)):
+                force = np.zeros(3)
+            ends.append([point, np.asarray(point) + scale * force])
+            pulling = float(force @ self.normal) < 0
+            colours.append(rgb255(palette.FORCE_PULLING if pulling else palette.FORCE))
+        ends = np.asarray(ends, dtype=np.float32)
+        colours = np.asarray(colours, dtype=np.uint8)
+        if self.forces is None:
+            self.forces = self.scene.add_arrows(
+                '/world/forces', ends, colours, shaft_radius=SHAFT * self.size,
+                head_radius=HEAD * self.size, head_length=HEAD_LENGTH * self.size)
+        else:
+            self.forces.points = ends
+            self.forces.colors = colours
