@@ -479,3 +479,48 @@ def test_a_change_after_dropped_samples_is_stamped_with_a_published_sample(tmp_p
     # counted from that tick)
     assert [m.msg.data for m in events] == ['command speed 4.0']
     assert events[0].log_time_ns in stamps
+
+
+def test_a_change_at_the_tick_a_command_would_time_out_comes_first(tmp_path, monkeypatch):
+    """The documented order at one tick: a change of drive (like a command, a reset or a
+    restart) applies before a time-out due at the same tick, which it cancels. The time-out
+    is decided when that tick's sample is published: a timer call with no sample due at the
+    time-out's tick decided it early, and a drive change queued after it (taking effect at
+    the same, still unpublished tick) came second (found under load by
+    test_driven_from_a_second_node: time-outs [112, 179] where the rule gives [179])."""
+    import rclpy
+    from rclpy.parameter import Parameter
+    from twodisk_ros.node import roller as roller_module
+    clock = _Clock()
+    monkeypatch.setattr(roller_module, 'time', clock)
+    path = tmp_path / 'order.mcap'
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=LIVE_DOMAIN)
+    try:
+        node = roller_module.Roller(context=context, parameter_overrides=[
+            Parameter('drive', value='speed'), Parameter('rate', value=100.0),
+            Parameter('cmd_timeout', value=0.3), Parameter('record', value=str(path))])
+        try:
+            clock.now = 0.0
+            node._on_timer()                        # tick 0
+            node.control._on_command('speed', 4.0)
+            clock.now = 0.01
+            node._on_timer()                        # the command at tick 1: due at tick 31
+            clock.now = 0.30
+            node._on_timer()                        # ticks 2 ... 30
+            clock.now = 0.305
+            node._on_timer()                        # no sample due: tick 31 not published
+            (result,) = node.set_parameters([Parameter('drive', value='torque')])
+            assert result.successful, result.reason
+            clock.now = 0.31
+            node._on_timer()                        # tick 31: the drive change, then the sample
+            assert node.samples_dropped == 0
+        finally:
+            node.close()
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+    recording = read_recording(path)
+    events = [(m.log_time_ns, m.msg.data) for m in recording.messages
+              if m.topic.endswith('/events')]
+    assert [text for _, text in events] == ['command speed 4.0', 'scene drive speed -> torque']

@@ -117,7 +117,8 @@ class SceneControl:
                 self.timed_out = False
                 self.node.continue_motion(drive=item[1], command=item[2])
                 self.event(f'command {item[1]} {item[2]!r}', tick)
-        self.check_timeout(tick)
+        # no time-out here: it is decided when the tick's sample is published (the roller's
+        # loop), so a change that arrives before that sample comes first at the same tick
         return pauses
 
     def timeout_tick(self):
