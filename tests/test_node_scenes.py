@@ -8,6 +8,7 @@ in ROS domain 68; the realtime integration test drives the node from a second rc
 domain 67.
 """
 
+import contextlib
 import os
 
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -441,37 +442,45 @@ class _Clock:
         return self.now
 
 
+@contextlib.contextmanager
+def _clocked_roller(monkeypatch, **parameters):
+    """(Roller, clock): a realtime roller in its own context whose ``time.monotonic()`` is
+    the stand-in ``clock.now``, driven by calling its ``_on_timer``; closed on exit."""
+    import rclpy
+    from rclpy.parameter import Parameter
+    from twodisk_ros.node import roller as roller_module
+    clock = _Clock()
+    monkeypatch.setattr(roller_module, 'time', clock)
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=LIVE_DOMAIN)
+    try:
+        node = roller_module.Roller(context=context, parameter_overrides=[
+            Parameter(name, value=value) for name, value in parameters.items()])
+        try:
+            yield node, clock
+        finally:
+            node.close()
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
 def test_a_change_after_dropped_samples_is_stamped_with_a_published_sample(tmp_path,
                                                                           monkeypatch):
     """A realtime node far behind the wall clock drops samples (counted); a command queued
     meanwhile takes effect at the first sample published after the drop, and its event is
     stamped with that sample's stamp (it was stamped with a dropped tick, which no sample
     had, and its time-out counted from there)."""
-    import rclpy
-    from rclpy.parameter import Parameter
-    from twodisk_ros.node import roller as roller_module
-    clock = _Clock()
-    monkeypatch.setattr(roller_module, 'time', clock)
     path = tmp_path / 'behind.mcap'
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=LIVE_DOMAIN)
-    try:
-        node = roller_module.Roller(context=context, parameter_overrides=[
-            Parameter('drive', value='speed'), Parameter('rate', value=100.0),
-            Parameter('record', value=str(path))])
-        try:
-            for now in (0.0, 0.05):
-                clock.now = now
-                node._on_timer()
-            node.control._on_command('speed', 4.0)
-            clock.now = 2.05                        # 2 s behind: beyond MAX_LAG (0.5 s)
+    with _clocked_roller(monkeypatch, drive='speed', rate=100.0, record=str(path)) as (node,
+                                                                                     clock):
+        for now in (0.0, 0.05):
+            clock.now = now
             node._on_timer()
-            assert node.samples_dropped > 0
-        finally:
-            node.close()
-            node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=context)
+        node.control._on_command('speed', 4.0)
+        clock.now = 2.05                            # 2 s behind: beyond MAX_LAG (0.5 s)
+        node._on_timer()
+        assert node.samples_dropped > 0
     recording = read_recording(path)
     stamps = {m.log_time_ns for m in recording.messages if m.topic.endswith('/pose')}
     events = [m for m in recording.messages if m.topic.endswith('/events')]
@@ -488,38 +497,24 @@ def test_a_change_at_the_tick_a_command_would_time_out_comes_first(tmp_path, mon
     time-out's tick decided it early, and a drive change queued after it (taking effect at
     the same, still unpublished tick) came second (found under load by
     test_driven_from_a_second_node: time-outs [112, 179] where the rule gives [179])."""
-    import rclpy
     from rclpy.parameter import Parameter
-    from twodisk_ros.node import roller as roller_module
-    clock = _Clock()
-    monkeypatch.setattr(roller_module, 'time', clock)
     path = tmp_path / 'order.mcap'
-    context = rclpy.Context()
-    rclpy.init(context=context, domain_id=LIVE_DOMAIN)
-    try:
-        node = roller_module.Roller(context=context, parameter_overrides=[
-            Parameter('drive', value='speed'), Parameter('rate', value=100.0),
-            Parameter('cmd_timeout', value=0.3), Parameter('record', value=str(path))])
-        try:
-            clock.now = 0.0
-            node._on_timer()                        # tick 0
-            node.control._on_command('speed', 4.0)
-            clock.now = 0.01
-            node._on_timer()                        # the command at tick 1: due at tick 31
-            clock.now = 0.30
-            node._on_timer()                        # ticks 2 ... 30
-            clock.now = 0.305
-            node._on_timer()                        # no sample due: tick 31 not published
-            (result,) = node.set_parameters([Parameter('drive', value='torque')])
-            assert result.successful, result.reason
-            clock.now = 0.31
-            node._on_timer()                        # tick 31: the drive change, then the sample
-            assert node.samples_dropped == 0
-        finally:
-            node.close()
-            node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=context)
+    with _clocked_roller(monkeypatch, drive='speed', rate=100.0, cmd_timeout=0.3,
+                         record=str(path)) as (node, clock):
+        clock.now = 0.0
+        node._on_timer()                            # tick 0
+        node.control._on_command('speed', 4.0)
+        clock.now = 0.01
+        node._on_timer()                            # the command at tick 1: due at tick 31
+        clock.now = 0.30
+        node._on_timer()                            # ticks 2 ... 30
+        clock.now = 0.305
+        node._on_timer()                            # no sample due: tick 31 not published
+        (result,) = node.set_parameters([Parameter('drive', value='torque')])
+        assert result.successful, result.reason
+        clock.now = 0.31
+        node._on_timer()                            # tick 31: the drive change, then the sample
+        assert node.samples_dropped == 0
     recording = read_recording(path)
     events = [(m.log_time_ns, m.msg.data) for m in recording.messages
               if m.topic.endswith('/events')]

@@ -264,12 +264,12 @@ def _end_state(dynamics, sol):
     """(u, u̇, w) at the end of a stepped segment: (u, w) of the regular chart if the segment
     holds it (u̇ = w/|ω_u|, infinite where the body stops turning), else (u, u̇) of the
     chart in t (a body that turns everywhere: w = |ω_u| u̇)."""
+    if sol.regular_chart:          # one search of t(τ): u̇ as the solution reports it
+        u, w = (float(np.ravel(x)[0]) for x in sol.state(sol.t_end))
+        with np.errstate(divide='ignore'):
+            return u, float(w / dynamics.angular_speed_per_phase(u)), w
     u, u_dot = (float(np.ravel(x)[0]) for x in sol(sol.t_end))
-    if sol.regular_chart:
-        w = float(np.ravel(sol.state(sol.t_end)[1])[0])
-    else:
-        w = u_dot * float(dynamics.angular_speed_per_phase(u))
-    return u, u_dot, w
+    return u, u_dot, u_dot * float(dynamics.angular_speed_per_phase(u))
 
 
 def _motion(dynamics, mode, method, t, sol, nfev=0):
