@@ -7,8 +7,11 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_DOMAIN_ID ?= 73
 export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 export MPLBACKEND := Agg
-# where make demo writes (a test runs it into a temporary directory)
+# where make demo writes (a test runs it into a temporary directory), the simulated seconds
+# it records and the seconds of it the GIF shows
 OUT ?= out
+DEMO_SECONDS ?= 20.0
+GIF_SECONDS ?= 6
 
 .PHONY: venv foxglove-readers chromium test demo figures bench clean
 
@@ -69,10 +72,10 @@ test: venv foxglove-readers chromium
 demo: venv
 	mkdir -p $(OUT)
 	$(PY) -m twodisk_ros.roller --ros-args --params-file config/oloid.yaml \
-	    -p realtime:=false -p duration:=20.0 -p record:=$(OUT)/oloid.mcap -p overwrite:=true
+	    -p realtime:=false -p duration:=$(DEMO_SECONDS) -p record:=$(OUT)/oloid.mcap -p overwrite:=true
 	$(PY) -m twodisk_ros.inspect_mcap $(OUT)/oloid.mcap --plot $(OUT)/oloid.png --overwrite
 	$(PY) -m twodisk_ros.plotting.animate_cli $(OUT)/oloid.mcap -o $(OUT)/oloid.gif \
-	    --stop 6 --fps 15 --size 480x360 --overwrite
+	    --stop $(GIF_SECONDS) --fps 15 --size 480x360 --overwrite
 
 ## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
 figures: venv
