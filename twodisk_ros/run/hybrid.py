@@ -78,7 +78,8 @@ class Stretch:
     model: 'rolling' or 'engine'; t_start, t_end (s; t_end inf while it lasts); reason (one
     sentence: why it began). A rolling stretch after the engine has ``mismatch`` (the
     :class:`~twodisk_ros.engine.state.NearestRolling` of the return) and ``engine_state``
-    ((qpos, qvel) of the engine there); an engine stretch lists its ``flights``: [(t0, t1)]
+    ((qpos, qvel) of the engine there); ``energy`` (J) is the rolling energy at its start
+    (of the state handed to the engine, or mapped back); an engine stretch lists its ``flights``: [(t0, t1)]
     step times between which no contact was active.
     """
 
@@ -86,6 +87,7 @@ class Stretch:
     t_start: float
     t_end: float
     reason: str
+    energy: float = math.nan     #: E (J) at its start: the rolling state's (switch, return)
     mismatch: object = None
     engine_state: tuple = None
     flights: list = field(default_factory=list)
@@ -177,7 +179,8 @@ class HybridMotion:
             if math.isfinite(self.mu) else p
         self.rule = rule or ReturnRule.for_body(dynamics.body.size, dynamics.gravity)
         self.weight = dynamics.mass.mass * dynamics.gravity
-        self.stretches = [Stretch('rolling', 0.0, math.inf, 'exact rolling from t = 0 s')]
+        self.stretches = [Stretch('rolling', 0.0, math.inf, 'exact rolling from t = 0 s',
+                                  energy=stream.initial_energy)]
         self._rolling = _Rolling(stream, 0.0)
         self._engine = engine         # built at the first switch if None
         self._held_since = None       # engine: the return rule holds since (s)
@@ -261,10 +264,13 @@ class HybridMotion:
         self._engine.set_state(state.qpos, state.qvel, t_switch)
         self._phase, self._held_since, self._rolling = u, None, None
         self.stretches[-1].t_end = t_switch
-        what = {'lift-off A': 'lift-off of A', 'lift-off B': 'lift-off of B'}.get(
-            report.kind, 'slip')
+        what = {'lift-off A': 'lift-off of A: N_A reaches 0 N',
+                'lift-off B': 'lift-off of B: N_B reaches 0 N'}.get(
+            report.kind, f'slip: mu_required reaches mu = {self.mu:g}')
+        what, why = what.split(': ')
         self.stretches.append(Stretch('engine', t_switch, math.inf,
-                                      f'{what} at t = {t_switch:.9g} s ({report.reason})'))
+                                      f'{what} at t = {t_switch:.9g} s ({why})',
+                                      energy=float(self.dynamics.energy_turning(u, w))))
 
     # -- engine ---------------------------------------------------------------------------
     def _advance(self, t):
@@ -315,6 +321,7 @@ class HybridMotion:
             f'rolling again at t = {now:.9g} s (mismatch: tilt {near.angle_mismatch:.3g} rad, '
             f'height {near.height_mismatch:.3g} m, velocity {near.velocity_mismatch:.3g} m/s, '
             f'energy added {near.energy_mismatch:.3g} J)', mismatch=near,
+            energy=float(self.dynamics.energy_turning(near.phase, near.angular_speed)),
             engine_state=(qpos, qvel)))
         return True
 
