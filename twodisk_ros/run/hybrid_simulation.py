@@ -17,7 +17,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .hybrid import HybridMotion
 from .simulation import Sample, Simulation, continuous_quaternions
 
 __all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'simulation_of']
@@ -53,6 +52,7 @@ class HybridSimulation(Simulation):
 
     def __init__(self, settings, run=None, **kwargs):
         super().__init__(settings, run, **kwargs)
+        from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
         s = self.settings
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
                                    method=s.method, tolerance=s.tolerance)
