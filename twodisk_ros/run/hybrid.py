@@ -280,16 +280,16 @@ class HybridMotion:
         while e.data.time < t - 1e-12:
             e.step_to(min(e.data.time + e.timestep, t))
             now = float(e.data.time)
-            c = e.contact_details()
-            if not c.touching.any():
+            touching, slip, normal = e.contact_speeds()
+            if not touching.any():
                 if stretch.flights and stretch.flights[-1][1] == -1.0:
                     pass
                 else:
                     stretch.flights.append([now, -1.0])
             elif stretch.flights and stretch.flights[-1][1] == -1.0:
                 stretch.flights[-1][1] = now
-            if c.touching.all() and c.slip.max() < rule.slip_speed \
-                    and c.normal.max() < rule.normal_speed:
+            if touching.all() and slip.max() < rule.slip_speed \
+                    and normal.max() < rule.normal_speed:
                 if self._held_since is None:
                     self._held_since = now
                 if now - self._held_since >= rule.hold - 1e-12 and self._try_return(now):
