@@ -44,7 +44,7 @@ def recording(tmp_path_factory):
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=ctx)
-    return read_recording(path), stretches
+    return read_recording(path), stretches, path
 
 
 def _topic(recording, name):
@@ -56,7 +56,7 @@ def _stamp(msg):
 
 
 def test_each_switch_is_an_event_at_the_new_models_first_sample(recording):
-    rec, stretches = recording
+    rec, stretches, _ = recording
     assert [s.model for s in stretches] == ['rolling', 'engine', 'rolling']
     events = [(m.log_time_ns, m.msg.data) for m in _topic(rec, 'events')]
     assert [text for _, text in events] == [f'contact_model {s.model}: {s.reason}'
@@ -70,7 +70,7 @@ def test_each_switch_is_an_event_at_the_new_models_first_sample(recording):
 
 
 def test_diagnostics_say_which_model_runs(recording):
-    rec, stretches = recording
+    rec, stretches, _ = recording
     last = _topic(rec, 'diagnostics')[-1].msg.status[0]
     values = {kv.key: kv.value for kv in last.values}
     assert values['contact_model'] == 'hybrid' and values['model'] == 'rolling'
@@ -82,7 +82,7 @@ def test_diagnostics_say_which_model_runs(recording):
 def test_a_disk_in_the_air_has_no_force_and_its_lowest_point(recording):
     """Samples where the engine's disk 1 (A) is in the air (wrench_a zero): contact_a lies in
     disk 1's plane (x3 = 0 of the pose), above the ground and below G."""
-    rec, _ = recording
+    rec, _, _ = recording
     wrench = np.array([[m.msg.wrench.force.x, m.msg.wrench.force.y, m.msg.wrench.force.z]
                        for m in _topic(rec, 'wrench_a')])
     point = np.array([[m.msg.point.x, m.msg.point.y, m.msg.point.z]
@@ -97,3 +97,32 @@ def test_a_disk_in_the_air_has_no_force_and_its_lowest_point(recording):
         e3 = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
         assert abs((point[i] - g) @ e3) <= 1e-3 * 0.2     # the rim polygon's tolerance
         assert 0 < point[i, 2] < g[2]
+
+
+def test_the_inspector_checks_engine_stretches_on_their_own(recording):
+    """twodisk-inspect leaves the engine's samples out of the rolling checks (which then
+    pass, energy from each return on) and checks them by the free body's own rules."""
+    from twodisk_ros.inspector import inspect_recording
+    inspection = inspect_recording(recording[2])
+    checks = {c.name: c for c in inspection.checks}
+    assert checks['engine_stretches'].passed, checks['engine_stretches'].detail
+    assert all(c.passed for c in inspection.checks), [
+        (c.name, c.detail) for c in inspection.checks if not c.passed]
+    assert inspection.summary['run']['recovered_samples'] == 101
+
+
+def test_the_engine_check_fails_outside_the_cone_and_through_the_ground():
+    from twodisk_ros.inspector.engine_stretches import engine_check
+    from twodisk_ros.inspector.series import Series
+    stamps = np.arange(3, dtype=np.int64)
+
+    def series(key, rows):
+        return Series('x', stamps, stamps, stamps, {key: np.array(rows, dtype=float)})
+    good = {'wrench_a': series('force', [[0.0, 0.0, 5.0], [2.0, 0.0, 5.0], [0, 0, 0]]),
+            'contact_a': series('point', [[0, 0, 0.0], [0, 0, -1e-5], [0, 0, 0.01]])}
+    assert engine_check(good, [(0, None)], {'friction': '0.5'}, 9.81, 0.2).passed
+    for key, rows in (('wrench_a', [[0, 0, 5.0], [2.6, 0, 5.0], [0, 0, 0]]),    # |F_t| > mu N
+                      ('wrench_a', [[0, 0, 5.0], [0, 0, -0.1], [0, 0, 0]]),     # pulls
+                      ('contact_a', [[0, 0, 0.0], [0, 0, -1e-3], [0, 0, 0]])):  # 5e-3 L deep
+        bad = dict(good, **{key: series('force' if key == 'wrench_a' else 'point', rows)})
+        assert not engine_check(bad, [(0, None)], {'friction': '0.5'}, 9.81, 0.2).passed
