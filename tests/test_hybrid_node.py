@@ -123,6 +123,6 @@ def test_the_engine_check_fails_outside_the_cone_and_through_the_ground():
     assert engine_check(good, [(0, None)], {'friction': '0.5'}, 9.81, 0.2).passed
     for key, rows in (('wrench_a', [[0, 0, 5.0], [2.6, 0, 5.0], [0, 0, 0]]),    # |F_t| > mu N
                       ('wrench_a', [[0, 0, 5.0], [0, 0, -0.1], [0, 0, 0]]),     # pulls
-                      ('contact_a', [[0, 0, 0.0], [0, 0, -1e-3], [0, 0, 0]])):  # 5e-3 L deep
+                      ('contact_a', [[0, 0, 0.0], [0, 0, -3e-3], [0, 0, 0]])):  # 1.5e-2 L deep
         bad = dict(good, **{key: series('force' if key == 'wrench_a' else 'point', rows)})
         assert not engine_check(bad, [(0, None)], {'friction': '0.5'}, 9.81, 0.2).passed

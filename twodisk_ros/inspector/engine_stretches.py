@@ -11,9 +11,10 @@ contact points:
 * Coulomb: |F_tangential| ≤ μ N (μ the recorded ``friction``), to 1e-6 of M g (MuJoCo's
   solver meets its elliptic cone to its tolerance; a disk's total of several contact forces
   inside the cone is inside it too);
-* no contact point below the ground by more than 1e-3 of the body's size (the engine's soft
-  contact sinks 1.4e-5 m for the package's bodies, its plates stand 5e-4 of the size off the
-  disk planes).
+* no contact point below the ground by more than 1e-2 of the body's size: the engine's soft
+  contact gives under an impact by about the impact speed × its time constant (5 ms: 1.1 mm
+  measured for the rounded square landing at 15 rad/s, 5.5e-3 of its size), and sinks
+  1.4e-5 m at rest.
 """
 
 from dataclasses import replace
@@ -31,7 +32,7 @@ ROLLING_EVENT = 'contact_model rolling:'
 #: roles sampled at the node's rate (the rest, e.g. diagnostics and paths, are kept whole)
 _PER_SAMPLE = ('pose', 'contact_a', 'contact_b', 'rolling_state', 'wrench_a', 'wrench_b')
 CONE_TOLERANCE = 1e-6      #: of M g: the engine's friction cone
-DEPTH_TOLERANCE = 1e-3     #: of the body's size: contact points below the ground
+DEPTH_TOLERANCE = 1e-2     #: of the body's size: contact points below the ground
 
 
 def engine_intervals(events):

@@ -187,6 +187,17 @@ class HybridMotion:
         self._phase = float(stream.state_at([0.0])[0][0])
         self._rims = self._normals = None
 
+    def prepare(self):
+        """Build now what the first switch needs (the engine: ~0.5 s, the phase grid), so a
+        realtime run does not pay it while publishing."""
+        if self._engine is None:
+            self._engine = Engine(self.dynamics.body, self.dynamics.mass,
+                                  self.dynamics.gravity, self.parameters)
+        if self._normals is None:
+            cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
+            self._normals = self.dynamics.body.phase_geometry(cycle).ground_normal
+        return self
+
     # -- rolling --------------------------------------------------------------------------
     def _rolling_forces(self, u, w):
         return self.model.dynamic(u, angular_speed=w)
@@ -220,10 +231,11 @@ class HybridMotion:
         grid = np.union1d(np.linspace(r.checked, ts[-1], count), ts)
         u, u_dot, w = r.stream.sample_with_speed(grid - r.t0)
         bad = self._bad(self._rolling_forces(u, w))
-        found = None
+        found, side = None, 'right'
         if bad.any():
             k = int(np.argmax(bad))
-            if k == 0:                   # fails at its start (t = 0)
+            if k == 0:                   # fails at its start (t = 0): the engine's from there
+                side = 'left'
                 found = float(grid[0]), check_validity(
                     grid[:1], self._rolling_forces(u[:1], w[:1]), self.mu)
             else:
@@ -231,9 +243,9 @@ class HybridMotion:
             r.checked = found[0]
         else:
             r.checked = float(ts[-1])
-        end = len(ts) if found is None else int(np.searchsorted(ts, found[0], 'right'))
+        end = len(ts) if found is None else int(np.searchsorted(ts, found[0], side))
         at = np.searchsorted(grid, ts[:end])
-        return self._rolling_samples(u[at], u_dot[at], w[at]), found
+        return (self._rolling_samples(u[at], u_dot[at], w[at]) if end else None), found
 
     def _rolling_samples(self, u, u_dot, w):
         r = self._rolling
@@ -258,9 +270,7 @@ class HybridMotion:
         r = self._rolling
         u, _, w = (float(x[0]) for x in r.stream.state_at([t_switch - r.t0]))
         state = engine_state(self.dynamics, u, w, r.yaw, r.shift[:2])
-        if self._engine is None:
-            self._engine = Engine(self.dynamics.body, self.dynamics.mass,
-                                  self.dynamics.gravity, self.parameters)
+        self.prepare()
         self._engine.set_state(state.qpos, state.qvel, t_switch)
         self._phase, self._held_since, self._rolling = u, None, None
         self.stretches[-1].t_end = t_switch
@@ -330,9 +340,6 @@ class HybridMotion:
         within π of the last one whose rolling pose has the closest ground normal to
         ``normal`` (body frame), and w from the energy E (J) as the return map does
         (:func:`~twodisk_ros.engine.state.nearest_rolling` solves for u exactly: 30 ms)."""
-        if self._normals is None:
-            cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
-            self._normals = self.dynamics.body.phase_geometry(cycle).ground_normal
         k0 = int(np.floor(self._phase / (2 * np.pi) * PHASE_GRID))
         ks = k0 + np.arange(-PHASE_GRID // 2, PHASE_GRID // 2 + 1)
         k = int(ks[np.argmax(self._normals[ks % PHASE_GRID] @ normal)])
@@ -384,10 +391,11 @@ class HybridMotion:
         while k < len(t):
             if self._rolling is not None:
                 values, found = self._rolling_block(t[k:])
-                parts.append(values)
+                if values is not None:
+                    parts.append(values)
+                    k += len(values['phase'])
                 if found is not None:
                     self._to_engine(*found)
-                k += len(values['phase'])
             else:
                 back = self._advance(float(t[k]))
                 if back is None:

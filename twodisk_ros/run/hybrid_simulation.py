@@ -55,7 +55,7 @@ class HybridSimulation(Simulation):
         from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
         s = self.settings
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
-                                   method=s.method, tolerance=s.tolerance)
+                                   method=s.method, tolerance=s.tolerance).prepare()
         self.announced = 1          # stretches already published as events
 
     def sample(self, t, forces=False, time_offset=0.0):
@@ -95,10 +95,12 @@ class HybridSimulation(Simulation):
         stretches = self.hybrid.stretches
         while self.announced < len(stretches):
             stretch = stretches[self.announced]
-            side = 'right' if stretch.model == 'engine' else 'left'
-            j = max(int(np.searchsorted(sample.t, stretch.t_start, side)), start)
-            if j >= stop:
+            mine = np.flatnonzero((sample.hybrid.engine == (stretch.model == 'engine'))
+                                  & (sample.t >= stretch.t_start))
+            mine = mine[mine >= start]
+            if not mine.size or mine[0] >= stop:
                 break
+            j = int(mine[0])
             found.append((j, f'contact_model {stretch.model}: {stretch.reason}'))
             self.announced += 1
         return found
