@@ -68,6 +68,8 @@ def test_the_stretches_alternate_with_reasons(runs):
     fast = runs['fast'].stretches
     assert [s.model for s in fast] == ['rolling', 'engine'] and fast[1].t_start == 0.0
     assert fast[1].reason.startswith('lift-off of B at t = 0 s'), fast[1].reason
+    # rolling fails at t = 0 (N_B < 0 there): the first sample is the engine's already
+    assert runs['s_fast'].engine.all() and runs['s_fast'].t[0] == 0.0
 
 
 def test_switch_time_is_the_crossing_of_the_rolling_model(runs):
