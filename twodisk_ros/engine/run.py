@@ -15,7 +15,7 @@ import numpy as np
 from .model import build_model
 from .state import quaternion_matrix
 
-__all__ = ['Engine', 'EngineSamples']
+__all__ = ['ContactDetails', 'Engine', 'EngineSamples']
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,21 @@ class EngineSamples:
     touching: np.ndarray
     normal_force: np.ndarray
     slip_speed: np.ndarray
+
+
+@dataclass(frozen=True)
+class ContactDetails:
+    """The contacts of each disk (A, B) now: touching (2,) bool; force (2, 3) N, the
+    ground's total force on the body (world); point (2, 3) m, the force-weighted mean contact
+    point (NaN if none pushes); slip (2,) m/s, the largest speed along the ground and normal
+    (2,) m/s, the largest speed along the normal of the body's material at its contact points
+    (0 where it does not touch)."""
+
+    touching: np.ndarray
+    force: np.ndarray
+    point: np.ndarray
+    slip: np.ndarray
+    normal: np.ndarray
 
 
 class Engine:
@@ -83,6 +98,77 @@ class Engine:
             speed = float(np.linalg.norm(tangential))
             slip[disk] = speed if np.isnan(slip[disk]) else max(slip[disk], speed)
         return touching, force, slip
+
+    def contact_details(self):
+        """The contacts now, per disk (A, B): :class:`ContactDetails` (module docstring's
+        attribution; the ground's force on the body, world frame)."""
+        mujoco, d = self._mujoco, self.data
+        touching = np.zeros(2, dtype=bool)
+        force, point = np.zeros((2, 3)), np.zeros((2, 3))
+        slip, normal = np.zeros(2), np.zeros(2)
+        rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
+        g, v, omega = d.qpos[:3], d.qvel[:3], rotation @ d.qvel[3:6]
+        f6 = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            if c.efc_address < 0:
+                continue
+            mujoco.mj_contactForce(self.model, d, i, f6)
+            p = rotation.T @ (c.pos - g)
+            disk = 0 if abs(p[2]) <= abs(p[0]) else 1
+            frame = c.frame.reshape(3, 3)
+            on_body = frame.T @ f6[:3] * (1.0 if c.geom1 == self._ground else -1.0)
+            velocity = v + np.cross(omega, c.pos - g)
+            along = float(velocity @ frame[0])
+            touching[disk] = True
+            force[disk] += on_body
+            point[disk] += max(f6[0], 0.0) * c.pos
+            slip[disk] = max(slip[disk], float(np.linalg.norm(velocity - along * frame[0])))
+            normal[disk] = max(normal[disk], abs(along))
+        weight = np.where(touching & (force[:, 2] > 0), force[:, 2], np.nan)
+        return ContactDetails(touching, force, point / weight[:, None], slip, normal)
+
+    def contact_speeds(self):
+        """(touching (2,) bool, slip (2,) m/s, normal (2,) m/s) per disk now, as
+        :meth:`contact_details` without the forces: vectorised, for a check after every step."""
+        d = self.data
+        touching, slip, normal = np.zeros(2, dtype=bool), np.zeros(2), np.zeros(2)
+        if d.ncon == 0:
+            return touching, slip, normal
+        con = d.contact
+        active = np.asarray(con.efc_address) >= 0
+        pos = np.asarray(con.pos).reshape(-1, 3)[active]
+        axis = np.asarray(con.frame).reshape(-1, 9)[active, :3]
+        rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
+        g = d.qpos[:3]
+        arm = pos - g
+        velocity = d.qvel[:3] + np.cross(rotation @ d.qvel[3:6], arm)
+        along = np.einsum('ij,ij->i', velocity, axis)
+        local = arm @ rotation
+        disk = (np.abs(local[:, 2]) > np.abs(local[:, 0])).astype(int)
+        sliding = np.linalg.norm(velocity - along[:, None] * axis, axis=1)
+        for k in range(2):
+            mine = disk == k
+            if mine.any():
+                touching[k] = True
+                slip[k] = sliding[mine].max()
+                normal[k] = np.abs(along[mine]).max()
+        return touching, slip, normal
+
+    def step_to(self, t):
+        """Step to time ``t`` (s, ≥ now): whole steps, then one shorter step to land on t
+        (so a sample is the state at its own time, not at the last step before it)."""
+        mujoco, d, m = self._mujoco, self.data, self.model
+        while d.time + self.timestep <= t + 1e-12 * max(1.0, abs(t)):
+            mujoco.mj_step(m, d)
+        rest = t - d.time
+        if rest > 1e-9 * self.timestep:
+            m.opt.timestep = rest
+            try:
+                mujoco.mj_step(m, d)
+            finally:
+                m.opt.timestep = self.timestep
+        d.time = float(t)
 
     def sample(self, times):
         """Step to each of ``times`` (s, non-decreasing, ≥ the current time), sampling there.

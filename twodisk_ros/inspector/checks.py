@@ -67,6 +67,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .engine_stretches import ROLLING_EVENT
 from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
 from .resolution import Resolution, resolve
@@ -277,7 +278,9 @@ def _energies(samples, motion, model):
     return recorded, model_fd, exact
 
 
-def _check_energy(samples, motion, model):
+def _check_energy(samples, motion, model, restarts=()):
+    """E against E0, E0 the first kept sample's, again after each stamp of ``restarts``
+    (int ns: exact rolling resumes with the engine's energy, contact_model hybrid)."""
     k = motion.index
     if k.size == 0:
         return _not_evaluated('energy', _NO_DIFFERENCES)
@@ -292,15 +295,19 @@ def _check_energy(samples, motion, model):
         return _not_evaluated('energy', kept.note)
     rows = np.nonzero(kept.keep)[0]
     reference = rows[0]
-    drift = np.abs(recorded[rows] - recorded[reference]) / scale
+    stretch = np.searchsorted(np.sort(np.asarray(restarts, dtype=np.int64)),
+                              samples.stamp_ns[k[rows]], side='right')
+    references = rows[np.searchsorted(stretch, stretch)]    # the first row of each stretch
+    drift = np.abs(recorded[rows] - recorded[references]) / scale
     worst = rows[int(np.argmax(drift))]
     fd_error = float(np.max(errors[rows]))
     solver = _solver_allowance(model)
-    model_drift = float(np.max(np.abs(exact[rows] - exact[reference]))) / scale
+    model_drift = float(np.max(np.abs(exact[rows] - exact[references]))) / scale
     return _check('energy', float(np.max(drift)), 2 * FD_MARGIN * fd_error + solver, '', [
         f'max |E − E0| / (M g L), E0 = {recorded[reference]:.8g} J'
         + ('' if reference == 0 else f' (at t = {samples.t[k[reference]]:.6g} s)')
-        + f', M g L = {scale:.4g} J; worst {_where(samples, k[worst])}, {rows.size} samples',
+        + f', M g L = {scale:.4g} J; worst {_where(samples, k[worst])}, {rows.size} samples'
+        + (f'; E0 again at each of {stretch[-1]} returns to rolling' if stretch[-1] else ''),
         f'FD-limited: the model poses at the recorded phases give E within {fd_error:.3g} of '
         f'the exact E(u, u̇); tolerance 2 × {FD_MARGIN:g} × that + {solver:.3g} (solver)',
         f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}']
@@ -345,8 +352,10 @@ def _run(checks, name, function, *args):
                                            f'{" ".join(str(error).split())}'))
 
 
-def run_checks(recording, problems, chosen, series, samples, model, parameters, events=()):
+def run_checks(recording, problems, chosen, series, samples, model, parameters, events=(),
+               whole=None):
     """Every check of a recording, in report order; returns (checks, Motion or None).
+    ``whole``: the series with the engine stretches of a hybrid run, for the stamp checks.
 
     An error while evaluating a check makes that check fail with the reason: never an
     exception out of here.
@@ -359,8 +368,9 @@ def run_checks(recording, problems, chosen, series, samples, model, parameters, 
     step_ns, source = nominal_step_ns(series, model)
     motion = _physics_checks(checks, samples, model, step_ns, scale, parameters, events,
                              series)
-    _run(checks, 'timestamps', check_timestamps, series, step_ns, source)
-    _run(checks, 'stamps', check_stamps, series, recording.truncated)
+    whole = series if whole is None else whole
+    _run(checks, 'timestamps', check_timestamps, whole, step_ns, source)
+    _run(checks, 'stamps', check_stamps, whole, recording.truncated)
     return checks, motion
 
 
@@ -406,7 +416,8 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(
             _run(checks, 'energy_balance', _check_energy_balance, samples, motion, model,
                  parameters, events, series)
     else:
-        _run(checks, 'energy', _check_energy, samples, motion, model)
+        _run(checks, 'energy', _check_energy, samples, motion, model,
+             [stamp for stamp, text in events if text.startswith(ROLLING_EVENT)])
     if any(speed_driven) and motion.index.size:
         _run(checks, 'speed_drive', speed_drive_check, samples, motion, model, timeline,
              parameters, events, FD_MARGIN, ROUNDOFF / motion.step + _solver_allowance(model))

@@ -23,6 +23,7 @@ from ..recordings.reader import collector_paused
 from .checks import run_checks
 from .completeness import run_completeness
 from .differences import kinetic_energy
+from .engine_stretches import engine_check, engine_intervals, split_series
 from .force_checks import FORCE_TITLES, force_checks
 from .model import build_model
 from .results import Check, Inspection, json_ready
@@ -153,19 +154,24 @@ def _inspect(path):
     t0_ns = min(log_times) if log_times else None
     t1_ns = max(log_times) if log_times else None
     stamp0 = min([int(s.stamp_ns.min()) for s in series.values() if len(s)] or [0])
+    events = [(message.log_time_ns, str(getattr(message.msg, 'data', '')))
+              for message in recording.messages if message.topic.rsplit('/', 1)[-1] == EVENTS]
+    intervals = engine_intervals(events)     # contact_model hybrid: checked on their own
+    whole, (series, engine) = series, split_series(series, intervals)
     samples = None
     try:
         samples = join_samples(series, stamp0)
     except ValueError as error:  # e.g. a zero quaternion
         problems.append(f'cannot use the poses: {" ".join(str(error).split())}')
-    events = [(message.log_time_ns, str(getattr(message.msg, 'data', '')))
-              for message in recording.messages if message.topic.rsplit('/', 1)[-1] == EVENTS]
     checks, motion = run_checks(recording, problems, chosen, series, samples, model,
-                                parameters, events)
+                                parameters, events, whole)
     more, forces, force_series = _force_checks(series, samples, motion, model, parameters,
                                                recording.truncated)
     checks.extend(more)
-    more, tf_summary = tf_check(recording, series, parameters, stamp0)
+    if intervals and model is not None:
+        checks.append(engine_check(engine, intervals, parameters, model.dynamics.mass.mass
+                                   * model.dynamics.gravity, model.body.size))
+    more, tf_summary = tf_check(recording, whole, parameters, stamp0)
     checks.extend(more)
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)
     summary['tf'] = tf_summary
@@ -174,12 +180,20 @@ def _inspect(path):
     summary['events'] = [{'t_s': (stamp - stamp0) * 1e-9, 'event': text}
                          for stamp, text in events]
     diagnostics = series.get('diagnostics')
+    every = samples if not intervals else _joined(whole, stamp0)    # (engine samples too)
     summary['run'] = json_ready(run_completeness(
-        recording, parameters, None if samples is None else samples.t,
+        recording, parameters, None if every is None else every.t,
         0 if diagnostics is None else len(diagnostics)))
     plot = _plot_series(series, samples, motion, model, stamp0)
     plot.update(force_series)
     return Inspection(summary, checks, plot, samples=samples, sources=series)
+
+
+def _joined(series, stamp0):
+    try:
+        return join_samples(series, stamp0)
+    except ValueError:      # (said of the rolling samples already)
+        return None
 
 
 def _force_checks(series, samples, motion, model, parameters, truncated):

@@ -41,7 +41,7 @@ def status(node, sample, i):
                    f'dropped since the last report ({node.samples_dropped} in all) to keep '
                    'real time')
     contact_level, contact_message, contact_values = simulation.contact_status(sample, i)
-    if contact_level > level:
+    if contact_level > level or contact_level == level == messages.OK:   # (OK: which model)
         level, message = contact_level, contact_message
     values = [(name, value), (f'{name}_drift', drift),
               ('energy', simulation.energy(sample, i)),

@@ -39,8 +39,8 @@ from ..physics.motion.startup import startup_estimate
 from ..run import schedule
 from ..run.description import RunDescription
 from ..run.parameters import BY_NAME, DEFAULTS, PARAMETERS
+from ..run.hybrid_simulation import simulation_of
 from ..run.scene_simulation import frame_metadata
-from ..run.simulation import Simulation
 from . import diagnostics, encoding, messages, run_summary, sim_clock
 from .descriptors import descriptor, ros_value
 from .frames_publisher import LatchedTopics, TF_QOS, TF_TOPIC, TFMessage, describe
@@ -70,7 +70,7 @@ NEED_FORCES = ('wrench_a', 'wrench_b', 'markers', '/diagnostics')
 
 
 class Roller(Node):
-    """Publishes the rolling body; the physics lives in :class:`Simulation`.
+    """Publishes the rolling body; the physics lives in :class:`Simulation` (or HybridSimulation).
 
     Raises ValueError or RuntimeError (one line) if the parameters define no valid run,
     and :class:`~twodisk_ros.recordings.RecordingError` if the record file cannot be written.
@@ -92,7 +92,7 @@ class Roller(Node):
         cost = startup_estimate(run.body)
         if cost.message:      # an extreme body: say what the tables cost while it is paid
             self.get_logger().info(cost.message)
-        self.simulation = Simulation(self.settings, run)
+        self.simulation = simulation_of(self.settings, run)
         note = run_summary.start_note(run.body, self.simulation.initial_state())
         if note:
             self.get_logger().info(note)
@@ -208,7 +208,7 @@ class Roller(Node):
         base = self._pending[0] if self._pending else self.settings
         try:
             candidate = base.with_values(**changes).checked()
-            simulation = (Simulation(candidate) if candidate.physics_differs(self.settings)
+            simulation = (simulation_of(candidate) if candidate.physics_differs(self.settings)
                           else None)
             built = simulation or self.simulation
             description = describe(candidate, built.body, built.dynamics.mass)
@@ -300,10 +300,14 @@ class Roller(Node):
         return encoded
 
     def _emit(self, sample, stamps, encoded, start, stop):
-        """Publish and record samples [start, stop) of a prepared block, sample by sample.
-
-        The latched topics go first when they changed, stamped with the first sample's stamp.
-        """
+        """Publish and record samples [start, stop) of a prepared block, sample by sample; the
+        latched topics first when they changed, stamped with the first sample's stamp; a
+        switch of contact model as an event stamped with the new model's first sample."""
+        for j, text in self.simulation.switches(sample, start, stop):
+            if j > start:
+                self._emit(sample, stamps, encoded, start, j)
+            start = j
+            self.control.event(text, self._tick)
         if self._latched.due:
             self._latched.send(int(stamps[start]), None if self._recorder is None
                                else self._recorder.write_serialized)
@@ -496,12 +500,9 @@ class Roller(Node):
             self._emit(sample, stamps, encoded, 0, missing)
 
     def close(self):
-        """Finish the recording (idempotent); RecordingError if it cannot be written.
-
-        A recording that never received a sample (stopped during start-up) is discarded:
-        its temporary file is removed and an existing file at ``record`` is left as it was.
-        Returns True if a recording was kept.
-        """
+        """Finish the recording (idempotent; RecordingError if it cannot be written); True if
+        one was kept. One without a sample (stopped during start-up) is discarded: its temporary
+        file removed, an existing file at ``record`` left as it was."""
         if self._recorder is None:
             return False
         return self._recorder.discard()   # closed as it is once it holds a sample

@@ -22,7 +22,7 @@ from ..physics.motion.simulate import METHODS, MODES
 from ..physics.scenes.scene import DRIVES
 from . import shape as shapes
 
-__all__ = ['BY_NAME', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
+__all__ = ['BY_NAME', 'CONTACT_MODELS', 'DEFAULTS', 'PARAMETERS', 'Parameter', 'RollerSettings', 'SHAPE_ONLY',
            'markdown_table', 'parse_recorded']
 
 B_OVER_A = (0.01, 100.0)             # allowed b/a
@@ -30,6 +30,8 @@ DAMPING_RATE = 1000.0                # 1/s: damping <= this x mass x max(a, b)^2
 SOLID_EXPONENT = 50.0                # largest superellipse exponent of the solid hull
 DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
 SLOPE_MAX = 1.5                      # rad: |slope| allowed (86 deg; pi/2 is a wall)
+#: contact_model values: exact rolling only, or rolling and MuJoCo's free body (issue 31)
+CONTACT_MODELS = ('rolling', 'hybrid')
 
 
 @dataclass(frozen=True)
@@ -138,6 +140,13 @@ PARAMETERS = (
     Parameter('friction', float, 0.5, '', 'friction coefficient mu between body and ground '
               '(.inf: no limit); slip where the motion needs more is outside the rolling '
               'model', 0.0, math.inf),
+    Parameter('contact_model', str, 'rolling', '', 'rolling (exact rolling throughout; where '
+              'it stops holding the rolling solution is published on, marked invalid) or '
+              'hybrid (exact rolling while it holds; from the instant a contact would lift off '
+              'or slip, a free rigid body with unilateral contacts and Coulomb friction '
+              'in MuJoCo, back to exact rolling once both contacts roll again); hybrid needs '
+              'mode dynamic, drive none, slope 0, no damping or rolling resistance',
+              choices=CONTACT_MODELS, physics=True),
     Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
     Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
               read_only=True),
@@ -254,6 +263,12 @@ def _check_together(s, outline=None):
         raise ValueError(f'damping must be <= {DAMPING_RATE:g}/s x mass x max(a, b)^2 = '
                          f'{damping_limit:.6g} N m s for this body (a spin-down faster than '
                          f'~1 ms is not simulated), got {s.damping!r}')
+    if s.contact_model == 'hybrid' and (s.mode, s.drive, s.slope, s.damping,
+                                        s.rolling_resistance) != ('dynamic', 'none', 0, 0, 0):
+        raise ValueError('contact_model hybrid needs mode dynamic, drive none, slope 0, damping 0 '
+                         'and rolling_resistance 0 (the free body has no motor, slope or '
+                         f'losses), got mode {s.mode}, drive {s.drive}, slope {s.slope!r}, '
+                         f'damping {s.damping!r}, rolling_resistance {s.rolling_resistance!r}')
     if s.shape == 'superellipse' and s.mass_model == 'solid' and s.exponent > SOLID_EXPONENT:
         raise ValueError(f'exponent must be <= {SOLID_EXPONENT:g} for mass_model solid (the '
                          'hull of sharper corners is not resolved in floating point; laminae '

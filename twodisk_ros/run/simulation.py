@@ -71,6 +71,8 @@ class Sample:
     #: w = |ω_u| u̇ (rad/s, signed as u̇): the angular speed about AB, finite also where the
     #: body stops turning in u (u̇ infinite there: a contact on a flat vertex)
     angular_speed: np.ndarray = None
+    #: contact_model hybrid: the block's HybridSamples (which model, engine state, energy)
+    hybrid: object = None
 
     def __len__(self):
         return len(self.t)
@@ -217,6 +219,11 @@ class Simulation:
         if settings.friction != self.settings.friction:
             self.invalid = None
         self.settings = settings
+
+    def switches(self, sample, start, stop):
+        """[(index, event text)] of the switches of contact model among samples [start, stop)
+        of a block (none: exact rolling only; :mod:`~twodisk_ros.run.hybrid_simulation`)."""
+        return []
 
     def contact_status(self, sample, i):
         """(level, message, values) of the contact forces at sample i, for the diagnostics.

@@ -235,6 +235,23 @@ class MotionStream:
         turning in u (:func:`~twodisk_ros.physics.motion.integrate.turning_state`)."""
         return self._sample(t, True)
 
+    @property
+    def segment(self):
+        """(start, end) (s) of the solution piece the last call ended in: :meth:`state_at`'s
+        span (end inf for a closed form)."""
+        return self._start, self._start + self._sol.t_end
+
+    def state_at(self, t):
+        """(u, u̇, w) at times t (s, any order) within :attr:`segment`, from the same dense
+        solution as :meth:`sample_with_speed` and without moving on: the root finding
+        between samples of :mod:`~twodisk_ros.run.hybrid`. ValueError outside the segment."""
+        t = np.asarray(t, dtype=float)
+        start, end = self.segment
+        if np.any(t < start) or np.any(t > end):
+            raise ValueError(f'state_at: times must lie in [{start:g}, {end:g}] s')
+        return tuple(np.stack(turning_state(self.dynamics, self._sol, t - start, self.mode,
+                                            self.initial_energy, self._speed)))
+
     def _sample(self, t, with_speed):
         t = np.asarray(t, dtype=float)
         pieces = []

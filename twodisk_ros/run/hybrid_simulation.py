@@ -1,0 +1,146 @@
+"""The node's simulation under ``contact_model:=hybrid`` (issue 31): no rclpy here.
+
+:class:`HybridSimulation` is the :class:`~twodisk_ros.run.simulation.Simulation` of the flat
+free scene whose samples come from :class:`~twodisk_ros.run.hybrid.HybridMotion`: exact
+rolling while it holds, MuJoCo's free body from the instant it stops holding, rolling again
+once both contacts roll. Nothing is marked invalid: ``/diagnostics`` says which model runs
+and why (:meth:`HybridSimulation.contact_status`), the node publishes each switch on
+``events`` (:meth:`HybridSimulation.switches`).
+
+The invariant: in a rolling stretch the energy against the stretch's start (exact rolling
+conserves it); in an engine stretch only an increase counts, beyond :data:`ENGINE_SINK`
+× M g (the soft contact's sinking, whose spring energy E does not hold): the engine loses
+energy where the plates' polygons roll over a vertex (docs/physics.md).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .simulation import Sample, Simulation, continuous_quaternions
+
+__all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'simulation_of']
+
+#: m: an engine stretch's energy may exceed its start by M g × this (G sinks 1.4e-5 m into
+#: the ground with the engine's defaults, engine/model.py)
+ENGINE_SINK = 2e-5
+
+
+@dataclass
+class HybridForces:
+    """The ground's forces of a block (arrays over samples, N, world frame): the rolling
+    model's in rolling samples, the engine's contact forces per disk in engine samples (0
+    for a disk in the air; ``mu_required`` is then the largest |tangential| / normal used,
+    NaN with no contact)."""
+
+    force_a: np.ndarray
+    force_b: np.ndarray
+    normal_a: np.ndarray
+    normal_b: np.ndarray
+    mu_required: np.ndarray
+
+
+def simulation_of(settings, run=None, **kwargs):
+    """The Simulation of ``settings``: :class:`HybridSimulation` for ``contact_model``
+    hybrid, else :class:`~twodisk_ros.run.simulation.Simulation` (bit for bit as before)."""
+    kind = HybridSimulation if settings.contact_model == 'hybrid' else Simulation
+    return kind(settings, run, **kwargs)
+
+
+class HybridSimulation(Simulation):
+    """:class:`~twodisk_ros.run.simulation.Simulation` under ``contact_model:=hybrid``."""
+
+    def __init__(self, settings, run=None, **kwargs):
+        super().__init__(settings, run, **kwargs)
+        from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
+        s = self.settings
+        self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
+                                   method=s.method, tolerance=s.tolerance).prepare()
+        self.announced = 1          # stretches already published as events
+
+    def sample(self, t, forces=False, time_offset=0.0):
+        """As :meth:`Simulation.sample`; the forces are always there (the switches need
+        them) and the block's :class:`~twodisk_ros.run.hybrid.HybridSamples` is ``hybrid``."""
+        h = self.hybrid.sample(t)
+        quaternion = continuous_quaternions(h.quaternion, self._last_quaternion)
+        if len(quaternion):
+            self._last_quaternion = quaternion[-1]
+        theta, psi, dtheta, dpsi = self.body.phase_angles_with_rates(h.phase)
+        with np.errstate(invalid='ignore'):
+            theta_rate, psi_rate = dtheta * h.phase_rate, dpsi * h.phase_rate
+        contact = HybridForces(h.force_a, h.force_b, h.normal_a, h.normal_b, h.mu_required)
+        return Sample(t=h.t, phase=h.phase, phase_rate=h.phase_rate, theta=theta, psi=psi,
+                      theta_rate=theta_rate, psi_rate=psi_rate, position_g=h.position_g,
+                      contact_a=h.contact_a, contact_b=h.contact_b, quaternion=quaternion,
+                      forces=contact, angular_speed=h.angular_speed, hybrid=h)
+
+    def update(self, settings):
+        """Take settings that leave the motion unchanged; a new friction is the engine's too
+        from the next switch on (rolling is judged by it at once)."""
+        super().update(settings)
+        self.hybrid.mu = float(settings.friction)
+
+    def stretch_at(self, t):
+        """The :class:`~twodisk_ros.run.hybrid.Stretch` holding time t (s, this motion's)."""
+        for stretch in reversed(self.hybrid.stretches):
+            if stretch.t_start <= t:
+                return stretch
+        return self.hybrid.stretches[0]
+
+    def switches(self, sample, start, stop):
+        """[(index, text)]: the stretches not yet announced whose first sample is among
+        [start, stop) of the block ``sample`` (index, ≥ start), with the event's text
+        (``contact_model <model>: <reason>``); marks them announced."""
+        found = []
+        stretches = self.hybrid.stretches
+        while self.announced < len(stretches):
+            stretch = stretches[self.announced]
+            mine = np.flatnonzero((sample.hybrid.engine == (stretch.model == 'engine'))
+                                  & (sample.t >= stretch.t_start))
+            mine = mine[mine >= start]
+            if not mine.size or mine[0] >= stop:
+                break
+            j = int(mine[0])
+            found.append((j, f'contact_model {stretch.model}: {stretch.reason}'))
+            self.announced += 1
+        return found
+
+    def contact_status(self, sample, i):
+        """(level, message, values): which model runs and why, with the contact values."""
+        h = sample.hybrid
+        stretch = self.stretch_at(float(sample.t[i]))
+        values = [('contact_model', 'hybrid'),
+                  ('model', 'engine' if h.engine[i] else 'rolling'),
+                  ('model_since', stretch.t_start), ('model_reason', stretch.reason),
+                  ('switches', len(self.hybrid.stretches) - 1)]
+        if not h.engine[i]:
+            level, message, rolling = super().contact_status(sample, i)
+            if stretch.mismatch is not None and level == 0:
+                message = f'rolling again since t = {stretch.t_start:.6g} s'
+            return level, message, rolling + values
+        touching = h.touching[i]
+        values += [('normal_a', float(h.normal_a[i])), ('normal_b', float(h.normal_b[i])),
+                   ('touching_a', bool(touching[0])), ('touching_b', bool(touching[1])),
+                   ('friction', self.settings.friction)]
+        air = [name for name, on in zip('AB', touching) if not on]
+        where = f'; {" and ".join(air)} in the air' if air else ''
+        return 0, f'free body (MuJoCo) since t = {stretch.t_start:.6g} s{where}', values
+
+    def invariant(self, sample, i):
+        """('energy', E, drift): rolling: |E − E_stretch| / (M g L); engine: only the rise
+        above E_stretch + :data:`ENGINE_SINK` × M g counts (module docstring)."""
+        energy = float(sample.hybrid.energy[i])
+        stretch = self.stretch_at(float(sample.t[i]))
+        scale = self.dynamics.energy_scale
+        if sample.hybrid.engine[i]:
+            rise = energy - stretch.energy - ENGINE_SINK * self.weight
+            return 'energy', energy, max(rise, 0.0) / scale
+        return 'energy', energy, abs(energy - stretch.energy) / scale
+
+    def energy(self, sample, i):
+        """E (J) at sample i: the rolling energy, or the engine's ½ M v² + ½ ωᵀIω + M g z."""
+        return float(sample.hybrid.energy[i])
+
+    def continued(self, settings, sample, i, *, drive=None, command=None):
+        """A hybrid run has no commands or scene changes (drive none, no losses): refused."""
+        raise ValueError('contact_model hybrid takes no commands or scene changes')
