@@ -204,6 +204,12 @@ def test_a_new_body_updates_the_plots_in_place(oloid, served):
     plot = explorer.cycle_plot
     assert explorer.change('delta', 0.06) is None
     assert explorer.cycle_plot is plot
+    # playing, the change draws the new motion's first frame with the new scene: t = 0 of the
+    # new settings' run (its Simulation sampled apart from the page)
+    first = explorer.shown
+    assert first is not None and first.t[0] == 0.0 and explorer.restart_shown is not None
+    reference = Simulation(oloid.with_values(delta=0.06).checked()).sample(first.t)
+    assert np.array_equal(first.position_g, reference.position_g)
     u, z = plot.data[0], plot.data[1]
     grid = np.linspace(0.0, 2 * math.pi, CYCLE_POINTS)
     poses = RunDescription(oloid.with_values(delta=0.06).checked()).dynamics.cycle.poses
