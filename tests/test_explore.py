@@ -232,6 +232,62 @@ def test_speed_pause_and_reset(oloid, served):
     assert explorer.motion.t == 0.0 and explorer.step(0.1).t[0] == 0.0
 
 
+def _distance_to_polyline(points, line):
+    """Distance (m) of each point (n, 3) to a polyline (k, 3): the least over its segments."""
+    a, b = line[:-1], line[1:]
+    d = b - a
+    rel = points[:, None, :] - a[None]
+    s = np.clip(np.einsum('nkj,kj->nk', rel, d) / np.einsum('kj,kj->k', d, d), 0.0, 1.0)
+    return np.linalg.norm(rel - s[..., None] * d[None], axis=2).min(axis=1)
+
+
+def test_a_simplified_trace_keeps_the_points_a_circle_needs():
+    """Points every theta on a circle of radius R: a chord spanning k steps passes
+    R (cos psi - cos(k theta / 2)) from the farthest point between (psi = 0 for k even,
+    theta / 2 for k odd), so the walk keeps every k-th point for the largest such k within
+    the tolerance; a straight line keeps its two ends, and its turning point if it goes back."""
+    from twodisk_ros.explore.scene3d import simplified
+    radius, theta, tolerance = 0.3, 2 * math.pi / 400, 1e-4
+    angles = theta * np.arange(150)
+    circle = radius * np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], 1)
+    def sagitta(k):
+        return radius * (math.cos(0.0 if k % 2 == 0 else theta / 2) - math.cos(k * theta / 2))
+    k = max(k for k in range(2, 150) if sagitta(k) <= tolerance)
+    expected = list(range(0, 150, k))
+    expected += [149] if expected[-1] != 149 else []
+    assert simplified(circle, tolerance).tolist() == expected
+    assert _distance_to_polyline(circle, circle[expected]).max() <= tolerance
+    line = np.outer(np.linspace(0.0, 1.0, 50), [0.3, -0.2, 0.1])
+    assert simplified(line, tolerance).tolist() == [0, 49]
+    # out and back along the line: the turning point is kept (every point lies on the line,
+    # but the tip lies beyond the chord from the first point to the last)
+    cusp = np.concatenate([line, line[-2::-1]])
+    assert simplified(cusp, tolerance).tolist() == [0, 49, 98]
+
+
+def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served):
+    """2 s of the oloid: the finished trace nodes have fewer points than samples, and every
+    sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of the
+    polyline drawn (the nodes' segments, sent as float32: 1e-6 m of rounding allowed)."""
+    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D
+    motion = LiveMotion(oloid)
+    scene = Scene3D(served, motion)
+    frames = [motion.advance(0.1, 10) for _ in range(20)]
+    for frame in frames:
+        scene.show(frame)
+    traces = scene.traces
+    assert len(traces.nodes) >= 2
+    for k, key in enumerate(('contact_a', 'contact_b', 'position_g')):
+        samples = np.concatenate([getattr(f, key) for f in frames])
+        segments = np.concatenate([handles[k].points for handles, _ in traces.nodes])
+        drawn = np.concatenate([segments[:, 0], segments[-1:, 1]]).astype(float)
+        assert np.array_equal(segments[1:, 0], segments[:-1, 1])      # one chain
+        covered = samples[:sum(n for _, n in traces.nodes) + 1]
+        assert len(drawn) < 0.7 * len(covered)
+        tolerance = TRACE_TOLERANCE * scene.size + 1e-6
+        assert _distance_to_polyline(covered, drawn).max() <= tolerance
+
+
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):
     from twodisk_ros.explore.page import Explorer
     explorer = Explorer(served, RecordedMotion(recording))
