@@ -395,9 +395,72 @@ def test_a_replay_shows_the_recorded_poses(recording):
     assert motion.change('a', 0.2).startswith('a is recorded in')
 
 
-def test_export_is_one_offline_file_and_of_a_recording_too(tmp_path, recording):
-    out = tmp_path / 'lesson.html'
-    result = _explore('--params-file', CONFIG / 'oloid.yaml', '--export', out, '--seconds', 2)
+def test_a_replay_has_the_phase_of_the_recorded_run(recording, oloid, served):
+    """The replay's phase u (for the marker on the z_G plot), found from the recorded
+    attitudes alone, is the phase of the node's own run of the same settings (its
+    Simulation sampled at the recorded stamps) to the matching grid's step 2 pi / PHASE_GRID;
+    the page's z_G plot marks the last frame's phase."""
+    from twodisk_ros.explore.motion import PHASE_GRID
+    from twodisk_ros.explore.page import Explorer
+    motion = RecordedMotion(recording)
+    frame = motion.advance(1.5)
+    node = Simulation(motion.settings).sample(frame.t).phase
+    error = np.angle(np.exp(1j * (frame.phase - np.asarray(node))))   # modulo 2 pi
+    assert len(frame) >= 50 and np.max(np.abs(error)) <= 0.5 * 2 * math.pi / PHASE_GRID + 1e-9
+    explorer = Explorer(served, RecordedMotion(recording))
+    shown = explorer.step(0.5)
+    now = explorer.cycle_plot.data[-1]
+    (k,) = np.flatnonzero(np.isfinite(now))
+    grid = explorer.cycle_plot.data[0]
+    assert k == np.argmin(abs(grid - shown.phase[-1] % (2 * math.pi)))
+
+
+def _lesson_moves(html):
+    import json
+    return json.loads(re.search(r'moves = (\{.*?\});', html).group(1))
+
+
+@pytest.fixture(scope='module')
+def lesson(tmp_path_factory):
+    """2 s of config/oloid.yaml exported by the command: (result, path)."""
+    out = tmp_path_factory.mktemp('lesson') / 'lesson.html'
+    return _explore('--params-file', CONFIG / 'oloid.yaml', '--export', out, '--seconds', 2), out
+
+
+def test_a_lesson_has_its_plots_and_their_markers_follow_the_run(lesson, oloid):
+    """2 s of the oloid: the lesson's panel has the three plots; frame k's translation of the
+    phase marker is, along u, the scale of the axis times the phase of the node's run at the
+    frame's time (its Simulation sampled apart; to the 0.01 pt the moves are rounded to), and
+    up the z_G axis that of the run's own z_G (flat ground: z_G(u) of the cycle, to 1 % of
+    the curve's span); the time lines move with t, not up or down."""
+    from twodisk_ros.explore.cli import EXPORT_FPS
+    result, path = lesson
+    assert result.returncode == 0, result.stderr
+    html = path.read_text(encoding='utf-8')
+    for title in ('id="lesson-plots"', 'z_G over the cycle', 'normal forces',
+                  'friction needed and available'):
+        assert title in html
+    moves = _lesson_moves(html)
+    t = np.arange(1, int(round(2 * EXPORT_FPS)) + 1) / EXPORT_FPS
+    run = Simulation(oloid).sample(t)
+    u = np.asarray(run.phase) % (2 * math.pi)
+    z = np.asarray(run.position_g)[:, 2]
+    phase = np.array(moves['lesson-phase'])
+    assert phase.shape == (len(t), 2)
+    k = np.argmax(abs(u - u[0]))
+    scale = phase[k, 0] / (u[k] - u[0])
+    assert scale > 0 and np.max(abs(phase[:, 0] - scale * (u - u[0]))) <= 0.01 + 1e-9
+    span = z.max() - z.min()
+    scale_z = -phase[np.argmax(abs(z - z[0])), 1] / (z[np.argmax(abs(z - z[0]))] - z[0])
+    assert np.max(abs(-phase[:, 1] - scale_z * (z - z[0]))) <= 0.01 * scale_z * span + 0.01
+    for key in ('lesson-time-1', 'lesson-time-2'):
+        line = np.array(moves[key])
+        step = line[-1, 0] / (t[-1] - t[0])
+        assert np.all(line[:, 1] == 0) and np.max(abs(line[:, 0] - step * (t - t[0]))) <= 0.01
+
+
+def test_export_is_one_offline_file_and_of_a_recording_too(tmp_path, recording, lesson):
+    result, out = lesson
     assert result.returncode == 0, result.stderr
     html = out.read_text(encoding='utf-8')
     assert len(html) < 3e6

@@ -329,6 +329,20 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     usable = np.ones(image.shape[:2], dtype=bool)
     usable[-45:] = False                               # the player's bar
     usable[-115:, :70] = False                         # the axes gizmo
+    left, top, right, bottom = browser.evaluate(      # the plots' panel
+        "(() => { const r = document.getElementById('lesson-plots').getBoundingClientRect();"
+        " return [r.left, r.top, r.right, r.bottom]; })()")
+    usable[max(0, int(top) - 2):int(bottom) + 3, max(0, int(left) - 2):int(right) + 3] = False
+    # the plots follow the player: the phase marker sits where the lesson puts frame k's
+    k = int(math.floor(seconds * EXPORT_FPS + 1e-6))
+    import json
+    import re
+    moves = json.loads(re.search(r'moves = (\{.*?\});', path.read_text(encoding='utf-8'))
+                       .group(1))
+    dx, dy = (0 if x == 0 else float(x) for x in moves['lesson-phase'][k])
+    assert browser.evaluate("document.getElementById('lesson-phase').getAttribute('transform')"
+                            ) == f"translate({repr(dx).removesuffix('.0')} " \
+                                 f"{repr(dy).removesuffix('.0')})"
     parts = mesh_parts(reference.body, settings.mass_model, resolution=MESH_RESOLUTION)
     g = frame.position_g[-1]
     check_drawn(image, parts, frame, -(g - g[2] * np.array([0.0, 0.0, 1.0])), camera,
