@@ -310,7 +310,7 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     explorer, browser, server, shots = live
     settings = explorer.motion.settings
     path = tmp_path / 'lesson.html'
-    export(LiveMotion(settings), path, seconds=5.0)     # long enough not to loop
+    export(LiveMotion(settings), path, seconds=3.0)     # paused before it loops
     browser.goto(path.as_uri())
     browser.wait_for("document.querySelector('.tabler-icon-player-pause-filled') !== null")
     _dismiss(browser)
