@@ -15,7 +15,9 @@ appended when absent) and prints JSON.
 - a lesson: ``--export`` of 20 s of the oloid and of the egg (bytes).
 
 Run ``python benchmarks/explore_rate.py [--quick] [--out docs/benchmarks.md]`` (PYTHONPATH = the
-repository); ``make bench`` runs it after benchmarks/run_all.py.
+repository); ``make bench`` runs it after benchmarks/run_all.py. ``--baseline DIR`` measures the
+page of another checkout (its ``twodisk_ros``, e.g. the main branch) the same way, with this
+script and this browser set-up, interleaved with this one, and reports both side by side.
 """
 
 import argparse
@@ -38,6 +40,9 @@ def _parser():
     parser.add_argument('--out', default=os.path.join(ROOT, 'docs', 'benchmarks.md'),
                         help='the report whose section is written (default docs/benchmarks.md)')
     parser.add_argument('--no-write', action='store_true', help='print the JSON only')
+    parser.add_argument('--baseline', metavar='DIR',
+                        help="also measure the page of the checkout DIR (its twodisk_ros)")
+    parser.add_argument('--code', metavar='DIR', help=argparse.SUPPRESS)   # the page measured
     return parser
 
 
@@ -76,10 +81,10 @@ def _open(browser, url):
                      ".forEach(b => b.click())")
 
 
-def server_cpu(seconds):
+def server_cpu(seconds, code=ROOT):
     """The command with one page connected: its CPU share and the browser's (1 = a core)."""
     from chromium import Chromium
-    env = dict(os.environ, PYTHONPATH=ROOT)
+    env = dict(os.environ, PYTHONPATH=code)
     process = subprocess.Popen(
         [sys.executable, '-m', 'twodisk_ros.explore', '--params-file',
          os.path.join(ROOT, 'config', 'oloid.yaml')], stdout=subprocess.PIPE, text=True,
@@ -237,29 +242,51 @@ def _median(values):
     return values[len(values) // 2] if values else float('nan')
 
 
+def _before(r, pick):
+    """' | a / b' of the baseline's two runs, or '' without a baseline."""
+    if 'baseline' not in r:
+        return ''
+    return ' | ' + ' / '.join(pick(run) for run in r['baseline']['runs'])
+
+
 def section(r):
     fps = r['fps']
     lat = r['latency_s']
+    base = 'baseline' in r
+    head = ('| measure | this page | before (baseline, run before / after) | target |'
+            if base else '| measure | value | target |')
+    rule = '| --- | --- | --- | --- |' if base else '| --- | --- | --- |'
+    blank = ' | -' if base else ''
     lines = [
         BEGIN, '## The page in a browser (twodisk-explore)', '',
         '`benchmarks/explore_rate.py` (`make bench`): the live page of config/oloid.yaml in '
-        "Debian's headless chromium with software GL (SwiftShader through ANGLE; no GPU), "
-        f'on this shared machine (load average {r["load"]:.1f} at the start).', '',
-        '| measure | value | target |', '| --- | --- | --- |',
-        *[f'| page frames a second, {size} | {value:.1f} fps | >= 30 fps |'
+        "Debian's headless chromium with software GL for WebGL (SwiftShader through ANGLE) "
+        'and software compositing, as Chrome runs without a usable GPU (tests/chromium.py), '
+        f'on this shared machine (load average {r["load"]:.1f} at the start, '
+        f'{r.get("load_end", r["load"]):.1f} at the end).'
+        + (f' Before: the page of `{r["baseline"]["dir"]}` measured the same way, just before '
+           'and just after this one.' if base else ''), '',
+        head, rule,
+        *[f'| page frames a second, {size} | {value:.1f} fps'
+          + _before(r, lambda run, size=size: f'{run["fps"][size]:.1f}') + ' | >= 30 fps |'
           for size, value in fps.items()],
         f'| server CPU at real time (oloid, one page connected) | {100 * r["server_cpu"]:.1f} '
-        '% of a core | <= 25 % |',
+        '% of a core' + _before(r, lambda run: f'{100 * run["server_cpu"]:.1f} %')
+        + ' | <= 25 % |',
         f'| the browser meanwhile (all its processes) | {100 * r["browser_cpu"]:.0f} % of a '
-        'core | - |',
+        'core' + _before(r, lambda run: f'{100 * run["browser_cpu"]:.0f} %') + ' | - |',
         f'| slider change to the new motion on screen, median of {len(lat)} (max) | '
-        f'{_median(lat):.2f} s ({max(lat):.2f} s) | <= 0.5 s |',
+        f'{_median(lat):.2f} s ({max(lat):.2f} s)'
+        + _before(r, lambda run: f'{_median(run["latency_s"]):.2f} s '
+                  f'({max(run["latency_s"]):.2f} s)') + ' | <= 0.5 s |',
         f'| of which: key press to the server\'s callback, median | '
-        f'{_median(r["server_heard_s"]):.3f} s | - |',
+        f'{_median(r["server_heard_s"]):.3f} s'
+        + _before(r, lambda run: f'{_median(run["server_heard_s"]):.3f} s') + ' | - |',
         f'| key press to the new motion\'s first frame sent, median | '
-        f'{_median(r["server_sent_s"]):.3f} s | - |',
+        f'{_median(r["server_sent_s"]):.3f} s'
+        + _before(r, lambda run: f'{_median(run["server_sent_s"]):.3f} s') + ' | - |',
         *[f'| lesson of {r["lesson_seconds"]:g} s, {name} (`--export`) | '
-          f'{v["bytes"] / 1e6:.2f} MB, written in {v["export_s"]:.1f} s | a few MB |'
+          f'{v["bytes"] / 1e6:.2f} MB, written in {v["export_s"]:.1f} s{blank} | a few MB |'
           for name, v in r['lessons'].items()],
         '',
         'Server side, a change of a control to the first frame of the new motion '
@@ -272,6 +299,9 @@ def section(r):
         *[f'| {name} | {v.get("theta0", math.nan):.3f} | {v.get("a", math.nan):.3f} |'
           for name, v in r['restart_s'].items()],
         '',
+        'The page\'s frame cost under software GL grows with the triangles drawn: the '
+        'traces are most of them, so a finished trace node keeps only the points needed to '
+        'pass within 1e-3 body sizes of every sample (about 0.2 px). '
         'Software GL draws the page slowly: the frame rate is that of SwiftShader on the '
         "machine's shared cores, not of a browser with a GPU. The on-screen latency is "
         'measured by screenshots (each one waits for a frame), so it includes at least one '
@@ -289,24 +319,50 @@ def write(path, text):
         out.write(new)
 
 
+def page(args):
+    """The measures of the page of the code imported (fps, server CPU, latency)."""
+    results = page_measures(2 if args.quick else 5, 1.0 if args.quick else 3.0)
+    results.update(server_cpu(3.0 if args.quick else 10.0, args.code or ROOT))
+    return results
+
+
+def baseline(args):
+    """The page measures of the checkout ``args.baseline`` (a run of this script with
+    ``--code``)."""
+    command = [sys.executable, os.path.abspath(__file__), '--code', args.baseline, '--no-write']
+    if args.quick:
+        command.append('--quick')
+    env = dict(os.environ, PYTHONPATH=args.baseline)
+    output = subprocess.run(command, env=env, capture_output=True, text=True, check=True).stdout
+    return json.loads(output[output.index('{'):])
+
+
 def main():
     args = _parser().parse_args()
     sys.path.insert(0, os.path.join(ROOT, 'tests'))
-    if ROOT not in sys.path:
-        sys.path.insert(0, ROOT)
+    code = args.code or ROOT
+    if code not in sys.path:
+        sys.path.insert(0, code)
     from chromium import missing
     reason = missing()
     if reason:
         print(f'explore_rate: skipped: {reason}', file=sys.stderr)
         return 0
     load = os.getloadavg()[0]
+    if args.code:                     # a baseline's page measures only
+        print(json.dumps(page(args)))
+        return 0
     results = {'load': load}
-    results.update(page_measures(2 if args.quick else 5, 1.0 if args.quick else 3.0))
-    results.update(server_cpu(3.0 if args.quick else 10.0))
+    before = baseline(args) if args.baseline else None
+    results.update(page(args))
+    if args.baseline:                 # before, after, before again: the machine's load drifts
+        again = baseline(args)
+        results['baseline'] = {'dir': args.baseline, 'runs': [before, again]}
     results['restart_repeats'] = 2 if args.quick else 4
     results['restart_s'] = restart_times(results['restart_repeats'])
     results['lesson_seconds'] = 5.0 if args.quick else 20.0
     results['lessons'] = lesson_sizes(results['lesson_seconds'])
+    results['load_end'] = os.getloadavg()[0]
     print(json.dumps(results, indent=1))
     if not args.no_write:
         write(args.out, section(results))

@@ -1,8 +1,10 @@
 """A headless Chromium driven over the DevTools protocol (tests and benchmarks of the page).
 
-Debian's ``chromium`` (``/usr/bin/chromium``) with software GL (SwiftShader through ANGLE),
-no sandbox (containers), no network but loopback (a proxy that does not exist for
-everything else), a profile of its own in a temporary directory. The protocol is spoken
+Debian's ``chromium`` (``/usr/bin/chromium``) with software GL (SwiftShader through ANGLE) for
+WebGL and software compositing, as Chrome runs on a machine without a usable GPU (compositing
+the page's layers through SwiftShader too costs the browser about a third more CPU a frame,
+docs/benchmarks.md); no sandbox (containers), no network but loopback (a proxy that does not
+exist for everything else), a profile of its own in a temporary directory. The protocol is spoken
 with ``websockets`` (pinned in requirements.txt): no Playwright and no browser download.
 """
 
@@ -27,7 +29,9 @@ FLAGS = ('--headless=new', '--use-angle=swiftshader', '--enable-unsafe-swiftshad
          '--remote-debugging-port=0', '--remote-allow-origins=*',
          # a headless page counts as hidden: without these its frames are throttled
          '--disable-background-timer-throttling', '--disable-backgrounding-occluded-windows',
-         '--disable-renderer-backgrounding')
+         '--disable-renderer-backgrounding',
+         # Chrome's own mode without a GPU: layers composited in software, WebGL in SwiftShader
+         '--disable-gpu-compositing')
 
 
 def missing():

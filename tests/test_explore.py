@@ -204,6 +204,12 @@ def test_a_new_body_updates_the_plots_in_place(oloid, served):
     plot = explorer.cycle_plot
     assert explorer.change('delta', 0.06) is None
     assert explorer.cycle_plot is plot
+    # playing, the change draws the new motion's first frame with the new scene: t = 0 of the
+    # new settings' run (its Simulation sampled apart from the page)
+    first = explorer.shown
+    assert first is not None and first.t[0] == 0.0 and explorer.restart_shown is not None
+    reference = Simulation(oloid.with_values(delta=0.06).checked()).sample(first.t)
+    assert np.array_equal(first.position_g, reference.position_g)
     u, z = plot.data[0], plot.data[1]
     grid = np.linspace(0.0, 2 * math.pi, CYCLE_POINTS)
     poses = RunDescription(oloid.with_values(delta=0.06).checked()).dynamics.cycle.poses
@@ -224,6 +230,62 @@ def test_speed_pause_and_reset(oloid, served):
     explorer.toggle()
     explorer.reset()
     assert explorer.motion.t == 0.0 and explorer.step(0.1).t[0] == 0.0
+
+
+def _distance_to_polyline(points, line):
+    """Distance (m) of each point (n, 3) to a polyline (k, 3): the least over its segments."""
+    a, b = line[:-1], line[1:]
+    d = b - a
+    rel = points[:, None, :] - a[None]
+    s = np.clip(np.einsum('nkj,kj->nk', rel, d) / np.einsum('kj,kj->k', d, d), 0.0, 1.0)
+    return np.linalg.norm(rel - s[..., None] * d[None], axis=2).min(axis=1)
+
+
+def test_a_simplified_trace_keeps_the_points_a_circle_needs():
+    """Points every theta on a circle of radius R: a chord spanning k steps passes
+    R (cos psi - cos(k theta / 2)) from the farthest point between (psi = 0 for k even,
+    theta / 2 for k odd), so the walk keeps every k-th point for the largest such k within
+    the tolerance; a straight line keeps its two ends, and its turning point if it goes back."""
+    from twodisk_ros.explore.scene3d import simplified
+    radius, theta, tolerance = 0.3, 2 * math.pi / 400, 1e-4
+    angles = theta * np.arange(150)
+    circle = radius * np.stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)], 1)
+    def sagitta(k):
+        return radius * (math.cos(0.0 if k % 2 == 0 else theta / 2) - math.cos(k * theta / 2))
+    k = max(k for k in range(2, 150) if sagitta(k) <= tolerance)
+    expected = list(range(0, 150, k))
+    expected += [149] if expected[-1] != 149 else []
+    assert simplified(circle, tolerance).tolist() == expected
+    assert _distance_to_polyline(circle, circle[expected]).max() <= tolerance
+    line = np.outer(np.linspace(0.0, 1.0, 50), [0.3, -0.2, 0.1])
+    assert simplified(line, tolerance).tolist() == [0, 49]
+    # out and back along the line: the turning point is kept (every point lies on the line,
+    # but the tip lies beyond the chord from the first point to the last)
+    cusp = np.concatenate([line, line[-2::-1]])
+    assert simplified(cusp, tolerance).tolist() == [0, 49, 98]
+
+
+def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served):
+    """2 s of the oloid: the finished trace nodes have fewer points than samples, and every
+    sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of the
+    polyline drawn (the nodes' segments, sent as float32: 1e-6 m of rounding allowed)."""
+    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D
+    motion = LiveMotion(oloid)
+    scene = Scene3D(served, motion)
+    frames = [motion.advance(0.1, 10) for _ in range(20)]
+    for frame in frames:
+        scene.show(frame)
+    traces = scene.traces
+    assert len(traces.nodes) >= 2
+    for k, key in enumerate(('contact_a', 'contact_b', 'position_g')):
+        samples = np.concatenate([getattr(f, key) for f in frames])
+        segments = np.concatenate([handles[k].points for handles, _ in traces.nodes])
+        drawn = np.concatenate([segments[:, 0], segments[-1:, 1]]).astype(float)
+        assert np.array_equal(segments[1:, 0], segments[:-1, 1])      # one chain
+        covered = samples[:sum(n for _, n in traces.nodes) + 1]
+        assert len(drawn) < 0.7 * len(covered)
+        tolerance = TRACE_TOLERANCE * scene.size + 1e-6
+        assert _distance_to_polyline(covered, drawn).max() <= tolerance
 
 
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):
@@ -333,9 +395,72 @@ def test_a_replay_shows_the_recorded_poses(recording):
     assert motion.change('a', 0.2).startswith('a is recorded in')
 
 
-def test_export_is_one_offline_file_and_of_a_recording_too(tmp_path, recording):
-    out = tmp_path / 'lesson.html'
-    result = _explore('--params-file', CONFIG / 'oloid.yaml', '--export', out, '--seconds', 2)
+def test_a_replay_has_the_phase_of_the_recorded_run(recording, oloid, served):
+    """The replay's phase u (for the marker on the z_G plot), found from the recorded
+    attitudes alone, is the phase of the node's own run of the same settings (its
+    Simulation sampled at the recorded stamps) to the matching grid's step 2 pi / PHASE_GRID;
+    the page's z_G plot marks the last frame's phase."""
+    from twodisk_ros.explore.motion import PHASE_GRID
+    from twodisk_ros.explore.page import Explorer
+    motion = RecordedMotion(recording)
+    frame = motion.advance(1.5)
+    node = Simulation(motion.settings).sample(frame.t).phase
+    error = np.angle(np.exp(1j * (frame.phase - np.asarray(node))))   # modulo 2 pi
+    assert len(frame) >= 50 and np.max(np.abs(error)) <= 0.5 * 2 * math.pi / PHASE_GRID + 1e-9
+    explorer = Explorer(served, RecordedMotion(recording))
+    shown = explorer.step(0.5)
+    now = explorer.cycle_plot.data[-1]
+    (k,) = np.flatnonzero(np.isfinite(now))
+    grid = explorer.cycle_plot.data[0]
+    assert k == np.argmin(abs(grid - shown.phase[-1] % (2 * math.pi)))
+
+
+def _lesson_moves(html):
+    import json
+    return json.loads(re.search(r'moves = (\{.*?\});', html).group(1))
+
+
+@pytest.fixture(scope='module')
+def lesson(tmp_path_factory):
+    """2 s of config/oloid.yaml exported by the command: (result, path)."""
+    out = tmp_path_factory.mktemp('lesson') / 'lesson.html'
+    return _explore('--params-file', CONFIG / 'oloid.yaml', '--export', out, '--seconds', 2), out
+
+
+def test_a_lesson_has_its_plots_and_their_markers_follow_the_run(lesson, oloid):
+    """2 s of the oloid: the lesson's panel has the three plots; frame k's translation of the
+    phase marker is, along u, the scale of the axis times the phase of the node's run at the
+    frame's time (its Simulation sampled apart; to the 0.01 pt the moves are rounded to), and
+    up the z_G axis that of the run's own z_G (flat ground: z_G(u) of the cycle, to 1 % of
+    the curve's span); the time lines move with t, not up or down."""
+    from twodisk_ros.explore.cli import EXPORT_FPS
+    result, path = lesson
+    assert result.returncode == 0, result.stderr
+    html = path.read_text(encoding='utf-8')
+    for title in ('id="lesson-plots"', 'z_G over the cycle', 'normal forces',
+                  'friction needed and available'):
+        assert title in html
+    moves = _lesson_moves(html)
+    t = np.arange(1, int(round(2 * EXPORT_FPS)) + 1) / EXPORT_FPS
+    run = Simulation(oloid).sample(t)
+    u = np.asarray(run.phase) % (2 * math.pi)
+    z = np.asarray(run.position_g)[:, 2]
+    phase = np.array(moves['lesson-phase'])
+    assert phase.shape == (len(t), 2)
+    k = np.argmax(abs(u - u[0]))
+    scale = phase[k, 0] / (u[k] - u[0])
+    assert scale > 0 and np.max(abs(phase[:, 0] - scale * (u - u[0]))) <= 0.01 + 1e-9
+    span = z.max() - z.min()
+    scale_z = -phase[np.argmax(abs(z - z[0])), 1] / (z[np.argmax(abs(z - z[0]))] - z[0])
+    assert np.max(abs(-phase[:, 1] - scale_z * (z - z[0]))) <= 0.01 * scale_z * span + 0.01
+    for key in ('lesson-time-1', 'lesson-time-2'):
+        line = np.array(moves[key])
+        step = line[-1, 0] / (t[-1] - t[0])
+        assert np.all(line[:, 1] == 0) and np.max(abs(line[:, 0] - step * (t - t[0]))) <= 0.01
+
+
+def test_export_is_one_offline_file_and_of_a_recording_too(tmp_path, recording, lesson):
+    result, out = lesson
     assert result.returncode == 0, result.stderr
     html = out.read_text(encoding='utf-8')
     assert len(html) < 3e6

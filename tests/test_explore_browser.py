@@ -114,6 +114,11 @@ def check_drawn(image, parts, frame, shift, camera, canvas, usable, overlay=None
     return hull, seen
 
 
+#: The browser's window (CSS px): small, because software GL's cost of a frame grows with its
+#: pixels; the scene checks collapse the control panel, which would cover the body.
+WINDOW = (640, 400)
+
+
 @pytest.fixture(scope='module')
 def live(tmp_path_factory):
     from twodisk_ros.explore.cli import _server, stop_server
@@ -122,10 +127,12 @@ def live(tmp_path_factory):
     from twodisk_ros.runs import settings_from
     settings = settings_from('config/oloid.yaml', realtime=True)
     server = _server('127.0.0.1', 0)
-    explorer = Explorer(server, open_motion(settings=settings)).start()
+    explorer = Explorer(server, open_motion(settings=settings))
+    explorer.toggle()            # paused: a test plays the motion only while it needs it
+    explorer.start()
     browser = None
     try:
-        browser = Chromium(960, 600)
+        browser = Chromium(*WINDOW)
         browser.goto(f'http://127.0.0.1:{server.get_port()}/')
         browser.wait_for("document.body !== null && document.body.innerText.includes('rolling')")
         _dismiss(browser)
@@ -150,16 +157,49 @@ def _camera(server):
             np.asarray(c.up_direction, dtype=float), float(c.fov))
 
 
+def _panel(browser, collapsed):
+    """Collapse (or open) the control panel with its own minimize button; wait until its
+    Play/Pause button is hidden (or shown)."""
+    button = "document.querySelector('[data-dock-minimize]')"
+    if browser.evaluate(f"{button}.getAttribute('aria-expanded') === 'true'") == collapsed:
+        browser.evaluate(f"{button}.click()")
+    browser.wait_for("Array.from(document.querySelectorAll('button')).some(b => "
+                     "/^(Play|Pause)$/.test(b.innerText) && "
+                     f"b.getBoundingClientRect().height > 0) === {str(not collapsed).lower()}")
+
+
 def _usable(browser, height, width):
-    """Pixels of the scene not under the control panel (from 30 px left of its Play button)
-    nor under the axes gizmo (the bottom left 70 px square)."""
-    left = browser.evaluate(
-        "Array.from(document.querySelectorAll('button'))"
-        ".find(b => /^(Play|Pause)$/.test(b.innerText)).getBoundingClientRect().left")
+    """Pixels of the scene not under the collapsed control panel (its title bar, from 30 px
+    left of its cloud icon and 30 px below its minimize button) nor under the axes gizmo (the
+    bottom left 70 px square)."""
+    left, bottom = browser.evaluate(
+        "[document.querySelector('.tabler-icon-cloud-check').getBoundingClientRect().left, "
+        "document.querySelector('[data-dock-minimize]').getBoundingClientRect().bottom]")
     usable = np.ones((height, width), dtype=bool)
-    usable[:, int(left) - 30:] = False
+    usable[:int(bottom) + 30, int(left) - 30:] = False
     usable[-70:, :70] = False
     return usable
+
+
+#: The page's three.js position of the body's node (viser's E2E hook ``__viserMutable``).
+BODY_NODE = "__viserMutable.nodeRefFromName['/world/body'].position"
+
+
+def _shown_on_page(browser, frame):
+    """Wait until the page has drawn ``frame``'s pose: the body node's position is G (the
+    client applies a pose in its render loop, just before drawing the frame)."""
+    g = [float(x) for x in frame.position_g[-1]]
+    browser.wait_for(f"(() => {{ const p = {BODY_NODE}; const g = {g}; "
+                     "return Math.hypot(p.x - g[0], p.y - g[1], p.z - g[2]) "
+                     "<= 1e-9 * (1 + Math.hypot(...g)); })()", timeout=20)
+
+
+def _play_until(explorer, t, timeout=20.0):
+    """Play until the page's last frame is at simulated time >= t (s), then pause."""
+    if not explorer.playing:
+        explorer.toggle()
+    _until(lambda: explorer.shown is not None and explorer.shown.t[-1] >= t, timeout)
+    explorer.toggle()
 
 
 def _paused_shot(explorer, browser, path):
@@ -167,7 +207,7 @@ def _paused_shot(explorer, browser, path):
     if explorer.playing:
         explorer.toggle()
     frame = explorer.shown
-    time.sleep(0.3)                                   # the last frame reaches the page
+    _shown_on_page(browser, frame)
     image = browser.screenshot(path)
     assert explorer.shown is frame
     return image, frame, explorer.scene.shift(frame.position_g[-1])
@@ -176,24 +216,24 @@ def _paused_shot(explorer, browser, path):
 def test_the_body_is_drawn_where_its_pose_projects_and_it_moves(live):
     explorer, browser, server, shots = live
     explorer.reset()
-    if not explorer.playing:
-        explorer.toggle()
-    time.sleep(0.5)
-    first, frame1, shift1 = _paused_shot(explorer, browser, shots / 'explore_live_1.png')
-    usable = _usable(browser, *first.shape[:2])
-    camera, canvas = _camera(server), _canvas(browser)
-    parts = explorer.scene.parts
-    hull1, seen1 = check_drawn(first, parts, frame1, shift1, camera, canvas, usable,
-                               shots / 'explore_live_1_projected.png')
-    explorer.toggle()
-    time.sleep(0.5)
-    second, frame2, shift2 = _paused_shot(explorer, browser, shots / 'explore_live_2.png')
-    hull2, seen2 = check_drawn(second, parts, frame2, shift2, camera, canvas, usable)
-    assert frame2.t[-1] > frame1.t[-1] + 0.2
-    # it moved: the projected silhouettes differ, and so do the drawn bodies
-    assert (hull1 ^ hull2).sum() > 0.05 * hull1.sum()
-    assert (seen1 ^ seen2).sum() > 0.05 * seen1.sum()
-    explorer.toggle()
+    _panel(browser, collapsed=True)
+    try:
+        _play_until(explorer, 0.5)
+        first, frame1, shift1 = _paused_shot(explorer, browser, shots / 'explore_live_1.png')
+        usable = _usable(browser, *first.shape[:2])
+        camera, canvas = _camera(server), _canvas(browser)
+        parts = explorer.scene.parts
+        hull1, seen1 = check_drawn(first, parts, frame1, shift1, camera, canvas, usable,
+                                   shots / 'explore_live_1_projected.png')
+        _play_until(explorer, frame1.t[-1] + 0.5)
+        second, frame2, shift2 = _paused_shot(explorer, browser, shots / 'explore_live_2.png')
+        hull2, seen2 = check_drawn(second, parts, frame2, shift2, camera, canvas, usable)
+        assert frame2.t[-1] > frame1.t[-1] + 0.2
+        # it moved: the projected silhouettes differ, and so do the drawn bodies
+        assert (hull1 ^ hull2).sum() > 0.05 * hull1.sum()
+        assert (seen1 ^ seen2).sum() > 0.05 * seen1.sum()
+    finally:
+        _panel(browser, collapsed=False)
 
 
 def _slider(browser, label):
@@ -204,6 +244,13 @@ def _slider(browser, label):
         "let row = label; while (row && !row.querySelector('[role=slider]')) "
         "row = row.parentElement; const t = row.querySelector('[role=slider]'); t.focus(); "
         "return Number(t.getAttribute('aria-valuenow')); })()")
+
+
+def _frames(browser, count):
+    """Wait for ``count`` animation frames of the page."""
+    browser.evaluate("new Promise(done => { let n = %d; const f = () => --n > 0 ? "
+                     "requestAnimationFrame(f) : done(true); requestAnimationFrame(f); })"
+                     % count)
 
 
 def _until(predicate, timeout=10.0):
@@ -239,10 +286,14 @@ def test_a_refused_value_shows_the_nodes_reason_and_the_motion_goes_on(live):
     reason = ' '.join(str(node.value).split())
     assert explorer.refused == reason
     browser.wait_for(f"document.body.innerText.includes({('refused: ' + reason)!r})")
-    browser.screenshot(shots / 'explore_refused.png')
     assert explorer.motion.settings == settings and explorer.motion.restarts == restarts
     t = explorer.motion.t
-    _until(lambda: explorer.motion.t > t + 0.1)        # the previous motion goes on
+    explorer.toggle()                                  # play: the previous motion goes on
+    try:
+        _until(lambda: explorer.motion.t > t + 0.1)
+    finally:
+        explorer.toggle()
+    assert explorer.motion.restarts == restarts
     # the slider is back at the accepted value
     browser.wait_for(f"Number(document.activeElement.getAttribute('aria-valuenow')) === "
                      f"{settings.delta}")
@@ -259,14 +310,14 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     explorer, browser, server, shots = live
     settings = explorer.motion.settings
     path = tmp_path / 'lesson.html'
-    export(LiveMotion(settings), path, seconds=5.0)     # long enough not to loop
+    export(LiveMotion(settings), path, seconds=3.0)     # paused before it loops
     browser.goto(path.as_uri())
     browser.wait_for("document.querySelector('.tabler-icon-player-pause-filled') !== null")
     _dismiss(browser)
-    time.sleep(0.3)
     browser.evaluate("document.querySelector('.tabler-icon-player-pause-filled')"
                      ".closest('button').click()")
-    time.sleep(0.3)
+    browser.wait_for("document.querySelector('.tabler-icon-player-play-filled') !== null")
+    _frames(browser, 2)                                # the paused scene is drawn
     image = browser.screenshot(shots / 'explore_lesson.png')
     seconds = float(browser.evaluate(          # the player's time (s, to 1 ms)
         "document.querySelector('.mantine-Slider-root input[type=hidden]').value"))
@@ -278,6 +329,20 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     usable = np.ones(image.shape[:2], dtype=bool)
     usable[-45:] = False                               # the player's bar
     usable[-115:, :70] = False                         # the axes gizmo
+    left, top, right, bottom = browser.evaluate(      # the plots' panel
+        "(() => { const r = document.getElementById('lesson-plots').getBoundingClientRect();"
+        " return [r.left, r.top, r.right, r.bottom]; })()")
+    usable[max(0, int(top) - 2):int(bottom) + 3, max(0, int(left) - 2):int(right) + 3] = False
+    # the plots follow the player: the phase marker sits where the lesson puts frame k's
+    k = int(math.floor(seconds * EXPORT_FPS + 1e-6))
+    import json
+    import re
+    moves = json.loads(re.search(r'moves = (\{.*?\});', path.read_text(encoding='utf-8'))
+                       .group(1))
+    dx, dy = (0 if x == 0 else float(x) for x in moves['lesson-phase'][k])
+    assert browser.evaluate("document.getElementById('lesson-phase').getAttribute('transform')"
+                            ) == f"translate({repr(dx).removesuffix('.0')} " \
+                                 f"{repr(dy).removesuffix('.0')})"
     parts = mesh_parts(reference.body, settings.mass_model, resolution=MESH_RESOLUTION)
     g = frame.position_g[-1]
     check_drawn(image, parts, frame, -(g - g[2] * np.array([0.0, 0.0, 1.0])), camera,

@@ -174,8 +174,11 @@ def stop_server(server):
 
 def export(motion, path, seconds=EXPORT_SECONDS, fps=EXPORT_FPS):
     """Write the lesson: ``seconds`` of ``motion`` at ``fps`` frames a second, one HTML file
-    that plays in a browser with no server and no network; return its size (bytes)."""
+    that plays in a browser with no server and no network, with its plots (z_G over the cycle
+    and the phase, N_A, N_B, mu_required: :mod:`~twodisk_ros.explore.lesson`); return its
+    size (bytes)."""
     from ..outputs import replacing
+    from .lesson import LessonPlots, with_plots
     from .page import PLOT_RATE
     from .scene3d import Scene3D, camera_for
     server = _server(DEFAULT_HOST, 0)
@@ -190,11 +193,13 @@ def export(motion, path, seconds=EXPORT_SECONDS, fps=EXPORT_FPS):
         if not motion.live:
             frames = min(frames, int(motion.duration * fps) + 1)
         every = max(1, int(round(fps / PLOT_RATE)))
+        plots = LessonPlots(motion, fps)
         for k in range(frames):
             frame = motion.advance(1.0 / fps, samples=4)
             scene.show(frame, traces=k % every == 0 or k == frames - 1)
+            plots.add(frame)
             serializer.insert_sleep(1.0 / fps)
-        html = serializer.as_html()
+        html = with_plots(serializer.as_html(), plots)
     finally:
         stop_server(server)
     with replacing(path) as temporary:

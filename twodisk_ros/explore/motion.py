@@ -25,7 +25,7 @@ from ..run.scene_simulation import ground_normal
 from ..run.simulation import Simulation
 from ..runs import RunError, recorded_run
 
-__all__ = ['CONTROLLED', 'CYCLE_POINTS', 'Frame', 'LiveMotion', 'RecordedMotion',
+__all__ = ['CONTROLLED', 'CYCLE_POINTS', 'PHASE_GRID', 'Frame', 'LiveMotion', 'RecordedMotion',
            'cycle_curve']
 
 #: The node's parameters the page controls (the physical ones), in the page's order.
@@ -34,6 +34,8 @@ CONTROLLED = ('shape', 'a', 'b', 'delta', 'exponent', 'egg_asymmetry', 'arrangem
               'rolling_resistance', 'friction', 'drive')
 #: Phase samples of the z_G curve over one cycle.
 CYCLE_POINTS = 361
+#: Phases a replay's pose is matched against (a step of 0.1 degree).
+PHASE_GRID = 3600
 
 
 @dataclass
@@ -42,7 +44,7 @@ class Frame:
     the last sample is the pose drawn."""
 
     t: np.ndarray             #: (n,) simulated time (s)
-    phase: np.ndarray | None  #: (n,) u (rad), None for a recording
+    phase: np.ndarray | None  #: (n,) u (rad); a replay's from its attitude (RecordedMotion.phases)
     position_g: np.ndarray    #: (n, 3) m
     quaternion: np.ndarray    #: (n, 4) x, y, z, w body → world
     contact_a: np.ndarray     #: (n, 3) m
@@ -55,6 +57,15 @@ class Frame:
 
     def __len__(self):
         return len(self.t)
+
+
+def _in_body(quaternion, vector):
+    """R^T v: a world vector (3,) in the body frames of unit quaternions (n, 4) x, y, z, w."""
+    q = np.asarray(quaternion, dtype=float)
+    u, w = -q[:, :3], q[:, 3:]                      # the inverse rotation
+    v = np.broadcast_to(np.asarray(vector, dtype=float), u.shape)
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def cycle_curve(dynamics, points=CYCLE_POINTS):
@@ -213,6 +224,20 @@ class RecordedMotion:
         return [(float(eq.phase), float(eq.height), eq.stability)
                 for eq, _ in self.description.dynamics.equilibria_with_periods()]
 
+    def phases(self, quaternion):
+        """u (rad, in [0, 2π)) of recorded orientations (n, 4): the cycle's phase (to
+        2π / :data:`PHASE_GRID`) whose attitude on the ground, the ground's normal in the
+        body frame, is nearest the recorded one (heading and position play no part)."""
+        if self._attitudes is None:
+            u = np.linspace(0.0, 2.0 * math.pi, PHASE_GRID, endpoint=False)
+            poses = self.description.dynamics.cycle.poses(u)     # on the flat ground, Z up
+            self._attitudes = u, _in_body(poses.quaternion, (0.0, 0.0, 1.0))
+        u, table = self._attitudes
+        seen = _in_body(quaternion, self.ground_normal)
+        return u[np.argmax(seen @ table.T, axis=1)]
+
+    _attitudes = None
+
     def change(self, name, value):
         return (f'{name} is recorded in {self.path}: a replay shows the recorded run '
                 '(simulate it with --params-file to change it)')
@@ -233,8 +258,8 @@ class RecordedMotion:
         last = max(first + 1, int(np.searchsorted(run.t, stop, side='right')))
         pick = slice(first - 1 if first else 0, last)
         self.t = stop
-        frame = Frame(run.t[pick], None, run.position_g[pick], run.quaternion[pick],
-                      run.contact_a[pick], run.contact_b[pick])
+        frame = Frame(run.t[pick], self.phases(run.quaternion[pick]), run.position_g[pick],
+                      run.quaternion[pick], run.contact_a[pick], run.contact_b[pick])
         if run.force_a is not None:
             self._forces(frame, run.force_a[pick], run.force_b[pick])
         return frame

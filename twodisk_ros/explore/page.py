@@ -244,7 +244,12 @@ class Explorer:
                 body_changed = (self.motion.body is not self.scene_body
                                 or old.mass_model != self.motion.settings.mass_model
                                 or old.slope != self.motion.settings.slope)
-                self._restarted(rebuild=body_changed)
+                # the new scene, plots and the new motion's first frame in one message
+                # window: the page draws them together, with no frame of a half-built scene
+                with self.server.atomic():
+                    self._restarted(rebuild=body_changed)
+                    if self.playing:
+                        self.step(1.0 / FPS)
             else:
                 self._revert(name)
             self.status.content = self._status_text()

@@ -17,12 +17,16 @@ import numpy as np
 from ..model import palette
 from ..model.mesh import mesh_parts
 
-__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'wxyz']
+__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'simplified', 'wxyz']
 
 #: Rim vertices per disk (and hull steps) of the drawn meshes.
 MESH_RESOLUTION = 128
 #: Traces: points per line node before a new node starts (a finished node is never resent).
 TRACE_CHUNK = 64
+#: A finished trace node keeps only the points needed to stay within this distance (× body
+#: size) of all its samples: about 0.2 px at the default camera on an 800 px high page, and
+#: software GL's cost of a frame grows with the segments drawn (docs/benchmarks.md).
+TRACE_TOLERANCE = 1e-3
 #: Widths (× body size, world units) of the contact segment and of the traces.
 SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.008
 #: Width of the traces on screen (px): screen-unit lines skip the world-unit lines' second
@@ -54,6 +58,29 @@ def camera_for(size):
     return look_at + offset, look_at
 
 
+def simplified(points, tolerance):
+    """Indices of the points (n, 3) kept by a greedy walk: from a kept point, the next one
+    kept is the farthest whose chord (the segment) passes within ``tolerance`` (m) of every
+    point between, so a cusp's tip is kept;
+    the first and the last points are kept. About 2 ms for a trace node's 64 points."""
+    points = np.asarray(points, dtype=float)
+    keep, i, n = [0], 0, len(points)
+    while i < n - 1:
+        j = i + 2
+        while j < n:
+            chord = points[j] - points[i]
+            offsets = points[i + 1:j] - points[i]
+            length2 = float(chord @ chord)
+            along = (np.clip(offsets @ chord / length2, 0.0, 1.0) if length2 > 0
+                     else np.zeros(len(offsets)))          # to the segment, not its line
+            if np.max(np.linalg.norm(offsets - along[:, None] * chord, axis=1)) > tolerance:
+                break
+            j += 1
+        i = j - 1
+        keep.append(i)
+    return np.asarray(keep)
+
+
 class Traces:
     """Traces of A, B and G as line nodes of at most :data:`TRACE_CHUNK` points each; at most
     ``length`` points per trace are kept (older nodes removed)."""
@@ -62,6 +89,7 @@ class Traces:
 
     def __init__(self, scene, size, length):
         self.scene, self.width = scene, TRACE_WIDTH * size
+        self.tolerance = TRACE_TOLERANCE * size
         self.length = max(2, int(length))
         self.nodes = []       # [(handles, count)] finished chunks, oldest first
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
@@ -91,12 +119,14 @@ class Traces:
             for h in self.handles:
                 h.remove()
         self.handles = []
+        count = len(self.current[0])
         for (key, colour), points in zip(self.KEYS, self.current):
+            if count >= TRACE_CHUNK:         # its last sending: only the points needed
+                points = points[simplified(points, self.tolerance)]
             segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
             self.handles.append(self.scene.add_line_segments(
                 f'/world/trace_{key}/{self.serial}', segments, rgb255(colour),
                 thickness=TRACE_PX, thickness_units='screen'))
-        count = len(self.current[0])
         if count >= TRACE_CHUNK:
             self.nodes.append((self.handles, count - 1))
             self.handles = None
