@@ -141,6 +141,9 @@ class RollingDynamics:
         first = np.column_stack([spectral_derivative(m), dv, spectral_derivative(w)])
         second = spectral_derivative(first)
         self._table = HermiteTable.periodic(np.column_stack([m, v, w]), first, second)
+        # m and V alone, for the energy (the same columns, so the same bits, a third less work)
+        self._energy_table = HermiteTable.periodic(np.column_stack([m, v]), first[:, :2],
+                                                   second[:, :2])
         # V alone, for the level searches of oscillations (a third of the work)
         self._potential = HermiteTable.periodic(v, dv, second[:, 1])
         self.table_size = n
@@ -187,7 +190,7 @@ class RollingDynamics:
     # -- derived quantities -----------------------------------------------------------------
     def energy(self, u, u_dot):
         """E = ½ m(u) u̇² + V(u) (J), from the tables."""
-        f = self.tabulated(u)
+        f = self._energy_table(np.mod(np.asarray(u, dtype=float), TWO_PI))
         return 0.5 * f[..., 0] * np.asarray(u_dot) ** 2 + f[..., 1]
 
     @property

@@ -169,7 +169,7 @@ class QuadratureSolution(PhaseSolution):
     """
 
     name = 'quadrature'
-    BLOCK = 65536   # samples solved at once (keeps the temporaries in cache)
+    BLOCK = 4096   # samples solved at once (keeps the temporaries in cache)
     #: largest |x(τ) − Newton| (rad) at which the inverse table replaces Newton
     INVERSE_TOLERANCE = 1e-13
 
