@@ -289,18 +289,16 @@ class RollingCycle:
         arm_b = _turned(angle, 1.0, tuple(x[:, 2] + 1j * x[:, 3] for x in frame))
         q_xy = _turned(angle, 0.5, tuple(x[:, 0] + 1j * x[:, 1] for x in quaternion))
         q_zw = _turned(angle, -0.5, tuple(x[:, 3] + 1j * x[:, 2] for x in quaternion))
-        # two tables on one grid (one set of weights per sample): the positions, columns X_A,
-        # Y_A, X_G, Y_G, X_B, Y_B (read as complex Z_A, Z_G, Z_B) and z_G = −r1·n; the
-        # attitude, q_x, q_y, q_z, q_w (read as q_x + i q_y, q_z + i q_w) and α
-        positions, attitude = [], []
+        # one table (one gather per sample): columns X_A, Y_A, X_G, Y_G, X_B, Y_B (read as
+        # complex Z_A, Z_G, Z_B), z_G = −r1·n, q_x, q_y, q_z, q_w (read as q_x + i q_y and
+        # q_z + i q_w) and α
+        columns = []
         for k in range(3):
             z_g = trace[k] - arm_a[k]
-            pairs = np.column_stack([trace[k], z_g, z_g + arm_b[k]])
-            positions.append(np.column_stack([pairs.view(float), -frame[k][:, 4]]))
-            pairs = np.column_stack([q_xy[k], q_zw[k]])
-            attitude.append(np.column_stack([pairs.view(float), angle[k]]))
-        self._table = HermiteTable(0.0, TWO_PI / n, *positions)
-        self._attitude = HermiteTable(0.0, TWO_PI / n, *attitude)
+            positions = np.column_stack([trace[k], z_g, z_g + arm_b[k]]).view(float)
+            attitude = np.column_stack([q_xy[k], q_zw[k]]).view(float)
+            columns.append(np.column_stack([positions, -frame[k][:, 4], attitude, angle[k]]))
+        self._table = HermiteTable(0.0, TWO_PI / n, *columns)
         self.nodes = np.append(u, TWO_PI)
         self.displacement = CycleDisplacement(turn=slope * TWO_PI, shift=complex(z_end))
 
@@ -400,17 +398,14 @@ class RollingCycle:
         parts = self._blocks(u, self._poses, [(3,), (3,), (3,), (4,), ()])
         return RollingPoses(*parts)
 
-    def _evaluate(self, u, attitude):
-        """Rows of the positions' table (and of the attitude's, or None) at phases u, and the
-        cycles' terms of :meth:`_cycle_terms`."""
+    def _evaluate(self, u):
+        """The table's rows at phases u and the cycles' terms of :meth:`_cycle_terms`."""
         cycles, rest = self._split(u)
-        index, weights = self._table.weights(rest)
-        rows = (self._attitude.combine(index, weights) if attitude else None)
-        return (self._table.combine(index, weights), rows) + self._cycle_terms(cycles)
+        return (self._table.expand(*self._table.powers(rest)),) + self._cycle_terms(cycles)
 
     @staticmethod
     def _world(f, spin, shift):
-        """G, A, B from the positions' rows f and the cycles' map p → spin·p + shift."""
+        """G, A, B from the table's rows f and the cycles' map p → spin·p + shift."""
         pairs = f[:, :6].view(np.complex128)      # Z_A, Z_G, Z_B within the cycle
         g, a, b = (np.empty((f.shape[0], 3)) for _ in range(3))
         for point, column in ((a, 0), (g, 1), (b, 2)):
@@ -422,22 +417,22 @@ class RollingCycle:
         return g, a, b
 
     def _positions(self, u):
-        f, _, spin, shift, _, _ = self._evaluate(u, False)
+        f, spin, shift, _, _ = self._evaluate(u)
         return self._world(f, spin, shift)
 
     def _poses(self, u):
-        f, rows, spin, shift, half, turn = self._evaluate(u, True)
+        f, spin, shift, half, turn = self._evaluate(u)
         g, a, b = self._world(f, spin, shift)
         # q_z(kT) ⊗ q(u − 2πk) (±, the cycle sign): (x + iy) turns by e^{ikT/2}, (z + iw)
         # by e^{−ikT/2}; then renormalised
-        within = rows[:, :4]
+        within = f[:, 7:11]
         scale = 1.0 / np.sqrt(np.einsum('ij,ij->i', within, within))
         q = np.empty((f.shape[0], 4))
         pairs, out = within.view(np.complex128), q.view(np.complex128)
         np.multiply(pairs[:, 0], half, out=out[:, 0])
         np.multiply(pairs[:, 1], np.conj(half), out=out[:, 1])
         q *= scale[:, None]
-        return g, a, b, q, rows[:, 4] + turn
+        return g, a, b, q, f[:, 11] + turn
 
     def heading(self, u):
         """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
@@ -446,7 +441,7 @@ class RollingCycle:
         moves the opposite way.
         """
         cycles, rest = self._split(u)
-        return self._attitude(rest)[..., 4] + cycles * self.displacement.turn
+        return self._table(rest)[..., 11] + cycles * self.displacement.turn
 
     def trace_a(self, u):
         """World position of A at phase(s) u (m), shape u.shape + (3,)."""
