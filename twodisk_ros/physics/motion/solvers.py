@@ -153,8 +153,10 @@ class QuadratureSolution(PhaseSolution):
     """u(t) for motion in one direction, from t(u) = ∫ du / |u̇| tabulated over one cycle.
 
     With x = s (u − u₀) ≥ 0 the distance travelled in u, τ(x) = s (G(u₀ + s x) − G(u₀)),
-    G′ = 1/|u̇|, is increasing and τ(x + 2π) = τ(x) + T. Each time is reduced to one cycle,
-    bracketed between two table nodes, and solved there by safeguarded Newton.
+    G′ = 1/|u̇|, is increasing and τ(x + 2π) = τ(x) + T. Each time is reduced to one cycle
+    and x read from a table of the inverse x(τ), kept if it reproduces Newton to
+    :attr:`INVERSE_TOLERANCE` (else each time is bracketed between two table nodes and solved
+    there by safeguarded Newton); docs/physics.md#the-two-methods-direct-and-table.
 
     Parameters
     ----------
