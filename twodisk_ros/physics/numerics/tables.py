@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ['HermiteTable', 'hermite_jet']
+__all__ = ['HermiteTable', 'hermite_jet', 'power_coefficients', 'power_value']
 
 
 class HermiteTable:
@@ -199,13 +199,8 @@ class HermiteTable:
 
     def _coefficients(self):
         if self._power_rows is None:
-            y0, d0, s0 = (x[:-1] for x in (self.values, self.first, self.second))
-            y1, d1, s1 = (x[1:] for x in (self.values, self.first, self.second))
-            jump = y1 - y0
-            c = np.stack([y0, d0, 0.5 * s0,
-                          10.0 * jump - 6.0 * d0 - 4.0 * d1 - 1.5 * s0 + 0.5 * s1,
-                          -15.0 * jump + 8.0 * d0 + 7.0 * d1 + 1.5 * s0 - s1,
-                          6.0 * jump - 3.0 * d0 - 3.0 * d1 - 0.5 * s0 + 0.5 * s1], axis=1)
+            c = power_coefficients(*(x[:-1] for x in (self.values, self.first, self.second)),
+                                   *(x[1:] for x in (self.values, self.first, self.second)))
             self._power_rows = np.ascontiguousarray(c.reshape(len(c), -1))
         return self._power_rows
 
@@ -218,6 +213,37 @@ class HermiteTable:
         """
         closed = [np.concatenate([x, x[:1]]) for x in (values, first, second)]
         return cls(0.0, 2.0 * np.pi / len(values), *closed)
+
+
+def power_coefficients(y0, d0, s0, y1, d1, s1):
+    """The quintic Hermite interpolant of :class:`HermiteTable` on intervals, in powers of t.
+
+    Parameters
+    ----------
+    y0, d0, s0, y1, d1, s1 : ndarray, shape (n, ...)
+        f, h f′ and h² f″ at the start and at the end of each interval (h its width).
+
+    Returns
+    -------
+    ndarray, shape (n, 6, ...)
+        c₀ … c₅ with f = Σ c_k t^k, t ∈ [0, 1] across the interval.
+    """
+    jump = y1 - y0
+    return np.stack([y0, d0, 0.5 * s0,
+                     10.0 * jump - 6.0 * d0 - 4.0 * d1 - 1.5 * s0 + 0.5 * s1,
+                     -15.0 * jump + 8.0 * d0 + 7.0 * d1 + 1.5 * s0 - s1,
+                     6.0 * jump - 3.0 * d0 - 3.0 * d1 - 0.5 * s0 + 0.5 * s1], axis=1)
+
+
+def power_value(coefficients, t):
+    """Σ c_k t^k (Horner) for rows of :func:`power_coefficients` of one column, shape (N, 6),
+    at t, shape (N,)."""
+    value = coefficients[:, 5] * t
+    for k in (4, 3, 2, 1):
+        value += coefficients[:, k]
+        value *= t
+    value += coefficients[:, 0]
+    return value
 
 
 def hermite_jet(t, start, end):
