@@ -346,17 +346,14 @@ class RollingCycle:
 
     # -- world positions ---------------------------------------------------------------------
     def _blocks(self, u, evaluate, trailing):
-        """evaluate(flat block) → arrays (block, *trailing[j]); blocks of BLOCK samples."""
+        """evaluate(flat block, outputs) fills arrays (block, *trailing[j]), blocks of BLOCK
+        samples written in place into the results."""
         u = np.asarray(u, dtype=float)
         flat = u.reshape(-1)
-        if flat.size <= self.BLOCK:
-            parts = evaluate(flat)
-        else:
-            parts = [np.empty((flat.size,) + shape) for shape in trailing]
-            for start in range(0, flat.size, self.BLOCK):
-                part = slice(start, start + self.BLOCK)
-                for array, block in zip(parts, evaluate(flat[part])):
-                    array[part] = block
+        parts = [np.empty((flat.size,) + shape) for shape in trailing]
+        for start in range(0, flat.size, self.BLOCK):
+            part = slice(start, start + self.BLOCK)
+            evaluate(flat[part], [array[part] for array in parts])
         return tuple(x.reshape(u.shape + shape) for x, shape in zip(parts, trailing))
 
     def positions(self, u):
@@ -404,35 +401,32 @@ class RollingCycle:
         return (self._table.expand(*self._table.powers(rest)),) + self._cycle_terms(cycles)
 
     @staticmethod
-    def _world(f, spin, shift):
-        """G, A, B from the table's rows f and the cycles' map p → spin·p + shift."""
+    def _world(f, spin, shift, g, a, b):
+        """G, A, B (into g, a, b) from the table's rows f and the cycles' map spin·p + shift."""
         pairs = f[:, :6].view(np.complex128)      # Z_A, Z_G, Z_B within the cycle
-        g, a, b = (np.empty((f.shape[0], 3)) for _ in range(3))
         for point, column in ((a, 0), (g, 1), (b, 2)):
             xy = point[:, :2].view(np.complex128)[:, 0]
             np.multiply(pairs[:, column], spin, out=xy)
             xy += shift
             point[:, 2] = 0.0
         g[:, 2] = f[:, 6]
-        return g, a, b
 
-    def _positions(self, u):
+    def _positions(self, u, out):
         f, spin, shift, _, _ = self._evaluate(u)
-        return self._world(f, spin, shift)
+        self._world(f, spin, shift, *out)
 
-    def _poses(self, u):
+    def _poses(self, u, out):
         f, spin, shift, half, turn = self._evaluate(u)
-        g, a, b = self._world(f, spin, shift)
+        self._world(f, spin, shift, *out[:3])
         # q_z(kT) ⊗ q(u − 2πk) (±, the cycle sign): (x + iy) turns by e^{ikT/2}, (z + iw)
         # by e^{−ikT/2}; then renormalised
-        within = f[:, 7:11]
+        within, q = f[:, 7:11], out[3]
         scale = 1.0 / np.sqrt(np.einsum('ij,ij->i', within, within))
-        q = np.empty((f.shape[0], 4))
-        pairs, out = within.view(np.complex128), q.view(np.complex128)
-        np.multiply(pairs[:, 0], half, out=out[:, 0])
-        np.multiply(pairs[:, 1], np.conj(half), out=out[:, 1])
+        pairs, turned = within.view(np.complex128), q.view(np.complex128)
+        np.multiply(pairs[:, 0], half, out=turned[:, 0])
+        np.multiply(pairs[:, 1], np.conj(half), out=turned[:, 1])
         q *= scale[:, None]
-        return g, a, b, q, f[:, 11] + turn
+        np.add(f[:, 11], turn, out=out[4])
 
     def heading(self, u):
         """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
