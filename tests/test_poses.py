@@ -51,8 +51,9 @@ FINE_DOT_MIN = 0.99
 #: After k whole cycles q(u + 2πk) = (−ε)^k q(u) up to the cycle's excess turn about Z
 #: (T − 2π ≤ 3e-11 rad, test_cycle) and rounding: measured ≤ 5e-14 for |k| ≤ 5.
 CYCLE_ATOL = 1e-10
-#: The vectorised table evaluation (weights + combine) against HermiteTable.__call__,
-#: relative to the largest node data: measured ≤ 1.5e-16 (300 random tables).
+#: The vectorised table evaluation (weights + combine, and powers + expand) against
+#: HermiteTable.__call__, relative to the largest node data: measured ≤ 1.5e-16 (combine)
+#: and ≤ 3.1e-15 (expand: coefficients up to 30× the node data) over 300 random tables.
 COMBINE_RTOL = 1e-14
 
 NAMED = {
@@ -222,5 +223,8 @@ def test_combine_equals_call(nodes, columns, seed):
     index, weights = table.weights(x)
     scale = np.max(np.abs(values)) + np.max(np.abs(first)) + np.max(np.abs(second))
     assert_allclose(table.combine(index, weights), table(x), rtol=0, atol=COMBINE_RTOL * scale)
+    # the power basis (RollingCycle's path): the same interpolant, from coefficients of t
+    assert_allclose(table.expand(*table.powers(x)), table(x), rtol=0, atol=COMBINE_RTOL * scale)
     # the nodes themselves are reproduced exactly
     assert_array_equal(table.combine(*table.weights(x[200:])), values)
+    assert_array_equal(table.expand(*table.powers(x[200:-1])), values[:-1])

@@ -39,6 +39,15 @@ def _arc_rate_and_turn(body, u):
     return ds, dalpha, dds, ddalpha
 
 
+def _turned(angle, factor, jet):
+    """(g, g′, g″) of g = e^{i c α} f from the jets (α, α′, α″) and (f, f′, f″), c = factor."""
+    (alpha, d_alpha, dd_alpha), (f, df, ddf) = angle, jet
+    rate = 1j * factor * d_alpha
+    turn = np.exp(1j * factor * alpha)
+    return (turn * f, turn * (df + rate * f),
+            turn * (ddf + 2.0 * rate * df + (1j * factor * dd_alpha + rate * rate) * f))
+
+
 def _exp_integral(mu, u):
     """∫₀ᵘ e^{iμv} dv, robust as μ → 0."""
     x = 0.5 * mu * u
@@ -212,9 +221,10 @@ class RollingCycle:
     """
 
     MAX_RESOLUTION = 2**17
-    #: Samples evaluated at once by positions and poses (temporaries stay in cache; 16384
-    #: measured fastest among 4096 … 65536 on the 2-core benchmark machine).
-    BLOCK = 16384
+    #: Samples evaluated at once by positions and poses (the gathered node data, 96 B per
+    #: sample and column, stays in cache; 8192 measured fastest among 1024 … 16384 on the
+    #: 2-core benchmark machine).
+    BLOCK = 8192
 
     def __init__(self, body, resolution=None, oversampling=4):
         self.body = check_rolling_body(body)
@@ -263,25 +273,32 @@ class RollingCycle:
         z_all = np.append(z_nodes, z_end)
         ds_all, dalpha_all = np.append(ds, ds[0]), np.append(dalpha, dalpha[0])
         dds_all, ddalpha_all = np.append(dds, dds[0]), np.append(ddalpha, ddalpha[0])
-        rot = np.exp(1j * alpha_all)
-        trace_first = ds_all * rot
-        trace_second = (dds_all + 1j * ds_all * dalpha_all) * rot
         r1, r2, normal, t1 = self.body.phase_vectors(u + 1j * COMPLEX_STEP)[:4]
-        frame_values, frame_first, frame_second = self._frame_samples(r1, r2, normal, t1)
+        frame = self._frame_samples(r1, r2, normal, t1)
         # q_c(u) of the contact frame (x, y, w, z), continued to u = 2π by ε q_c(0)
         q, q_first, q_second, self._cycle_sign = contact_quaternion_samples(t1, normal)
-        quaternion = (np.concatenate([x[:, [0, 1, 3, 2]], self._cycle_sign * x[:1, [0, 1, 3, 2]]])
-                      for x in (q, q_first, q_second))
-        # one table (one gather per sample); columns X_A, Y_A, r1·t1, r1·m, r2·t1, r2·m,
-        # q_x, q_y, q_w, q_z, α, r1·n (m = n × t1): the first five pairs are read as complex
-        # numbers Z_A, r1, r2 (contact frame), q_x + i q_y and q_w + i q_z
-        columns = [(z_all.real, z_all.imag, alpha_all),
-                   (trace_first.real, trace_first.imag, dalpha_all),
-                   (trace_second.real, trace_second.imag, ddalpha_all)]
-        self._table = HermiteTable(0.0, TWO_PI / n, *(
-            np.column_stack([x, y, frame[:, :4], quat, alpha, frame[:, 4]])
-            for (x, y, alpha), frame, quat in zip(columns, (frame_values, frame_first,
-                                                             frame_second), quaternion)))
+        quaternion = [np.concatenate([x[:, [0, 1, 3, 2]], self._cycle_sign * x[:1, [0, 1, 3, 2]]])
+                      for x in (q, q_first, q_second)]
+        trace = (z_all, ds_all * np.exp(1j * alpha_all),
+                 (dds_all + 1j * ds_all * dalpha_all) * np.exp(1j * alpha_all))
+        angle = (alpha_all, dalpha_all, ddalpha_all)
+        # the world within the cycle, whose rotation e^{iα} is applied here, once per node:
+        # G = A − e^{iα} r1 and B = G + e^{iα} r2 (r1, r2 in the contact frame, as x + iy),
+        # q = q_z(α) ⊗ q_c, with (x + iy) turned by e^{iα/2} and (z + iw) by e^{−iα/2}
+        arm_a = _turned(angle, 1.0, tuple(x[:, 0] + 1j * x[:, 1] for x in frame))
+        arm_b = _turned(angle, 1.0, tuple(x[:, 2] + 1j * x[:, 3] for x in frame))
+        q_xy = _turned(angle, 0.5, tuple(x[:, 0] + 1j * x[:, 1] for x in quaternion))
+        q_zw = _turned(angle, -0.5, tuple(x[:, 3] + 1j * x[:, 2] for x in quaternion))
+        # one table (one gather per sample): columns X_A, Y_A, X_G, Y_G, X_B, Y_B (read as
+        # complex Z_A, Z_G, Z_B), z_G = −r1·n, q_x, q_y, q_z, q_w (read as q_x + i q_y and
+        # q_z + i q_w) and α
+        columns = []
+        for k in range(3):
+            z_g = trace[k] - arm_a[k]
+            positions = np.column_stack([trace[k], z_g, z_g + arm_b[k]]).view(float)
+            attitude = np.column_stack([q_xy[k], q_zw[k]]).view(float)
+            columns.append(np.column_stack([positions, -frame[k][:, 4], attitude, angle[k]]))
+        self._table = HermiteTable(0.0, TWO_PI / n, *columns)
         self.nodes = np.append(u, TWO_PI)
         self.displacement = CycleDisplacement(turn=slope * TWO_PI, shift=complex(z_end))
 
@@ -315,6 +332,8 @@ class RollingCycle:
             empty = np.empty(cycles.shape, complex)
             return empty, empty, empty, cycles
         low, high = float(cycles.min()), float(cycles.max())
+        if low == high:              # one cycle (most blocks): scalars
+            return tuple(x[0] for x in self._cycle_terms_of(np.array([low])))
         if high - low <= 4096:       # few distinct cycles: evaluate once each, then gather
             index = (cycles - low).astype(np.intp)
             return tuple(x[index] for x in self._cycle_terms_of(np.arange(low, high + 1.0)))
@@ -327,17 +346,14 @@ class RollingCycle:
 
     # -- world positions ---------------------------------------------------------------------
     def _blocks(self, u, evaluate, trailing):
-        """evaluate(flat block) → arrays (block, *trailing[j]); blocks of BLOCK samples."""
+        """evaluate(flat block, outputs) fills arrays (block, *trailing[j]), blocks of BLOCK
+        samples written in place into the results."""
         u = np.asarray(u, dtype=float)
         flat = u.reshape(-1)
-        if flat.size <= self.BLOCK:
-            parts = evaluate(flat)
-        else:
-            parts = [np.empty((flat.size,) + shape) for shape in trailing]
-            for start in range(0, flat.size, self.BLOCK):
-                part = slice(start, start + self.BLOCK)
-                for array, block in zip(parts, evaluate(flat[part])):
-                    array[part] = block
+        parts = [np.empty((flat.size,) + shape) for shape in trailing]
+        for start in range(0, flat.size, self.BLOCK):
+            part = slice(start, start + self.BLOCK)
+            evaluate(flat[part], [array[part] for array in parts])
         return tuple(x.reshape(u.shape + shape) for x, shape in zip(parts, trailing))
 
     def positions(self, u):
@@ -380,46 +396,37 @@ class RollingCycle:
         return RollingPoses(*parts)
 
     def _evaluate(self, u):
+        """The table's rows at phases u and the cycles' terms of :meth:`_cycle_terms`."""
         cycles, rest = self._split(u)
-        spin, shift, half, turn = self._cycle_terms(cycles)
-        index, weights = self._table.weights(rest)
-        f = self._table.combine(index, weights)
-        pairs = f[:, :10].view(np.complex128)      # Z_A, r1, r2 (contact frame), q_c pairs
-        return f, pairs, spin, shift, half, turn
+        return (self._table.expand(*self._table.powers(rest)),) + self._cycle_terms(cycles)
 
     @staticmethod
-    def _world(f, pairs, spin, shift, c):
-        """G, A, B from the table's row f and c = c_α (complex, world)."""
-        # R r = c_α (t1·r) + (e_z × c_α)(m·r) + e_z (n·r), and e_z × c_α = i c_α
-        size = f.shape[0]
-        g, a, b = (np.empty((size, 3)) for _ in range(3))
-        z_a = spin * pairs[:, 0] + shift
-        z_g = z_a - c * pairs[:, 1]
-        g[:, :2].view(np.complex128)[:, 0] = z_g
-        g[:, 2] = -f[:, 11]
-        a[:, :2].view(np.complex128)[:, 0] = z_a
-        a[:, 2] = 0.0
-        b[:, :2].view(np.complex128)[:, 0] = z_g + c * pairs[:, 2]
-        b[:, 2] = 0.0
-        return g, a, b
+    def _world(f, spin, shift, g, a, b):
+        """G, A, B (into g, a, b) from the table's rows f and the cycles' map spin·p + shift."""
+        pairs = f[:, :6].view(np.complex128)      # Z_A, Z_G, Z_B within the cycle
+        for point, column in ((a, 0), (g, 1), (b, 2)):
+            xy = point[:, :2].view(np.complex128)[:, 0]
+            np.multiply(pairs[:, column], spin, out=xy)
+            xy += shift
+            point[:, 2] = 0.0
+        g[:, 2] = f[:, 6]
 
-    def _positions(self, u):
-        f, pairs, spin, shift, half, _ = self._evaluate(u)
-        half = half * np.exp(0.5j * f[:, 10])        # as in _poses: the same bits
-        return self._world(f, pairs, spin, shift, half * half)
+    def _positions(self, u, out):
+        f, spin, shift, _, _ = self._evaluate(u)
+        self._world(f, spin, shift, *out)
 
-    def _poses(self, u):
-        f, pairs, spin, shift, half, turn = self._evaluate(u)
-        half = half * np.exp(0.5j * f[:, 10])        # ±e^{iα/2}: q_z(α) as a phasor
-        g, a, b = self._world(f, pairs, spin, shift, half * half)   # c_α = (±e^{iα/2})²
-        # q_z(α) ⊗ q_c with q_z = (0, 0, sin α/2, cos α/2): (x + iy) and (w + iz) turn by α/2
-        xy, wz = half * pairs[:, 3], half * pairs[:, 4]
-        scale = 1.0 / np.sqrt(xy.real**2 + xy.imag**2 + wz.real**2 + wz.imag**2)
-        q = np.empty((f.shape[0], 4))
-        q[:, :2].view(np.complex128)[:, 0] = xy * scale
-        q[:, 2] = wz.imag * scale
-        q[:, 3] = wz.real * scale
-        return g, a, b, q, f[:, 10] + turn
+    def _poses(self, u, out):
+        f, spin, shift, half, turn = self._evaluate(u)
+        self._world(f, spin, shift, *out[:3])
+        # q_z(kT) ⊗ q(u − 2πk) (±, the cycle sign): (x + iy) turns by e^{ikT/2}, (z + iw)
+        # by e^{−ikT/2}; then renormalised
+        within, q = f[:, 7:11], out[3]
+        scale = 1.0 / np.sqrt(np.einsum('ij,ij->i', within, within))
+        pairs, turned = within.view(np.complex128), q.view(np.complex128)
+        np.multiply(pairs[:, 0], half, out=turned[:, 0])
+        np.multiply(pairs[:, 1], np.conj(half), out=turned[:, 1])
+        q *= scale[:, None]
+        np.add(f[:, 11], turn, out=out[4])
 
     def heading(self, u):
         """α(u) (rad): heading of disk 1's tangent t1 at A in the world, α(0) = 0.
@@ -428,7 +435,7 @@ class RollingCycle:
         moves the opposite way.
         """
         cycles, rest = self._split(u)
-        return self._table(rest)[..., 10] + cycles * self.displacement.turn
+        return self._table(rest)[..., 11] + cycles * self.displacement.turn
 
     def trace_a(self, u):
         """World position of A at phase(s) u (m), shape u.shape + (3,)."""

@@ -10,7 +10,8 @@ u̇ = Ω / |ω_u(u)|). Two methods (docs/physics.md#the-two-methods-direct-and-t
     Periodic tables of one cycle (m, V, |ω_u| with derivatives, spectral to rounding), then:
     when u moves one way for ever (kinematic mode, or rolling over the top: E > max V),
     t(u) = ∫ du/|u̇| is a secular-plus-periodic function, tabulated once and inverted by
-    bracketed Newton (no time stepping, no drift); when it oscillates in a well (E < max V),
+    bracketed Newton, or for large calls by a table of its inverse checked against it (no time
+    stepping, no drift); when it oscillates in a well (E < max V),
     the same in the angle φ of V(u* + δ(φ)) = V* + (E − V*) sin²φ, in the displacement δ.
     Only near the separatrix E = max V (LIBRATION_MARGIN below to ROLLING_MARGIN above) is
     DOP853 run on the tabulated right-hand side, with ``tolerance`` as its rtol.

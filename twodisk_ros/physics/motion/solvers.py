@@ -15,7 +15,7 @@ from ..bodies.cycle import TWO_PI
 from ..numerics.dense import dense_reader
 from ..numerics.spectral import (STALL, refine_grid, spectral_antiderivative, spectral_derivative,
                        spectral_tail, upsample)
-from ..numerics.tables import HermiteTable
+from ..numerics.tables import HermiteTable, power_coefficients, power_value
 
 __all__ = ['LibrationSolution', 'OdeSolution', 'PhaseSolution', 'QuadratureSolution',
            'RestSolution', 'SundmanSolution', 'import_integrator']
@@ -154,7 +154,10 @@ class QuadratureSolution(PhaseSolution):
 
     With x = s (u − u₀) ≥ 0 the distance travelled in u, τ(x) = s (G(u₀ + s x) − G(u₀)),
     G′ = 1/|u̇|, is increasing and τ(x + 2π) = τ(x) + T. Each time is reduced to one cycle,
-    bracketed between two table nodes, and solved there by safeguarded Newton.
+    bracketed between two table nodes, and solved there by safeguarded Newton; a call of at
+    least n + 1 times reads x from the inverse x(τ) instead, interpolated between the same
+    nodes, if it reproduces Newton to :attr:`INVERSE_TOLERANCE`;
+    docs/physics.md#the-two-methods-direct-and-table.
 
     Parameters
     ----------
@@ -169,7 +172,9 @@ class QuadratureSolution(PhaseSolution):
     """
 
     name = 'quadrature'
-    BLOCK = 65536   # samples solved at once (keeps the temporaries in cache)
+    BLOCK = 4096   # samples solved at once (keeps the temporaries in cache)
+    #: largest |x(τ) − Newton| (rad) at which the inverse table replaces Newton
+    INVERSE_TOLERANCE = 1e-13
 
     def __init__(self, u0, direction, inverse_speed, n):
         u = TWO_PI * np.arange(n) / n
@@ -187,6 +192,9 @@ class QuadratureSolution(PhaseSolution):
         self._x_nodes = TWO_PI * np.arange(n + 1) / n
         self._tau_nodes = self._tau(self._x_nodes)
         self._tau_nodes[0], self._tau_nodes[-1] = 0.0, self.cycle_time
+        #: x(τ) over one cycle (a table instead of Newton): False until a call of at least
+        #: as many samples as the table has nodes builds it, None if refused
+        self._inverse = False
 
     def _antiderivative(self, u):
         cycles = np.floor(np.asarray(u) / TWO_PI)
@@ -200,16 +208,59 @@ class QuadratureSolution(PhaseSolution):
         return self._s * (self._antiderivative(self._u0 + self._s * x) - self._g0)
 
     def _evaluate(self, t):
+        # the inverse's build costs about as much as Newton on half its nodes' count of
+        # samples: calls that large use it (built on the first), smaller ones (a node's
+        # blocks) solve by Newton
+        large = t.size >= len(self._x_nodes)
+        if large and self._inverse is False:
+            self._inverse = self._build_inverse()
+        inverse = large and self._inverse is not None
         u, u_dot = np.empty_like(t), np.empty_like(t)
         for start in range(0, t.size, self.BLOCK):
             part = slice(start, start + self.BLOCK)
-            u[part], u_dot[part] = self._solve(t[part])
+            u[part], u_dot[part] = self._solve(t[part], inverse)
         return u, u_dot
 
-    def _solve(self, t):
+    def _build_inverse(self):
+        """The power-basis coefficients of x(τ) on the intervals [τ_i, τ_i+1] of the table's own
+        nodes (x_i, τ_i), a quintic Hermite from dx/dτ = 1/τ′ and d²x/dτ² = −τ″/τ′³ there (no
+        solving); kept only if τ(x(τ)) − τ, divided by τ′, is within ``INVERSE_TOLERANCE`` at
+        the midpoint of every interval (where the interpolant's error peaks); else None."""
+        x, taus = self._x_nodes, self._tau_nodes
+        width = np.diff(taus)
+        u = self._u0 + self._s * x
+        rate = self._rate(u)
+        if not (np.all(rate > 0) and np.all(width > 0)):
+            return None           # u̇ infinite somewhere: x(τ) has no bounded slope there
+        slope = 1.0 / rate
+        curvature = -self._s * self._table.jet(np.mod(u, TWO_PI))[2] * slope**3
+        self._inverse = power_coefficients(
+            x[:-1], width * slope[:-1], width**2 * curvature[:-1],
+            x[1:], width * slope[1:], width**2 * curvature[1:])
+        middle = taus[:-1] + 0.5 * width
+        x_middle = self._invert(middle)
+        error = np.abs(self._tau(x_middle) - middle) / self._rate(self._u0 + self._s * x_middle)
+        return self._inverse if np.max(error) <= self.INVERSE_TOLERANCE else None
+
+    def _invert(self, rest):
+        """x(τ) at times rest (s, in [0, T]) from the inverse's coefficients."""
+        taus = self._tau_nodes
+        j = np.clip(np.searchsorted(taus, rest, side='right') - 1, 0, len(taus) - 2)
+        return power_value(self._inverse.take(j, axis=0),
+                           (rest - taus[j]) / (taus[j + 1] - taus[j]))
+
+    def _solve(self, t, inverse):
         period = self.cycle_time
         cycles = np.floor(t / period)
         rest = np.clip(t - cycles * period, 0.0, period)
+        x = np.clip(self._invert(rest), 0.0, TWO_PI) if inverse else self._newton(rest)
+        u = self._u0 + self._s * (x + TWO_PI * cycles)
+        with np.errstate(divide='ignore'):
+            return u, self._s / self._rate(u)
+
+    def _newton(self, rest):
+        """x ∈ [0, 2π] with τ(x) = rest (s, in [0, T]): bracketed, safeguarded Newton."""
+        period = self.cycle_time
         nodes, taus = self._x_nodes, self._tau_nodes
         j = np.clip(np.searchsorted(taus, rest, side='right') - 1, 0, len(nodes) - 2)
         low, high = nodes[j], nodes[j + 1]
@@ -229,9 +280,7 @@ class QuadratureSolution(PhaseSolution):
         residual = np.max(np.abs(self._tau(x) - rest), initial=0.0)
         if residual > 1e-10 * period:
             raise RuntimeError(f'inverting t(u) failed: residual {residual:.3g} s')
-        u = self._u0 + self._s * (x + TWO_PI * cycles)
-        with np.errstate(divide='ignore'):
-            return u, self._s / self._rate(u)
+        return x
 
 
 class LibrationSolution(PhaseSolution):

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ['HermiteTable', 'hermite_jet']
+__all__ = ['HermiteTable', 'hermite_jet', 'power_coefficients', 'power_value']
 
 
 class HermiteTable:
@@ -27,6 +27,10 @@ class HermiteTable:
         f, f′ and f″ at the nodes (real or complex; trailing axes are carried along).
     """
 
+    #: points evaluated at once by :meth:`__call__` (4096 measured fastest among 1024 …
+    #: 65536 on the 2-core benchmark machine, for one and for three columns)
+    BLOCK = 4096
+
     def __init__(self, start, step, values, first, second):
         self.start = float(start)
         self.step = float(step)
@@ -39,6 +43,7 @@ class HermiteTable:
         self.values, self.first, self.second = (self._nodes[:, k] for k in range(3))
         self._rows = self._nodes.reshape(len(self._nodes), -1)
         self.last_index = len(self.values) - 2
+        self._power_rows = None          # the power basis' coefficients, built on first use
 
     def _locate(self, x):
         s = (np.asarray(x, dtype=float) - self.start) / self.step
@@ -51,7 +56,11 @@ class HermiteTable:
 
         A finite scalar x (an ODE's right-hand side asks for one point at a time) takes the
         same arithmetic in Python floats, without the array set-up: the same result bit for
-        bit, at a third of the cost."""
+        bit, at a third of the cost. Arrays of more than :attr:`BLOCK` points are evaluated in
+        blocks of that size (the same operations per point, so the same result bit for bit:
+        the temporaries stay in cache, 3× faster for three columns on 65536 points)."""
+        if np.ndim(x) and np.size(x) > self.BLOCK:
+            return self._blocked(np.asarray(x, dtype=float), derivative)
         if isinstance(x, (float, np.floating)) and math.isfinite(x):
             position = (float(x) - self.start) / self.step
             i = min(max(math.floor(position), 0), self.last_index)
@@ -81,6 +90,24 @@ class HermiteTable:
             g4 = t2 * (-12 + t * (28 - 15 * t))
             return (g0 * (y0 - y1) + g1 * d0 + g2 * s0 + g3 * s1 + g4 * d1) / self.step
         raise ValueError(f'derivative must be 0 or 1, got {derivative!r}')
+
+    def _blocked(self, x, derivative):
+        flat = x.reshape(-1)
+        out = np.empty(flat.shape + self.values.shape[1:], dtype=self.values.dtype)
+        for start in range(0, flat.size, self.BLOCK):
+            part = slice(start, start + self.BLOCK)
+            out[part] = self(flat[part], derivative)
+        return out.reshape(x.shape + self.values.shape[1:])
+
+    def jet(self, x):
+        """(f, f′, f″) at points x inside the table's span: the interpolant and its first two
+        derivatives (:func:`hermite_jet`; f″ is the quintic's, accurate to O(h⁴))."""
+        i, t = self._locate(x)
+        t = t.reshape(t.shape + (1,) * (self.values.ndim - 1))
+        value, slope, curvature = hermite_jet(
+            t, [x[i] for x in (self.values, self.first, self.second)],
+            [x[i + 1] for x in (self.values, self.first, self.second)])
+        return value, slope / self.step, curvature / self.step**2
 
     def weights(self, x, derivative=0):
         """Interval indices and Hermite weights at points x, for :meth:`combine`.
@@ -139,6 +166,44 @@ class HermiteTable:
         out = np.matmul(weights.reshape(flat.size, 1, 6), data)
         return out.reshape(index.shape + self.values.shape[1:])
 
+    def powers(self, x):
+        """Interval indices and the powers (1, t, t², t³, t⁴, t⁵) of points x, for :meth:`expand`.
+
+        Cheaper than :meth:`weights` (four products per point instead of six polynomials);
+        the powers depend on the grid only, so they serve every table on it.
+        """
+        i, t = self._locate(x)
+        p = np.empty(t.shape + (6,))
+        p[..., 0] = 1.0
+        p[..., 1] = t
+        np.multiply(t, t, out=p[..., 2])
+        np.multiply(p[..., 2], t, out=p[..., 3])
+        np.multiply(p[..., 2], p[..., 2], out=p[..., 4])
+        np.multiply(p[..., 4], t, out=p[..., 5])
+        return i, p
+
+    def expand(self, index, powers):
+        """f at the points of :meth:`powers`: the same interpolant in the power basis of t.
+
+        The coefficients of every interval are computed once from the node data (c₀ = f_i,
+        c₁ = h f′_i, c₂ = h² f″_i/2, and c₃ … c₅ from the differences to node i + 1: terms of
+        order h³ and up, so their rounding stays far below an ulp of f); each point then takes
+        one gather of its interval's row and a 1 × 6 by 6 × m product. Agrees with
+        :meth:`__call__` to a few ulps of the node data; reproduces the nodes exactly.
+        """
+        index = np.asarray(index)
+        flat = index.reshape(-1)
+        data = self._coefficients().take(flat, axis=0).reshape(flat.size, 6, -1)
+        out = np.matmul(powers.reshape(flat.size, 1, 6), data)
+        return out.reshape(index.shape + self.values.shape[1:])
+
+    def _coefficients(self):
+        if self._power_rows is None:
+            c = power_coefficients(*(x[:-1] for x in (self.values, self.first, self.second)),
+                                   *(x[1:] for x in (self.values, self.first, self.second)))
+            self._power_rows = np.ascontiguousarray(c.reshape(len(c), -1))
+        return self._power_rows
+
     @classmethod
     def periodic(cls, values, first, second):
         """A table over one cycle [0, 2π] from samples at u_j = 2πj/N of a periodic function.
@@ -148,6 +213,37 @@ class HermiteTable:
         """
         closed = [np.concatenate([x, x[:1]]) for x in (values, first, second)]
         return cls(0.0, 2.0 * np.pi / len(values), *closed)
+
+
+def power_coefficients(y0, d0, s0, y1, d1, s1):
+    """The quintic Hermite interpolant of :class:`HermiteTable` on intervals, in powers of t.
+
+    Parameters
+    ----------
+    y0, d0, s0, y1, d1, s1 : ndarray, shape (n, ...)
+        f, h f′ and h² f″ at the start and at the end of each interval (h its width).
+
+    Returns
+    -------
+    ndarray, shape (n, 6, ...)
+        c₀ … c₅ with f = Σ c_k t^k, t ∈ [0, 1] across the interval.
+    """
+    jump = y1 - y0
+    return np.stack([y0, d0, 0.5 * s0,
+                     10.0 * jump - 6.0 * d0 - 4.0 * d1 - 1.5 * s0 + 0.5 * s1,
+                     -15.0 * jump + 8.0 * d0 + 7.0 * d1 + 1.5 * s0 - s1,
+                     6.0 * jump - 3.0 * d0 - 3.0 * d1 - 0.5 * s0 + 0.5 * s1], axis=1)
+
+
+def power_value(coefficients, t):
+    """Σ c_k t^k (Horner) for rows of :func:`power_coefficients` of one column, shape (N, 6),
+    at t, shape (N,)."""
+    value = coefficients[:, 5] * t
+    for k in (4, 3, 2, 1):
+        value += coefficients[:, k]
+        value *= t
+    value += coefficients[:, 0]
+    return value
 
 
 def hermite_jet(t, start, end):
