@@ -18,7 +18,8 @@ GIF_SECONDS ?= 6
 venv: $(VENV)/.installed $(VENV)/.tf2_msgs
 
 # The pinned requirements, then twodisk_ros itself (editable: the venv runs this checkout's
-# code), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep`, `twodisk-view`
+# code; in setuptools' "compat" mode, a path entry in a .pth file, where the default editable
+# finder cost every Python process of the venv ~40 ms of CPU at start-up), so `roller`, `twodisk-inspect`, `twodisk-animate`, `twodisk-sweep`, `twodisk-view`
 # and `twodisk-figures` are in .venv/bin and work from any directory; the parameter files go to
 # .venv/share/twodisk_ros/config, where a colcon install puts them.
 $(VENV)/.installed: requirements.txt requirements-nodeps.txt setup.py setup.cfg $(wildcard config/*)
@@ -26,7 +27,7 @@ $(VENV)/.installed: requirements.txt requirements-nodeps.txt setup.py setup.cfg 
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps -r requirements-nodeps.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation \
-	    --use-pep517 --editable .
+	    --use-pep517 --config-settings editable_mode=compat --editable .
 	install -d $(VENV)/share/twodisk_ros/config
 	install -m 644 package.xml $(VENV)/share/twodisk_ros/
 	install -m 644 config/* $(VENV)/share/twodisk_ros/config/
