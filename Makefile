@@ -85,10 +85,12 @@ figures: venv
 	$(PY) -m twodisk_ros.plotting.hybrid_figures --out docs/figures --overwrite
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot; then the page's section
-## of docs/benchmarks.md (twodisk-explore in headless Chromium).
+## of docs/benchmarks.md (twodisk-explore in headless Chromium) and the section of
+## contact_model hybrid against MuJoCo alone.
 bench: venv chromium
 	$(PY) benchmarks/run_all.py --overwrite
 	$(PY) benchmarks/explore_rate.py
+	$(PY) benchmarks/hybrid_cost.py
 
 clean:
 	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info
