@@ -218,7 +218,8 @@ def tables(r, o):
               f't = {t:.6f} s, u = {u:.9g}, |w| = {speed:.10g} rad/s '
               f'(relative to Omega_c {speed / crit[0] - 1:.2e})', '',
               '| ω0 (rad/s) | hybrid: switch (s) | MuJoCo alone: first separation ≥ 5 ms (s) '
-              '| flights (hybrid / alone) | highest rise, hybrid (mm) | v_z0²/2g (− h v_z0/2) (mm) '
+              '| flights (hybrid / alone) | highest rise, hybrid (mm) '
+              '| v_z0²/2g (− h v_z0/2) (mm) '
               '| highest rise, alone (mm) | v_z0²/2g (− h v_z0/2) (mm) '
               '| cpu hybrid / alone (s) |',
               '|' + '---|' * 9]

@@ -32,8 +32,9 @@ from ..run.description import RunDescription
 from ..run.hybrid import HybridMotion, ReturnRule
 from ..run.parameters import DEFAULTS
 
-__all__ = ['ROUNDED_SQUARE', 'OLOID', 'OLOID_PHASE', 'EngineAlone', 'Vertex', 'classify', 'description',
-           'engine_alone', 'liftoff_threshold', 'oloid_hops', 'rolling_stretch_errors', 'slip_speeds',
+__all__ = ['ROUNDED_SQUARE', 'OLOID', 'OLOID_PHASE', 'EngineAlone', 'Vertex', 'classify',
+           'description', 'engine_alone', 'liftoff_threshold', 'oloid_hops',
+           'rolling_stretch_errors', 'slip_speeds',
            'square_runs']
 
 #: config/rounded_square.yaml's parameters
