@@ -150,6 +150,12 @@ class HybridSimulation(Simulation):
         """E (J) at sample i: the rolling energy, or the engine's ½ M v² + ½ ωᵀIω + M g z."""
         return float(sample.hybrid.energy[i])
 
+    def check_scene_change(self, settings):
+        """A hybrid run's scene is fixed at its start: a runtime change of it is refused."""
+        if settings.scene_differs(self.settings):
+            raise ValueError('contact_model hybrid takes no scene changes at run time (set '
+                             'damping at the start)')
+
     def continued(self, settings, sample, i, *, drive=None, command=None):
         """A hybrid run has no commands or scene changes (drive none): refused."""
         raise ValueError('contact_model hybrid takes no commands or scene changes')
