@@ -78,16 +78,20 @@ demo: venv
 	$(PY) -m twodisk_ros.plotting.animate_cli $(OUT)/oloid.mcap -o $(OUT)/oloid.gif \
 	    --stop $(GIF_SECONDS) --fps 15 --size 480x360 --overwrite
 
-## The paper's figures, whole cycles, the height of G, the stability map, contact forces (PNG).
+## The paper's figures, whole cycles, the height of G, the stability map, contact forces, and
+## contact_model hybrid beside MuJoCo alone (PNG; the last prints the tables of docs/physics.md).
 figures: venv
 	$(PY) -m twodisk_ros.plotting.figures --out docs/figures --overwrite
 	$(PY) -m twodisk_ros.plotting.contact_forces --out docs/figures --overwrite
+	$(PY) -m twodisk_ros.plotting.hybrid_figures --out docs/figures --overwrite
 
 ## Benchmarks: writes docs/benchmarks.md and the work-precision plot; then the page's section
-## of docs/benchmarks.md (twodisk-explore in headless Chromium).
+## of docs/benchmarks.md (twodisk-explore in headless Chromium) and the section of
+## contact_model hybrid against MuJoCo alone.
 bench: venv chromium
 	$(PY) benchmarks/run_all.py --overwrite
 	$(PY) benchmarks/explore_rate.py
+	$(PY) benchmarks/hybrid_cost.py
 
 clean:
 	rm -rf $(VENV) tests/foxglove/node_modules out build install log .pytest_cache .hypothesis twodisk_ros.egg-info

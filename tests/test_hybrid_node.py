@@ -39,12 +39,13 @@ def recording(tmp_path_factory):
         try:
             node.run_batch()
             stretches = list(node.simulation.hybrid.stretches)
+            (refused,) = node.set_parameters([Parameter('damping', value=0.01)])
         finally:
             node.close()
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=ctx)
-    return read_recording(path), stretches, path
+    return read_recording(path), stretches, path, refused
 
 
 def _topic(recording, name):
@@ -56,7 +57,7 @@ def _stamp(msg):
 
 
 def test_each_switch_is_an_event_at_the_new_models_first_sample(recording):
-    rec, stretches, _ = recording
+    rec, stretches, _, _ = recording
     assert [s.model for s in stretches] == ['rolling', 'engine', 'rolling']
     events = [(m.log_time_ns, m.msg.data) for m in _topic(rec, 'events')]
     assert [text for _, text in events] == [f'contact_model {s.model}: {s.reason}'
@@ -70,7 +71,7 @@ def test_each_switch_is_an_event_at_the_new_models_first_sample(recording):
 
 
 def test_diagnostics_say_which_model_runs(recording):
-    rec, stretches, _ = recording
+    rec, stretches, _, _ = recording
     last = _topic(rec, 'diagnostics')[-1].msg.status[0]
     values = {kv.key: kv.value for kv in last.values}
     assert values['contact_model'] == 'hybrid' and values['model'] == 'rolling'
@@ -82,7 +83,7 @@ def test_diagnostics_say_which_model_runs(recording):
 def test_a_disk_in_the_air_has_no_force_and_its_lowest_point(recording):
     """Samples where the engine's disk 1 (A) is in the air (wrench_a zero): contact_a lies in
     disk 1's plane (x3 = 0 of the pose), above the ground and below G."""
-    rec, _, _ = recording
+    rec, _, _, _ = recording
     wrench = np.array([[m.msg.wrench.force.x, m.msg.wrench.force.y, m.msg.wrench.force.z]
                        for m in _topic(rec, 'wrench_a')])
     point = np.array([[m.msg.point.x, m.msg.point.y, m.msg.point.z]
@@ -109,6 +110,15 @@ def test_the_inspector_checks_engine_stretches_on_their_own(recording):
     assert all(c.passed for c in inspection.checks), [
         (c.name, c.detail) for c in inspection.checks if not c.passed]
     assert inspection.summary['run']['recovered_samples'] == 101
+
+
+def test_a_scene_change_at_run_time_is_refused_in_one_line(recording):
+    """damping is taken at the start (tests/test_hybrid_damping.py) but not changed at run
+    time: the hybrid motion cannot continue a new scene; refused, the run keeps its own."""
+    refused = recording[3]
+    assert not refused.successful
+    assert refused.reason == ('contact_model hybrid takes no scene changes at run time (set '
+                              'damping at the start)')
 
 
 def test_the_engine_check_fails_outside_the_cone_and_through_the_ground():

@@ -44,7 +44,8 @@ import numpy as np
 
 from twodisk_ros.model.mesh import mesh_parts
 
-__all__ = ['ContactParameters', 'INTEGRATORS', 'CONES', 'engine_xml', 'build_model']
+__all__ = ['ContactParameters', 'INTEGRATORS', 'CONES', 'engine_xml', 'build_model',
+           'gravity_vector']
 
 #: MuJoCo integrators accepted (its names).
 INTEGRATORS = ('implicitfast', 'Euler', 'implicit', 'RK4')
@@ -121,7 +122,18 @@ def _fmt(values):
     return ' '.join(f'{x:.17g}' for x in np.ravel(values))
 
 
-def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
+def gravity_vector(gravity, slope=0.0):
+    """Gravity (m/s², (3,)) in the engine's world, the slope frame (x straight downhill in
+    the ground, z the ground's normal, up; docs/physics.md "Scenes"): g (sin β, 0, −cos β)
+    for a slope β (rad, |β| < π/2; 0: the level ground's (0, 0, −g))."""
+    gravity = _number('gravity', gravity, 0.0, 1e3, 'm/s^2')
+    slope = _number('slope', slope, -0.5 * math.pi + 1e-9, 0.5 * math.pi - 1e-9, 'rad')
+    if slope == 0.0:
+        return np.array([0.0, 0.0, -gravity])
+    return np.array([gravity * math.sin(slope), 0.0, -gravity * math.cos(slope)])
+
+
+def engine_xml(body, mass_properties, gravity=9.81, parameters=None, slope=0.0):
     """The MJCF of ``body`` on the ground plane, as a string.
 
     Parameters
@@ -136,6 +148,9 @@ def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
         g (m/s²), ≥ 0.
     parameters : ContactParameters, optional
         Defaults if None.
+    slope : float
+        β (rad): the ground is the plane z = 0 of the slope frame and gravity is tilted in it
+        (:func:`gravity_vector`); 0 gives the level ground's model, unchanged.
 
     Returns
     -------
@@ -146,7 +161,9 @@ def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
     p = ContactParameters() if parameters is None else parameters
     if not isinstance(p, ContactParameters):
         raise ValueError(f'parameters must be a ContactParameters, got {type(p).__name__}')
+    tilted = gravity_vector(gravity, slope)
     gravity = _number('gravity', gravity, 0.0, 1e3, 'm/s^2')
+    gravity_text = f'0 0 {-gravity!r}' if slope == 0.0 else _fmt(tilted)
     if np.max(np.abs(mass_properties.center_of_mass)) > 1e-9 * body.size:
         raise ValueError('mass_properties.center_of_mass must be G, the body-frame origin '
                          '(use centred_on_mass)')
@@ -159,7 +176,7 @@ def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
     return f"""<mujoco model="twodisk">
   <compiler inertiafromgeom="false" angle="radian"/>
   <option timestep="{p.timestep!r}" integrator="{p.integrator}" cone="{p.cone}"
-          gravity="0 0 {-gravity!r}"/>
+          gravity="{gravity_text}"/>
   <default><geom condim="3" friction="{float(p.mu)!r} 0 0"
     solref="{p.time_constant!r} {p.damping_ratio!r}" margin="0"/></default>
   <asset>{meshes}</asset>
@@ -174,7 +191,8 @@ def engine_xml(body, mass_properties, gravity=9.81, parameters=None):
 </mujoco>"""
 
 
-def build_model(body, mass_properties, gravity=9.81, parameters=None):
+def build_model(body, mass_properties, gravity=9.81, parameters=None, slope=0.0):
     """MuJoCo's compiled ``MjModel`` of :func:`engine_xml` (same arguments)."""
     import mujoco
-    return mujoco.MjModel.from_xml_string(engine_xml(body, mass_properties, gravity, parameters))
+    return mujoco.MjModel.from_xml_string(engine_xml(body, mass_properties, gravity, parameters,
+                                                     slope))

@@ -9,6 +9,7 @@ contact points along the ground (NaN where it does not touch).
 """
 
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
@@ -53,16 +54,36 @@ class ContactDetails:
 class Engine:
     """MuJoCo's free body of one body, mass model, g and :class:`ContactParameters`.
 
-    Parameters as in :func:`~twodisk_ros.engine.model.engine_xml`.
+    Parameters as in :func:`~twodisk_ros.engine.model.engine_xml` (``slope`` β, rad: the
+    world is the slope frame, gravity tilted in it), and ``damping`` c (N m s, ≥ 0): the
+    viscous torque −c ω on the body (the scenes' damping, docs/physics.md "Scenes"), applied
+    before every step from that step's ω (explicit: ω decays by the factor 1 − c h / I about a
+    principal axis of moment I per step h; MuJoCo's integrator handles contacts and gravity
+    as without it). c = 0 and β = 0 leave the engine as it was.
     """
 
-    def __init__(self, body, mass_properties, gravity=9.81, parameters=None):
+    def __init__(self, body, mass_properties, gravity=9.81, parameters=None, *, slope=0.0,
+                 damping=0.0):
         import mujoco
+        if isinstance(damping, (bool, str, bytes)) or not np.isscalar(damping) \
+                or not (math.isfinite(float(damping)) and float(damping) >= 0):
+            raise ValueError(f'damping must be a finite torque per angular speed >= 0 N m s, '
+                             f'got {damping!r}')
         self._mujoco = mujoco
-        self.model = build_model(body, mass_properties, gravity, parameters)
+        self.model = build_model(body, mass_properties, gravity, parameters, slope)
         self.data = mujoco.MjData(self.model)
         self.timestep = float(self.model.opt.timestep)
         self._ground = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, 'ground')
+        self.damping = float(damping)
+        self._body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, 'body')
+
+    def _step(self):
+        """One mj_step, with the damping torque −c ω (world frame) of the state before it."""
+        d = self.data
+        if self.damping:
+            rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
+            d.xfrc_applied[self._body, 3:6] = -self.damping * (rotation @ d.qvel[3:6])
+        self._mujoco.mj_step(self.model, d)
 
     def set_state(self, qpos, qvel, time=0.0):
         """Start from the free joint's (qpos, qvel) at ``time`` (s); the solver's warm start
@@ -158,14 +179,14 @@ class Engine:
     def step_to(self, t):
         """Step to time ``t`` (s, ≥ now): whole steps, then one shorter step to land on t
         (so a sample is the state at its own time, not at the last step before it)."""
-        mujoco, d, m = self._mujoco, self.data, self.model
+        d, m = self.data, self.model
         while d.time + self.timestep <= t + 1e-12 * max(1.0, abs(t)):
-            mujoco.mj_step(m, d)
+            self._step()
         rest = t - d.time
         if rest > 1e-9 * self.timestep:
             m.opt.timestep = rest
             try:
-                mujoco.mj_step(m, d)
+                self._step()
             finally:
                 m.opt.timestep = self.timestep
         d.time = float(t)
@@ -183,14 +204,14 @@ class Engine:
         if times.ndim != 1 or np.any(np.diff(times) < 0) \
                 or (times.size and times[0] < self.data.time - 0.5 * self.timestep):
             raise ValueError('times must be a non-decreasing 1-D array from the current time on')
-        mujoco, d, m = self._mujoco, self.data, self.model
+        d = self.data
         n = times.size
         qpos, qvel = np.empty((n, 7)), np.empty((n, 6))
         touching, force, slip = np.empty((n, 2), dtype=bool), np.empty((n, 2)), np.empty((n, 2))
         for k, t in enumerate(times):
             steps = int(np.floor((t - d.time) / self.timestep + 1e-9))
             for _ in range(max(steps, 0)):
-                mujoco.mj_step(m, d)
+                self._step()
             qpos[k], qvel[k] = d.qpos, d.qvel
             touching[k], force[k], slip[k] = self.contacts()
         return EngineSamples(times, qpos, qvel, touching, force, slip)

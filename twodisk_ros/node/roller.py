@@ -210,6 +210,8 @@ class Roller(Node):
             candidate = base.with_values(**changes).checked()
             simulation = (simulation_of(candidate) if candidate.physics_differs(self.settings)
                           else None)
+            if simulation is None:
+                self.simulation.check_scene_change(candidate)
             built = simulation or self.simulation
             description = describe(candidate, built.body, built.dynamics.mass)
         except (ValueError, TypeError, RuntimeError, ArithmeticError) as error:

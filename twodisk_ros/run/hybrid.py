@@ -38,7 +38,7 @@ from ..engine.run import Engine
 from ..engine.state import engine_state, nearest_rolling, quaternion_matrix
 from ..model.frames import disk_rims
 from ..physics.forces.validity import check_validity
-from ..physics.motion.simulate import MotionStream
+from .hybrid_rolling import FreeRolling
 
 __all__ = ['HybridMotion', 'HybridSamples', 'ReturnRule', 'SCAN_STEP', 'SWITCH_TOLERANCE',
            'Stretch']
@@ -103,7 +103,8 @@ class HybridSamples:
     force on the body; normal_a, normal_b, mu_required (n,) (engine: the force's normal part
     and |tangential| / normal, NaN in the air); energy (n,) J; touching (n, 2) bool;
     velocity_g (n, 3) m/s and angular_velocity (n, 3) rad/s (world) of the engine's samples
-    (NaN in rolling ones).
+    (NaN in rolling ones); dissipated (n,) J: the work done against the damping since the
+    rolling stretch's start (0 without damping; NaN in engine samples).
     """
 
     t: np.ndarray
@@ -124,6 +125,7 @@ class HybridSamples:
     touching: np.ndarray
     velocity_g: np.ndarray
     angular_velocity: np.ndarray
+    dissipated: np.ndarray
 
 
 def _yaw_matrix(yaw):
@@ -139,10 +141,11 @@ def _times_quaternion(yaw, q):
 
 
 class _Rolling:
-    """A rolling stretch: its stream from t0, placed by yaw (rad) and shift (m, (2,))."""
+    """A rolling stretch: its motion from t0 (:mod:`~twodisk_ros.run.hybrid_rolling`), placed
+    by yaw (rad) and shift (m, (2,))."""
 
-    def __init__(self, stream, t0, yaw=0.0, shift=(0.0, 0.0)):
-        self.stream, self.t0, self.yaw = stream, float(t0), float(yaw)
+    def __init__(self, source, t0, yaw=0.0, shift=(0.0, 0.0)):
+        self.source, self.t0, self.yaw = source, float(t0), float(yaw)
         self.shift = np.array([shift[0], shift[1], 0.0])
         self.checked = float(t0)      # rolling holds up to here (s)
 
@@ -166,12 +169,17 @@ class HybridMotion:
     rule : ReturnRule, optional
         Default :meth:`ReturnRule.for_body`.
     engine : Engine, optional
-        An engine of the same body, mass model, g and parameters to reuse (else built at
-        the first switch: 0.5 s for the default mesh).
+        An engine of the same body, mass model, g, parameters and damping to reuse (else
+        built at the first switch: 0.5 s for the default mesh).
+    rolling : FreeRolling or DampedRolling, optional
+        The first rolling stretch's motion (default: ``FreeRolling`` of ``stream``); each
+        later one restarts it (:mod:`~twodisk_ros.run.hybrid_rolling`).
+    damping : float
+        c (N m s): the engine's viscous torque −c ω (that of ``rolling``'s scene).
     """
 
     def __init__(self, dynamics, model, stream, mu, *, method='table', tolerance=1e-10,
-                 parameters=None, rule=None, engine=None):
+                 parameters=None, rule=None, engine=None, rolling=None, damping=0.0):
         self.dynamics, self.model, self.mu = dynamics, model, float(mu)
         self.method, self.tolerance = method, tolerance
         p = parameters or ContactParameters()
@@ -179,12 +187,15 @@ class HybridMotion:
             if math.isfinite(self.mu) else p
         self.rule = rule or ReturnRule.for_body(dynamics.body.size, dynamics.gravity)
         self.weight = dynamics.mass.mass * dynamics.gravity
+        source = rolling or FreeRolling(dynamics, model, stream)
+        self.damping = float(damping)
         self.stretches = [Stretch('rolling', 0.0, math.inf, 'exact rolling from t = 0 s',
-                                  energy=stream.initial_energy)]
-        self._rolling = _Rolling(stream, 0.0)
+                                  energy=source.initial_energy)]
+        self._first = source          # each return restarts its kind of rolling
+        self._rolling = _Rolling(source, 0.0)
         self._engine = engine         # built at the first switch if None
         self._held_since = None       # engine: the return rule holds since (s)
-        self._phase = float(stream.state_at([0.0])[0][0])
+        self._phase = float(source.state_at([0.0])[0][0])
         self._rims = self._normals = None
 
     def prepare(self):
@@ -192,16 +203,13 @@ class HybridMotion:
         realtime run does not pay it while publishing."""
         if self._engine is None:
             self._engine = Engine(self.dynamics.body, self.dynamics.mass,
-                                  self.dynamics.gravity, self.parameters)
+                                  self.dynamics.gravity, self.parameters, damping=self.damping)
         if self._normals is None:
             cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
             self._normals = self.dynamics.body.phase_geometry(cycle).ground_normal
         return self
 
     # -- rolling --------------------------------------------------------------------------
-    def _rolling_forces(self, u, w):
-        return self.model.dynamic(u, angular_speed=w)
-
     def _bad(self, forces):
         return (forces.normal_a < 0) | (forces.normal_b < 0) | (forces.mu_required > self.mu)
 
@@ -209,18 +217,17 @@ class HybridMotion:
         """Bisect the first time rolling fails in (good, bad] on the dense solution: (last
         good time, the failing time's report)."""
         r = self._rolling
-        lo, hi = max(good, r.stream.segment[0] + r.t0), bad
+        lo, hi = max(good, r.source.window_start + r.t0), bad
         while hi - lo > SWITCH_TOLERANCE:
             mid = 0.5 * (lo + hi)
             if mid <= lo or mid >= hi:
                 break
-            u, _, w = r.stream.state_at([mid - r.t0])
-            if self._bad(self._rolling_forces(u, w))[0]:
+            if self._bad(r.source.forces(*r.source.state_at([mid - r.t0])[:4]))[0]:
                 hi = mid
             else:
                 lo = mid
-        u, _, w = r.stream.state_at([hi - r.t0])
-        return lo, check_validity([hi], self._rolling_forces(u, w), self.mu)
+        state = r.source.state_at([hi - r.t0])[:4]
+        return lo, check_validity([hi], r.source.forces(*state), self.mu)
 
     def _rolling_block(self, ts):
         """Samples at times ts (s, increasing) of the rolling stretch up to the first time it
@@ -229,15 +236,15 @@ class HybridMotion:
         r = self._rolling
         count = max(2, int(math.ceil((ts[-1] - r.checked) / SCAN_STEP)) + 1)
         grid = np.union1d(np.linspace(r.checked, ts[-1], count), ts)
-        u, u_dot, w = r.stream.sample_with_speed(grid - r.t0)
-        bad = self._bad(self._rolling_forces(u, w))
+        u, u_dot, w, w_dot, work = r.source.states(grid - r.t0)
+        bad = self._bad(r.source.forces(u, u_dot, w, w_dot))
         found, side = None, 'right'
         if bad.any():
             k = int(np.argmax(bad))
             if k == 0:                   # fails at its start (t = 0): the engine's from there
                 side = 'left'
-                found = float(grid[0]), check_validity(
-                    grid[:1], self._rolling_forces(u[:1], w[:1]), self.mu)
+                found = float(grid[0]), check_validity(grid[:1], r.source.forces(
+                    u[:1], u_dot[:1], w[:1], None if w_dot is None else w_dot[:1]), self.mu)
             else:
                 found = self._crossing(float(grid[k - 1]), float(grid[k]))
             r.checked = found[0]
@@ -245,13 +252,15 @@ class HybridMotion:
             r.checked = float(ts[-1])
         end = len(ts) if found is None else int(np.searchsorted(ts, found[0], side))
         at = np.searchsorted(grid, ts[:end])
-        return (self._rolling_samples(u[at], u_dot[at], w[at]) if end else None), found
+        return (self._rolling_samples(u[at], u_dot[at], w[at],
+                                      None if w_dot is None else w_dot[at], work[at])
+                if end else None), found
 
-    def _rolling_samples(self, u, u_dot, w):
+    def _rolling_samples(self, u, u_dot, w, w_dot, work):
         r = self._rolling
         poses = self.dynamics.cycle.poses(u)
         rz = _yaw_matrix(r.yaw)
-        f = self._rolling_forces(u, w)
+        f = r.source.forces(u, u_dot, w, w_dot)
         if len(u):
             self._phase = float(u[-1])
         return dict(engine=np.zeros(len(u), dtype=bool), phase=u, phase_rate=u_dot,
@@ -261,14 +270,14 @@ class HybridMotion:
                     quaternion=_times_quaternion(r.yaw, poses.quaternion),
                     force_a=f.force_a @ rz.T, force_b=f.force_b @ rz.T, normal_a=f.normal_a,
                     normal_b=f.normal_b, mu_required=f.mu_required,
-                    energy=self.dynamics.energy_turning(u, w),
+                    energy=r.source.energy(u, w),
                     touching=np.ones((len(u), 2), dtype=bool),
                     velocity_g=np.full((len(u), 3), np.nan),
-                    angular_velocity=np.full((len(u), 3), np.nan))
+                    angular_velocity=np.full((len(u), 3), np.nan), dissipated=work)
 
     def _to_engine(self, t_switch, report):
         r = self._rolling
-        u, _, w = (float(x[0]) for x in r.stream.state_at([t_switch - r.t0]))
+        u, _, w = (float(x[0]) for x in r.source.state_at([t_switch - r.t0])[:3])
         state = engine_state(self.dynamics, u, w, r.yaw, r.shift[:2])
         self.prepare()
         self._engine.set_state(state.qpos, state.qvel, t_switch)
@@ -312,15 +321,14 @@ class HybridMotion:
         e = self._engine
         qpos, qvel = e.data.qpos.copy(), e.data.qvel.copy()
         near = nearest_rolling(self.dynamics, qpos, qvel, near_phase=self._phase)
-        if self._bad(self._rolling_forces(np.array([near.phase]),
-                                          np.array([near.angular_speed])))[0]:
+        source = self._first.restart(near.phase, near.angular_speed, self.method,
+                                     self.tolerance)
+        _, u_dot, _, w_dot, _ = source.state_at([0.0])
+        if self._bad(source.forces(np.array([near.phase]), u_dot,
+                                   np.array([near.angular_speed]), w_dot))[0]:
             self._held_since = None       # rolling would not hold there: hold again
             return False
-        stream = MotionStream(self.dynamics, near.phase,
-                              self.dynamics.initial_phase_rate(near.phase, near.angular_speed),
-                              method=self.method, tolerance=self.tolerance,
-                              angular_speed=near.angular_speed)
-        self._rolling = _Rolling(stream, now, near.yaw, near.shift)
+        self._rolling = _Rolling(source, now, near.yaw, near.shift)
         self._phase = near.phase
         stretch = self.stretches[-1]
         stretch.t_end = now
@@ -381,7 +389,7 @@ class HybridMotion:
                     force_b=c.force[1], normal_a=normal[0], normal_b=normal[1],
                     mu_required=float(np.nanmax(ratio)) if np.any(np.isfinite(ratio))
                     else math.nan, energy=energy, touching=c.touching, velocity_g=v.copy(),
-                    angular_velocity=rotation @ omega)
+                    angular_velocity=rotation @ omega, dissipated=math.nan)
 
     # -- sampling -------------------------------------------------------------------------
     def sample(self, t):

@@ -53,9 +53,16 @@ class HybridSimulation(Simulation):
     def __init__(self, settings, run=None, **kwargs):
         super().__init__(settings, run, **kwargs)
         from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
+        from .hybrid_rolling import DampedRolling
         s = self.settings
+        rolling = None
+        if self.scene is not None:        # damping (level ground, no drive: parameters.py)
+            start = self.initial_state()
+            rolling = DampedRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
+                                    start.angular_speed)
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
-                                   method=s.method, tolerance=s.tolerance).prepare()
+                                   method=s.method, tolerance=s.tolerance, rolling=rolling,
+                                   damping=s.damping).prepare()
         self.announced = 1          # stretches already published as events
 
     def sample(self, t, forces=False, time_offset=0.0):
@@ -127,7 +134,8 @@ class HybridSimulation(Simulation):
         return 0, f'free body (MuJoCo) since t = {stretch.t_start:.6g} s{where}', values
 
     def invariant(self, sample, i):
-        """('energy', E, drift): rolling: |E − E_stretch| / (M g L); engine: only the rise
+        """('energy', E, drift): rolling: |E + W − E_stretch| / (M g L) (W the work done
+        against the damping since the stretch's start, 0 without); engine: only the rise
         above E_stretch + :data:`ENGINE_SINK` × M g counts (module docstring)."""
         energy = float(sample.hybrid.energy[i])
         stretch = self.stretch_at(float(sample.t[i]))
@@ -135,12 +143,19 @@ class HybridSimulation(Simulation):
         if sample.hybrid.engine[i]:
             rise = energy - stretch.energy - ENGINE_SINK * self.weight
             return 'energy', energy, max(rise, 0.0) / scale
-        return 'energy', energy, abs(energy - stretch.energy) / scale
+        balance = energy + float(sample.hybrid.dissipated[i])
+        return 'energy', energy, abs(balance - stretch.energy) / scale
 
     def energy(self, sample, i):
         """E (J) at sample i: the rolling energy, or the engine's ½ M v² + ½ ωᵀIω + M g z."""
         return float(sample.hybrid.energy[i])
 
+    def check_scene_change(self, settings):
+        """A hybrid run's scene is fixed at its start: a runtime change of it is refused."""
+        if settings.scene_differs(self.settings):
+            raise ValueError('contact_model hybrid takes no scene changes at run time (set '
+                             'damping at the start)')
+
     def continued(self, settings, sample, i, *, drive=None, command=None):
-        """A hybrid run has no commands or scene changes (drive none, no losses): refused."""
+        """A hybrid run has no commands or scene changes (drive none): refused."""
         raise ValueError('contact_model hybrid takes no commands or scene changes')

@@ -145,7 +145,8 @@ PARAMETERS = (
               'hybrid (exact rolling while it holds; from the instant a contact would lift off '
               'or slip, a free rigid body with unilateral contacts and Coulomb friction '
               'in MuJoCo, back to exact rolling once both contacts roll again); hybrid needs '
-              'mode dynamic, drive none, slope 0, no damping or rolling resistance',
+              'mode dynamic, drive none, slope 0, no rolling resistance (damping acts on '
+              'both: -c omega on the engine\'s body)',
               choices=CONTACT_MODELS, physics=True),
     Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
     Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
@@ -263,12 +264,12 @@ def _check_together(s, outline=None):
         raise ValueError(f'damping must be <= {DAMPING_RATE:g}/s x mass x max(a, b)^2 = '
                          f'{damping_limit:.6g} N m s for this body (a spin-down faster than '
                          f'~1 ms is not simulated), got {s.damping!r}')
-    if s.contact_model == 'hybrid' and (s.mode, s.drive, s.slope, s.damping,
-                                        s.rolling_resistance) != ('dynamic', 'none', 0, 0, 0):
-        raise ValueError('contact_model hybrid needs mode dynamic, drive none, slope 0, damping 0 '
-                         'and rolling_resistance 0 (the free body has no motor, slope or '
-                         f'losses), got mode {s.mode}, drive {s.drive}, slope {s.slope!r}, '
-                         f'damping {s.damping!r}, rolling_resistance {s.rolling_resistance!r}')
+    if s.contact_model == 'hybrid' and (s.mode, s.drive, s.slope,
+                                        s.rolling_resistance) != ('dynamic', 'none', 0, 0):
+        raise ValueError('contact_model hybrid needs mode dynamic, drive none, slope 0 and '
+                         'rolling_resistance 0 (the free body has no motor, slope or rolling '
+                         f'resistance; damping it has), got mode {s.mode}, drive {s.drive}, '
+                         f'slope {s.slope!r}, rolling_resistance {s.rolling_resistance!r}')
     if s.shape == 'superellipse' and s.mass_model == 'solid' and s.exponent > SOLID_EXPONENT:
         raise ValueError(f'exponent must be <= {SOLID_EXPONENT:g} for mass_model solid (the '
                          'hull of sharper corners is not resolved in floating point; laminae '

@@ -220,6 +220,10 @@ class Simulation:
             self.invalid = None
         self.settings = settings
 
+    def check_scene_change(self, settings):
+        """Raise ValueError (one line) if this motion cannot continue under ``settings``'
+        scene (a runtime change of drive, damping or rolling resistance); rolling can."""
+
     def switches(self, sample, start, stop):
         """[(index, event text)] of the switches of contact model among samples [start, stop)
         of a block (none: exact rolling only; :mod:`~twodisk_ros.run.hybrid_simulation`)."""
