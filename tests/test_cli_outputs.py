@@ -15,14 +15,13 @@ group if it overruns.
 
 import os
 from pathlib import Path
-import resource
 import shutil
-import signal
-import subprocess
 import sys
 import time
 
 import pytest
+
+from zygote import Zygote
 
 REPO = Path(__file__).resolve().parents[1]
 ENV = dict(os.environ, PYTHONPATH=str(REPO), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
@@ -61,30 +60,28 @@ runpy.run_module({module!r}, run_name='__main__', alter_sys=True)
 '''
 
 
-def _limit_address_space():
-    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+@pytest.fixture(scope='module', autouse=True)
+def zygote():
+    """The module's command runs are children of one fork server (tests/zygote.py), each in
+    a session of its own: the command as ``python`` runs it, without ~0.25 s of interpreter
+    start and numpy import (numpy is not among the imports these tests refuse)."""
+    global ZYGOTE
+    with Zygote(ENV) as ZYGOTE:
+        yield ZYGOTE
 
 
 def _run(module, *args, cwd, blocked=(), address_space=False, timeout=60):
     """Run ``python -m module args`` (through the import-blocking wrapper if ``blocked``);
     returns (CompletedProcess, seconds)."""
     if blocked:
-        command = [sys.executable, '-c', WRAPPER.format(blocked=tuple(blocked), module=module,
-                                                        refused=REFUSED), *map(str, args)]
+        command = ['-c', WRAPPER.format(blocked=tuple(blocked), module=module,
+                                        refused=REFUSED), *args]
     else:
-        command = [sys.executable, '-m', module, *map(str, args)]
+        command = ['-m', module, *args]
     start = time.monotonic()
-    proc = subprocess.Popen(command, cwd=cwd, env=ENV, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True,
-                            preexec_fn=_limit_address_space if address_space else None)
-    try:
-        out, err = proc.communicate(timeout=timeout)
-    finally:
-        if proc.poll() is None:         # the command and anything it started (its group)
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.communicate(timeout=10)
-    return subprocess.CompletedProcess(command, proc.returncode, out, err), \
-        time.monotonic() - start
+    result = ZYGOTE.run(command, cwd=cwd, timeout=timeout, new_session=True,
+                        address_space=ADDRESS_SPACE if address_space else None)
+    return result, time.monotonic() - start
 
 
 @pytest.fixture(scope='module')
