@@ -183,3 +183,46 @@ def test_the_return_matches_the_engine_within_the_reported_mismatch(runs):
         assert abs(rolling_energy - energy(qpos, qvel) - near.energy_mismatch) <= 1e-6
         # the rule held: the engine was rolling, so the map's mismatch is small
         assert near.angle_mismatch < 1e-3 and abs(near.height_mismatch) < 1e-4
+
+
+def test_state_at_reaches_every_piece_of_the_latest_call():
+    """MotionStream.state_at (the bisection's dense solution) answers at every time of its
+    latest call, also in a DOP853 segment before the one the call ended in (it raised there):
+    against one segment over the whole span (solver tolerance 1e-8: measured 1e-9 rad)."""
+    from twodisk_ros.physics import EllipseBody, RollingDynamics
+    from twodisk_ros.physics.mass.models import laminae
+    dynamics = RollingDynamics(EllipseBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
+    stream = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=0.1, tolerance=1e-8)
+    reference = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=100.0, tolerance=1e-8)
+    stream.sample_with_speed(np.array([0.02, 0.04]))
+    sampled = np.array(stream.sample_with_speed(np.array([0.06, 0.1, 0.14, 0.18])))
+    assert stream.segment == (0.1, 0.2)        # the call crossed into a second segment
+    # the same dense solutions as the call's samples (bit for bit: one evaluation)
+    assert np.array_equal(np.array(stream.state_at([0.18, 0.06, 0.1, 0.14])),
+                          sampled[:, [3, 0, 1, 2]])
+    times = np.array([0.05, 0.09, 0.11, 0.19])
+    u, u_dot, w = stream.state_at(times)
+    u_ref, u_dot_ref, w_ref = reference.sample_with_speed(times)
+    np.testing.assert_allclose(u, u_ref, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(u_dot, u_dot_ref, rtol=0, atol=1e-5 * np.abs(u_dot_ref).max())
+    with pytest.raises(ValueError, match='times must lie in'):
+        stream.state_at([0.21])                # beyond the latest call's last piece
+
+
+def test_a_crossing_in_an_earlier_dopri_segment_of_the_block(runs):
+    """A rolling block whose scan grid starts in one DOP853 segment (0.03 s chunks here)
+    with the crossing there, and ends in the next (it raised in state_at): the switch is the
+    table run's (runs['slow'], a closed-form quadrature) to 1e-8 s — the two solvers' states
+    agree to their tolerance 1e-10, the crossing moves by that over the rate of μ_required
+    (measured 9e-12 s)."""
+    run, t0 = runs['run'], 0.45
+    u, u_dot, w = (float(x[0]) for x in run.stream().sample_with_speed([t0]))
+    stream = MotionStream(run.dynamics, u, u_dot, method='direct', chunk=0.03,
+                          lookahead=0.03, angular_speed=w)
+    motion = HybridMotion(run.dynamics, runs['model'], stream, runs['settings'].friction,
+                          engine=runs['slow']._engine)
+    t = np.arange(0.0, 0.08, 0.01)          # switch at 0.0494 s, in the segment [0.03, 0.06]
+    motion.sample(t[:5])
+    motion.sample(t[5:])                    # its grid: 0.04 … 0.07 s, over two segments
+    assert [s.model for s in motion.stretches] == ['rolling', 'engine']
+    assert abs(motion.stretches[1].t_start + t0 - runs['slow'].stretches[1].t_start) < 1e-8
