@@ -226,3 +226,24 @@ def test_a_crossing_in_an_earlier_dopri_segment_of_the_block(runs):
     motion.sample(t[5:])                    # its grid: 0.04 … 0.07 s, over two segments
     assert [s.model for s in motion.stretches] == ['rolling', 'engine']
     assert abs(motion.stretches[1].t_start + t0 - runs['slow'].stretches[1].t_start) < 1e-8
+
+
+def test_a_friction_change_reaches_the_engine(runs):
+    """HybridSimulation.update's set_friction: every geom of the engine has the new μ as its
+    sliding friction (a MuJoCo contact takes the larger of its two geoms'), and the rolling
+    model is judged by it; a switch of a motion sharing the engine puts its own μ back."""
+    engine = runs['slow']._engine
+    motion = HybridMotion(runs['run'].dynamics, runs['model'], runs['run'].stream(), 0.5,
+                          engine=engine)
+    try:
+        motion.set_friction(0.8)
+        assert motion.mu == 0.8 and motion.parameters.mu == 0.8
+        assert np.all(engine.model.geom_friction[:, 0] == 0.8)
+        assert np.all(engine.model.geom_friction[:, 1:] == 0.0)    # no torsion or rolling
+        motion.set_friction(0.5)
+        engine.model.geom_friction[:, 0] = 0.9                     # as another motion left it
+        motion.sample(np.arange(0.45, 0.52, 0.01))                 # the switch at 0.4994 s
+        assert motion.stretches[-1].model == 'engine'
+        assert np.all(engine.model.geom_friction[:, 0] == 0.5)
+    finally:
+        engine.model.geom_friction[:, 0] = runs['settings'].friction

@@ -82,10 +82,10 @@ class HybridSimulation(Simulation):
                       forces=contact, angular_speed=h.angular_speed, hybrid=h)
 
     def update(self, settings):
-        """Take settings that leave the motion unchanged; a new friction is the engine's too
-        from the next switch on (rolling is judged by it at once)."""
+        """Take settings that leave the motion unchanged; a new friction is the rolling
+        model's and the engine's from the next block sampled on (also in an engine stretch)."""
         super().update(settings)
-        self.hybrid.mu = float(settings.friction)
+        self.hybrid.set_friction(settings.friction)
 
     def stretch_at(self, t):
         """The :class:`~twodisk_ros.run.hybrid.Stretch` holding time t (s, this motion's)."""
