@@ -80,7 +80,7 @@ class Stretch:
     :class:`~twodisk_ros.engine.state.NearestRolling` of the return) and ``engine_state``
     ((qpos, qvel) of the engine there); ``energy`` (J) is the rolling energy at its start
     (of the state handed to the engine, or mapped back); an engine stretch lists its ``flights``: [(t0, t1)]
-    step times between which no contact was active.
+    step times (s): the states from t0 to before t1 had no active contact.
     """
 
     model: str
@@ -306,6 +306,7 @@ class HybridMotion:
         time, or None."""
         e, rule, stretch = self._engine, self.rule, self.stretches[-1]
         while e.data.time < t - 1e-12:
+            before = float(e.data.time)    # after mj_step the contacts are this state's
             e.step_to(min(e.data.time + e.timestep, t))
             now = float(e.data.time)
             touching, slip, normal = e.contact_speeds()
@@ -313,9 +314,9 @@ class HybridMotion:
                 if stretch.flights and stretch.flights[-1][1] == -1.0:
                     pass
                 else:
-                    stretch.flights.append([now, -1.0])
+                    stretch.flights.append([before, -1.0])
             elif stretch.flights and stretch.flights[-1][1] == -1.0:
-                stretch.flights[-1][1] = now
+                stretch.flights[-1][1] = before
             if touching.all() and slip.max() < rule.slip_speed \
                     and normal.max() < rule.normal_speed:
                 if self._held_since is None:
