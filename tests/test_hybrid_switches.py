@@ -70,3 +70,22 @@ def test_diagnostics_count_the_switches_by_the_sample_time():
         normal_b=np.ones(n)))
     counts = [dict(simulation.contact_status(sample, i)[2])['switches'] for i in (12, 15)]
     assert counts == [1, 3]
+
+
+#: a hybrid recording's events (stamps ns): engine stretches ended by a reset, a restart and
+#: a return to rolling; a pause is no end
+EVENTS = [(10, 'contact_model engine: slip at t = 0.1 s'), (15, 'pause'), (20, 'reset'),
+          (30, 'contact_model engine: lift-off of A at t = 0.3 s'), (40, 'restart'),
+          (45, 'scene damping 0.0 -> 0.01'), (50, 'contact_model engine: slip at t = 0.5 s'),
+          (60, 'contact_model rolling: rolling again at t = 0.6 s'),
+          (70, 'contact_model engine: slip at t = 0.7 s')]
+
+
+def test_a_reset_or_restart_ends_an_engine_stretch_for_the_inspector():
+    from twodisk_ros.inspector.engine_stretches import engine_intervals
+    assert engine_intervals(EVENTS) == [(10, 20), (30, 40), (50, 60), (70, None)]
+
+
+def test_the_energy_check_starts_again_at_a_reset_restart_or_return():
+    from twodisk_ros.inspector import engine_stretches
+    assert engine_stretches.rolling_starts(EVENTS) == [20, 40, 60]      # E0 again at each
