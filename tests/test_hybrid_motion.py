@@ -183,3 +183,93 @@ def test_the_return_matches_the_engine_within_the_reported_mismatch(runs):
         assert abs(rolling_energy - energy(qpos, qvel) - near.energy_mismatch) <= 1e-6
         # the rule held: the engine was rolling, so the map's mismatch is small
         assert near.angle_mismatch < 1e-3 and abs(near.height_mismatch) < 1e-4
+
+
+def test_state_at_reaches_every_piece_of_the_latest_call():
+    """MotionStream.state_at (the bisection's dense solution) answers at every time of its
+    latest call, also in a DOP853 segment before the one the call ended in (it raised there):
+    against one segment over the whole span (solver tolerance 1e-8: measured 1e-9 rad)."""
+    from twodisk_ros.physics import EllipseBody, RollingDynamics
+    from twodisk_ros.physics.mass.models import laminae
+    dynamics = RollingDynamics(EllipseBody(0.1, 0.1, 0.05), laminae(0.1, 0.1, 0.05, 1.0))
+    stream = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=0.1, tolerance=1e-8)
+    reference = MotionStream(dynamics, 0.3, 2.0, method='direct', chunk=100.0, tolerance=1e-8)
+    stream.sample_with_speed(np.array([0.02, 0.04]))
+    sampled = np.array(stream.sample_with_speed(np.array([0.06, 0.1, 0.14, 0.18])))
+    assert stream.segment == (0.1, 0.2)        # the call crossed into a second segment
+    # the same dense solutions as the call's samples (bit for bit: one evaluation)
+    assert np.array_equal(np.array(stream.state_at([0.18, 0.06, 0.1, 0.14])),
+                          sampled[:, [3, 0, 1, 2]])
+    times = np.array([0.05, 0.09, 0.11, 0.19])
+    u, u_dot, w = stream.state_at(times)
+    u_ref, u_dot_ref, w_ref = reference.sample_with_speed(times)
+    np.testing.assert_allclose(u, u_ref, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(u_dot, u_dot_ref, rtol=0, atol=1e-5 * np.abs(u_dot_ref).max())
+    with pytest.raises(ValueError, match='times must lie in'):
+        stream.state_at([0.21])                # beyond the latest call's last piece
+
+
+def test_a_crossing_in_an_earlier_dopri_segment_of_the_block(runs):
+    """A rolling block whose scan grid starts in one DOP853 segment (0.03 s chunks here)
+    with the crossing there, and ends in the next (it raised in state_at): the switch is the
+    table run's (runs['slow'], a closed-form quadrature) to 1e-8 s — the two solvers' states
+    agree to their tolerance 1e-10, the crossing moves by that over the rate of μ_required
+    (measured 9e-12 s)."""
+    run, t0 = runs['run'], 0.45
+    u, u_dot, w = (float(x[0]) for x in run.stream().sample_with_speed([t0]))
+    stream = MotionStream(run.dynamics, u, u_dot, method='direct', chunk=0.03,
+                          lookahead=0.03, angular_speed=w)
+    motion = HybridMotion(run.dynamics, runs['model'], stream, runs['settings'].friction,
+                          engine=runs['slow']._engine)
+    t = np.arange(0.0, 0.08, 0.01)          # switch at 0.0494 s, in the segment [0.03, 0.06]
+    motion.sample(t[:5])
+    motion.sample(t[5:])                    # its grid: 0.04 … 0.07 s, over two segments
+    assert [s.model for s in motion.stretches] == ['rolling', 'engine']
+    assert abs(motion.stretches[1].t_start + t0 - runs['slow'].stretches[1].t_start) < 1e-8
+
+
+def test_a_friction_change_reaches_the_engine(runs):
+    """HybridSimulation.update's set_friction: every geom of the engine has the new μ as its
+    sliding friction (a MuJoCo contact takes the larger of its two geoms'), and the rolling
+    model is judged by it; a switch of a motion sharing the engine puts its own μ back."""
+    engine = runs['slow']._engine
+    motion = HybridMotion(runs['run'].dynamics, runs['model'], runs['run'].stream(), 0.5,
+                          engine=engine)
+    try:
+        motion.set_friction(0.8)
+        assert motion.mu == 0.8 and motion.parameters.mu == 0.8
+        assert np.all(engine.model.geom_friction[:, 0] == 0.8)
+        assert np.all(engine.model.geom_friction[:, 1:] == 0.0)    # no torsion or rolling
+        motion.set_friction(0.5)
+        engine.model.geom_friction[:, 0] = 0.9                     # as another motion left it
+        motion.sample(np.arange(0.45, 0.52, 0.01))                 # the switch at 0.4994 s
+        assert motion.stretches[-1].model == 'engine'
+        assert np.all(engine.model.geom_friction[:, 0] == 0.5)
+    finally:
+        engine.model.geom_friction[:, 0] = runs['settings'].friction
+
+
+def test_engine_forces_are_of_the_samples_own_state(runs):
+    """Newton's second law between consecutive engine steps: with a sample at every step h,
+    M (v(t + h) − v(t)) / h = F_A + F_B + M g at sample t (MuJoCo's implicitfast integrator
+    updates G's velocity by h × the acceleration of the state at t; no velocity-dependent
+    force acts on G). The forces were those of the state one step earlier (off by up to
+    16 N in the impacts of this hopping start, M g = 9.8 N). Tolerance: 16 ulps of
+    M max|v| / h, the rounding of the velocity difference (measured 2.2e-13 N)."""
+    run = runs['run']
+    dynamics = run.dynamics
+    start = dynamics.initial_state(run.start().phase, 15.0)
+    motion = HybridMotion(dynamics, runs['model'],
+                          MotionStream(dynamics, start.phase, start.phase_rate,
+                                       angular_speed=15.0),
+                          runs['settings'].friction, engine=runs['slow']._engine)
+    h = motion.prepare()._engine.timestep
+    s = motion.sample(np.arange(0.0, 0.06, h))       # 120 steps: a flight and its landing
+    both = s.engine[:-1] & s.engine[1:]
+    assert both.sum() > 100 and not s.touching[:, 1].all()
+    mass = dynamics.mass.mass
+    newton = mass * np.diff(s.velocity_g, axis=0) / h - mass * np.array(
+        [0.0, 0.0, -dynamics.gravity])
+    force = (s.force_a + s.force_b)[:-1]
+    tolerance = 16 * np.finfo(float).eps * mass * np.abs(s.velocity_g).max() / h
+    assert np.abs(force - newton)[both].max() < tolerance

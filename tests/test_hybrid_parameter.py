@@ -34,3 +34,22 @@ def test_contact_model_default_and_recorded():
     assert problems == [] and settings.contact_model == 'rolling'
     with pytest.raises(ValueError, match='drive none'):
         hybrid.with_values(drive='speed').checked()
+
+
+@pytest.mark.parametrize('friction', [0.0, float('inf'), 20.0])
+def test_hybrid_friction_outside_the_engines_range_is_refused(friction):
+    """The engine's μ is ``friction`` (it was silently 0.5 for .inf and 10 for 20)."""
+    with pytest.raises(ValueError, match=r'^friction must be in \(0, 10\] for contact_model '
+                                         r'hybrid .*, got ' + repr(friction)):
+        DEFAULTS.with_values(contact_model='hybrid', friction=friction).checked()
+    DEFAULTS.with_values(friction=friction).checked()     # exact rolling takes them
+    DEFAULTS.with_values(contact_model='hybrid', friction=10.0).checked()
+
+
+def test_hybrid_friction_zero_exits_2_in_one_line(tmp_path, monkeypatch, capfd):
+    code, err = run_roller_main(('-p', 'realtime:=false', '-p', 'duration:=0.1', '-p',
+                                 'contact_model:=hybrid', '-p', 'friction:=0.0'),
+                                monkeypatch, capfd, domain=DOMAIN, cwd=tmp_path)
+    lines = err.splitlines()
+    assert code == 2 and len(lines) == 1 and 'Traceback' not in lines[0], err
+    assert 'friction must be in (0, 10] for contact_model hybrid' in lines[0], lines[0]

@@ -122,8 +122,12 @@ class Engine:
 
     def contact_details(self):
         """The contacts now, per disk (A, B): :class:`ContactDetails` (module docstring's
-        attribution; the ground's force on the body, world frame)."""
+        attribution; the ground's force on the body, world frame). Of the state now: after
+        mj_step the contacts and forces in ``data`` are those of the state before the step,
+        so mj_forward recomputes them first (it leaves qpos, qvel and the solver's warm
+        start as they are: the next step is the same)."""
         mujoco, d = self._mujoco, self.data
+        mujoco.mj_forward(self.model, d)
         touching = np.zeros(2, dtype=bool)
         force, point = np.zeros((2, 3)), np.zeros((2, 3))
         slip, normal = np.zeros(2), np.zeros(2)

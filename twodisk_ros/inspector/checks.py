@@ -67,7 +67,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .engine_stretches import ROLLING_EVENT
+from .engine_stretches import rolling_starts
 from .balance import balance_stretches, scene_timeline
 from .differences import kinetic_energy, motion_of
 from .resolution import Resolution, resolve
@@ -280,7 +280,8 @@ def _energies(samples, motion, model):
 
 def _check_energy(samples, motion, model, restarts=()):
     """E against E0, E0 the first kept sample's, again after each stamp of ``restarts``
-    (int ns: exact rolling resumes with the engine's energy, contact_model hybrid)."""
+    (int ns: exact rolling resumes with the engine's energy, contact_model hybrid; a reset
+    or restart starts a new motion)."""
     k = motion.index
     if k.size == 0:
         return _not_evaluated('energy', _NO_DIFFERENCES)
@@ -307,7 +308,8 @@ def _check_energy(samples, motion, model, restarts=()):
         f'max |E − E0| / (M g L), E0 = {recorded[reference]:.8g} J'
         + ('' if reference == 0 else f' (at t = {samples.t[k[reference]]:.6g} s)')
         + f', M g L = {scale:.4g} J; worst {_where(samples, k[worst])}, {rows.size} samples'
-        + (f'; E0 again at each of {stretch[-1]} returns to rolling' if stretch[-1] else ''),
+        + (f'; E0 again at each of {stretch[-1]} returns to rolling, resets or restarts'
+           if stretch[-1] else ''),
         f'FD-limited: the model poses at the recorded phases give E within {fd_error:.3g} of '
         f'the exact E(u, u̇); tolerance 2 × {FD_MARGIN:g} × that + {solver:.3g} (solver)',
         f'the exact E(u, u̇) of the recorded rolling_state drifts by {model_drift:.3g}']
@@ -417,7 +419,7 @@ def _physics_checks(checks, samples, model, step_ns, scale, parameters, events=(
                  parameters, events, series)
     else:
         _run(checks, 'energy', _check_energy, samples, motion, model,
-             [stamp for stamp, text in events if text.startswith(ROLLING_EVENT)])
+             rolling_starts(events))
     if any(speed_driven) and motion.index.size:
         _run(checks, 'speed_drive', speed_drive_check, samples, motion, model, timeline,
              parameters, events, FD_MARGIN, ROUNDOFF / motion.step + _solver_allowance(model))

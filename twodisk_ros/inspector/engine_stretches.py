@@ -24,25 +24,43 @@ import numpy as np
 
 from .results import Check
 
-__all__ = ['ENGINE_EVENT', 'ROLLING_EVENT', 'engine_check', 'engine_intervals',
-           'split_series']
+__all__ = ['ENGINE_EVENT', 'RESTART_EVENTS', 'ROLLING_EVENT', 'engine_check',
+           'engine_intervals', 'rolling_starts', 'split_series', 'starts_anew']
 
 ENGINE_EVENT = 'contact_model engine:'
 ROLLING_EVENT = 'contact_model rolling:'
+#: events after which the motion starts anew from a rolling state (the node's texts)
+RESTART_EVENTS = ('reset', 'restart')
 #: roles sampled at the node's rate (the rest, e.g. diagnostics and paths, are kept whole)
 _PER_SAMPLE = ('pose', 'contact_a', 'contact_b', 'rolling_state', 'wrench_a', 'wrench_b')
 CONE_TOLERANCE = 1e-6      #: of M g: the engine's friction cone
 DEPTH_TOLERANCE = 1e-2     #: of the body's size: contact points below the ground
 
 
+def starts_anew(text):
+    """Whether the event ``text`` starts the motion anew from a rolling state: ``reset``
+    (scene_control) or ``restart`` (a parameter change that rebuilds the motion, the node's
+    roller.py); neither announces its first rolling stretch."""
+    return text.split(' ', 1)[0] in RESTART_EVENTS
+
+
+def rolling_starts(events):
+    """Stamps (int ns) where exact rolling starts from a new state: a ``contact_model
+    rolling`` event (the engine's state mapped back), ``reset`` or ``restart``: the energy
+    check's E0 is taken again there."""
+    return [int(stamp) for stamp, text in events
+            if text.startswith(ROLLING_EVENT) or starts_anew(text)]
+
+
 def engine_intervals(events):
     """[(first stamp, end stamp or None)] (int ns) of the engine stretches: from a
-    ``contact_model engine`` event to the next ``contact_model rolling`` event (excluded)."""
+    ``contact_model engine`` event to the next ``contact_model rolling``, ``reset`` or
+    ``restart`` event (excluded)."""
     intervals, start = [], None
     for stamp, text in events:
         if text.startswith(ENGINE_EVENT) and start is None:
             start = int(stamp)
-        elif text.startswith(ROLLING_EVENT) and start is not None:
+        elif (text.startswith(ROLLING_EVENT) or starts_anew(text)) and start is not None:
             intervals.append((start, int(stamp)))
             start = None
     if start is not None:

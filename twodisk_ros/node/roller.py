@@ -306,9 +306,9 @@ class Roller(Node):
         latched topics first when they changed, stamped with the first sample's stamp; a
         switch of contact model as an event stamped with the new model's first sample."""
         for j, text in self.simulation.switches(sample, start, stop):
-            if j > start:
+            if j > start:               # (the simulation's indices never go back)
                 self._emit(sample, stamps, encoded, start, j)
-            start = j
+                start = j
             self.control.event(text, self._tick)
         if self._latched.due:
             self._latched.send(int(stamps[start]), None if self._recorder is None

@@ -80,7 +80,7 @@ class Stretch:
     :class:`~twodisk_ros.engine.state.NearestRolling` of the return) and ``engine_state``
     ((qpos, qvel) of the engine there); ``energy`` (J) is the rolling energy at its start
     (of the state handed to the engine, or mapped back); an engine stretch lists its ``flights``: [(t0, t1)]
-    step times between which no contact was active.
+    step times (s): the states from t0 to before t1 had no active contact.
     """
 
     model: str
@@ -183,8 +183,7 @@ class HybridMotion:
         self.dynamics, self.model, self.mu = dynamics, model, float(mu)
         self.method, self.tolerance = method, tolerance
         p = parameters or ContactParameters()
-        self.parameters = ContactParameters(**{**p.__dict__, 'mu': min(self.mu, 10.0)}) \
-            if math.isfinite(self.mu) else p
+        self.parameters = ContactParameters(**{**p.__dict__, 'mu': self.mu})   # (0, 10]
         self.rule = rule or ReturnRule.for_body(dynamics.body.size, dynamics.gravity)
         self.weight = dynamics.mass.mass * dynamics.gravity
         source = rolling or FreeRolling(dynamics, model, stream)
@@ -197,6 +196,15 @@ class HybridMotion:
         self._held_since = None       # engine: the return rule holds since (s)
         self._phase = float(source.state_at([0.0])[0][0])
         self._rims = self._normals = None
+
+    def set_friction(self, mu):
+        """Take the friction coefficient μ (in (0, 10]) from now on: the rolling model is
+        judged by it and the engine's contacts have it (MuJoCo's geom friction; a contact
+        takes the larger of its two geoms')."""
+        self.mu = float(mu)
+        self.parameters = ContactParameters(**{**self.parameters.__dict__, 'mu': self.mu})
+        if self._engine is not None:
+            self._engine.model.geom_friction[:, 0] = self.mu
 
     def prepare(self):
         """Build now what the first switch needs (the engine: ~0.5 s, the phase grid), so a
@@ -280,6 +288,7 @@ class HybridMotion:
         u, _, w = (float(x[0]) for x in r.source.state_at([t_switch - r.t0])[:3])
         state = engine_state(self.dynamics, u, w, r.yaw, r.shift[:2])
         self.prepare()
+        self._engine.model.geom_friction[:, 0] = self.mu     # (a shared engine: this run's)
         self._engine.set_state(state.qpos, state.qvel, t_switch)
         self._phase, self._held_since, self._rolling = u, None, None
         self.stretches[-1].t_end = t_switch
@@ -297,6 +306,7 @@ class HybridMotion:
         time, or None."""
         e, rule, stretch = self._engine, self.rule, self.stretches[-1]
         while e.data.time < t - 1e-12:
+            before = float(e.data.time)    # after mj_step the contacts are this state's
             e.step_to(min(e.data.time + e.timestep, t))
             now = float(e.data.time)
             touching, slip, normal = e.contact_speeds()
@@ -304,9 +314,9 @@ class HybridMotion:
                 if stretch.flights and stretch.flights[-1][1] == -1.0:
                     pass
                 else:
-                    stretch.flights.append([now, -1.0])
+                    stretch.flights.append([before, -1.0])
             elif stretch.flights and stretch.flights[-1][1] == -1.0:
-                stretch.flights[-1][1] = now
+                stretch.flights[-1][1] = before
             if touching.all() and slip.max() < rule.slip_speed \
                     and normal.max() < rule.normal_speed:
                 if self._held_since is None:

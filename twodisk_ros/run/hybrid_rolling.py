@@ -25,8 +25,8 @@ class FreeRolling:
 
     @property
     def window_start(self):
-        """The earliest time (s) :meth:`state_at` answers."""
-        return self.stream.segment[0]
+        """The earliest time (s) :meth:`state_at` answers (the latest call's first piece)."""
+        return self.stream.window[0]
 
     def states(self, t):
         """(u, u̇, w, None, W = 0) at times t (s, increasing, after earlier calls)."""

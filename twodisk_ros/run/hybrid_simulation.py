@@ -82,10 +82,10 @@ class HybridSimulation(Simulation):
                       forces=contact, angular_speed=h.angular_speed, hybrid=h)
 
     def update(self, settings):
-        """Take settings that leave the motion unchanged; a new friction is the engine's too
-        from the next switch on (rolling is judged by it at once)."""
+        """Take settings that leave the motion unchanged; a new friction is the rolling
+        model's and the engine's from the next block sampled on (also in an engine stretch)."""
         super().update(settings)
-        self.hybrid.mu = float(settings.friction)
+        self.hybrid.set_friction(settings.friction)
 
     def stretch_at(self, t):
         """The :class:`~twodisk_ros.run.hybrid.Stretch` holding time t (s, this motion's)."""
@@ -96,21 +96,37 @@ class HybridSimulation(Simulation):
 
     def switches(self, sample, start, stop):
         """[(index, text)]: the stretches not yet announced whose first sample is among
-        [start, stop) of the block ``sample`` (index, ≥ start), with the event's text
-        (``contact_model <model>: <reason>``); marks them announced."""
+        [start, stop) of the block ``sample``, with the event's text (``contact_model
+        <model>: <reason>``); marks them announced. A stretch's first sample is the first
+        with t_start ≤ t < t_end of its model; a stretch that ended before any sample (a
+        flight or a rolling stretch shorter than a sample period) is announced at the next
+        sample, its text saying so. The indices are ≥ start and non-decreasing."""
         found = []
         stretches = self.hybrid.stretches
+        t, engine = sample.t, sample.hybrid.engine
+        floor = start
         while self.announced < len(stretches):
             stretch = stretches[self.announced]
-            mine = np.flatnonzero((sample.hybrid.engine == (stretch.model == 'engine'))
-                                  & (sample.t >= stretch.t_start))
-            mine = mine[mine >= start]
+            mine = np.flatnonzero((t >= stretch.t_start)
+                                  & ((engine == (stretch.model == 'engine'))
+                                     | (t >= stretch.t_end)))
+            mine = mine[mine >= floor]
             if not mine.size or mine[0] >= stop:
                 break
             j = int(mine[0])
-            found.append((j, f'contact_model {stretch.model}: {stretch.reason}'))
+            text = f'contact_model {stretch.model}: {stretch.reason}'
+            if t[j] >= stretch.t_end:
+                text += (f' (ended at t = {stretch.t_end:.9g} s, before any sample: '
+                         'announced at the next sample)')
+            found.append((j, text))
             self.announced += 1
+            floor = j
         return found
+
+    def switches_so_far(self, t):
+        """How many switches of contact model happened by time t (s, this motion's): the
+        stretches after the first with t_start ≤ t."""
+        return sum(1 for stretch in self.hybrid.stretches[1:] if stretch.t_start <= t)
 
     def contact_status(self, sample, i):
         """(level, message, values): which model runs and why, with the contact values."""
@@ -119,7 +135,7 @@ class HybridSimulation(Simulation):
         values = [('contact_model', 'hybrid'),
                   ('model', 'engine' if h.engine[i] else 'rolling'),
                   ('model_since', stretch.t_start), ('model_reason', stretch.reason),
-                  ('switches', len(self.hybrid.stretches) - 1)]
+                  ('switches', self.switches_so_far(float(sample.t[i])))]
         if not h.engine[i]:
             level, message, rolling = super().contact_status(sample, i)
             if stretch.mismatch is not None and level == 0:

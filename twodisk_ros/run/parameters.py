@@ -32,6 +32,8 @@ DELTA_OVER_A = (1e-3, 1.0 - 1e-6)    # allowed Δ/a
 SLOPE_MAX = 1.5                      # rad: |slope| allowed (86 deg; pi/2 is a wall)
 #: contact_model values: exact rolling only, or rolling and MuJoCo's free body (issue 31)
 CONTACT_MODELS = ('rolling', 'hybrid')
+#: the largest friction of contact_model hybrid (MuJoCo's engine: engine/model.py)
+HYBRID_FRICTION_MAX = 10.0
 
 
 @dataclass(frozen=True)
@@ -146,7 +148,7 @@ PARAMETERS = (
               'or slip, a free rigid body with unilateral contacts and Coulomb friction '
               'in MuJoCo, back to exact rolling once both contacts roll again); hybrid needs '
               'mode dynamic, drive none, slope 0, no rolling resistance (damping acts on '
-              'both: -c omega on the engine\'s body)',
+              'both: -c omega on the engine\'s body) and 0 < friction <= 10',
               choices=CONTACT_MODELS, physics=True),
     Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
     Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
@@ -270,6 +272,10 @@ def _check_together(s, outline=None):
                          'rolling_resistance 0 (the free body has no motor, slope or rolling '
                          f'resistance; damping it has), got mode {s.mode}, drive {s.drive}, '
                          f'slope {s.slope!r}, rolling_resistance {s.rolling_resistance!r}')
+    if s.contact_model == 'hybrid' and not 0 < s.friction <= HYBRID_FRICTION_MAX:
+        raise ValueError(f'friction must be in (0, {HYBRID_FRICTION_MAX:g}] for contact_model '
+                         'hybrid (the engine\'s Coulomb friction; 0 and .inf are exact '
+                         f'rolling\'s only), got {s.friction!r}')
     if s.shape == 'superellipse' and s.mass_model == 'solid' and s.exponent > SOLID_EXPONENT:
         raise ValueError(f'exponent must be <= {SOLID_EXPONENT:g} for mass_model solid (the '
                          'hull of sharper corners is not resolved in floating point; laminae '

@@ -220,6 +220,8 @@ class MotionStream:
         self._sol = closed if closed is not None else OdeSolution(None, [u0, u_dot0], 0.0)
         #: right-hand-side evaluations of the ODE segments so far (0 for a closed form)
         self.nfev = 0
+        #: [(start s, solution)]: the pieces the latest call reached (:meth:`state_at`)
+        self._window = [(self._start, self._sol)]
 
     @property
     def solver(self):
@@ -238,26 +240,42 @@ class MotionStream:
 
     @property
     def segment(self):
-        """(start, end) (s) of the solution piece the last call ended in: :meth:`state_at`'s
-        span (end inf for a closed form)."""
+        """(start, end) (s) of the solution piece the last call ended in (end inf for a
+        closed form)."""
         return self._start, self._start + self._sol.t_end
 
+    @property
+    def window(self):
+        """(start, end) (s): :meth:`state_at`'s span, every solution piece the last call
+        reached (a call past a segment's end integrates the next ones)."""
+        start, sol = self._window[-1]
+        return self._window[0][0], start + sol.t_end
+
     def state_at(self, t):
-        """(u, u̇, w) at times t (s, any order) within :attr:`segment`, from the same dense
-        solution as :meth:`sample_with_speed` and without moving on: the root finding
-        between samples of :mod:`~twodisk_ros.run.hybrid`. ValueError outside the segment."""
+        """(u, u̇, w) at times t (s, 1-d, any order) within :attr:`window`, from the same
+        dense solutions as :meth:`sample_with_speed` (a time on the boundary of two pieces
+        from the earlier one, as there) and without moving on: the root finding between
+        samples of :mod:`~twodisk_ros.run.hybrid`. ValueError outside the window."""
         t = np.asarray(t, dtype=float)
-        start, end = self.segment
+        start, end = self.window
         if np.any(t < start) or np.any(t > end):
             raise ValueError(f'state_at: times must lie in [{start:g}, {end:g}] s')
-        return tuple(np.stack(turning_state(self.dynamics, self._sol, t - start, self.mode,
-                                            self.initial_energy, self._speed)))
+        ends = np.array([s + sol.t_end for s, sol in self._window])
+        piece = np.minimum(np.searchsorted(ends, t, 'left'), len(ends) - 1)
+        out = np.empty((3, t.size))
+        for k in np.unique(piece):
+            mine = piece == k
+            s, sol = self._window[k]
+            out[:, mine] = np.stack(turning_state(self.dynamics, sol, t[mine] - s, self.mode,
+                                                  self.initial_energy, self._speed))
+        return tuple(out)
 
     def _sample(self, t, with_speed):
         t = np.asarray(t, dtype=float)
-        pieces = []
+        pieces, window = [], []
         while True:
             end = self._start + self._sol.t_end
+            window.append((self._start, self._sol))
             inside = t <= end
             local = t[inside] - self._start
             pieces.append(np.stack(turning_state(self.dynamics, self._sol, local, self.mode,
@@ -274,6 +292,7 @@ class MotionStream:
             self._sol, nfev = integrate(self.dynamics, self.mode, self.method, span, u0, w0,
                                         u_dot0, self.tolerance)
             self.nfev += nfev
+        self._window = [piece for piece in window if piece[1].t_end > 0] or window
         joined = np.concatenate(pieces, axis=1)
         return tuple(joined)
 
