@@ -62,32 +62,13 @@ def client():
 
 @pytest.fixture(scope='module', autouse=True)
 def bodies_computed_once():
-    """Each block's bodies are computed once in this module (by the first sweep that asks for
-    them, on this process's workers) and handed out again, as copies, to every later task of
-    this process with the same bodies, mass model, speed and exponent. The claims here are
-    about the outputs — which blocks are written, resumed, refused, their flags, their place in
-    the grid — not about the values (tests/test_sweep.py and tests/test_sweep_batch.py check
-    those against the library, and that a body's bits do not depend on its batch): a block
-    written at the wrong place, twice, or not at all still differs from the reference; a task
-    with other bodies or settings is computed afresh. The `dask worker` command's process
-    computes its blocks itself. Saves the ~1.4 s of CPU of each repeated 48-body sweep."""
-    import copy
-    import twodisk_ros.sweep.run as run
-    from twodisk_ros.sweep import store
-    real = run.timed_chunk
-    assert store.timed_chunk is real
-    computed = {}
-
-    def once(b_values, delta_values, *settings):
-        key = (np.asarray(b_values, dtype=float).tobytes(),
-               np.asarray(delta_values, dtype=float).tobytes(), settings)
-        if key not in computed:
-            computed[key] = real(b_values, delta_values, *settings)
-        return copy.deepcopy(computed[key])
-
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(run, 'timed_chunk', once)
-        patch.setattr(store, 'timed_chunk', once)
+    """Each block's bodies are computed once in this module (dask_helpers.blocks_computed_once):
+    the claims here are about the outputs — which blocks are written, resumed, refused, their
+    flags, their place in the grid — not about the values (tests/test_sweep.py and
+    tests/test_sweep_batch.py check those against the library, and that a body's bits do not
+    depend on its batch). Saves the ~1.4 s of CPU of each repeated 48-body sweep."""
+    from dask_helpers import blocks_computed_once
+    with blocks_computed_once():
         yield
 
 
