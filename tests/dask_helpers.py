@@ -107,3 +107,36 @@ def worker_processes(folder, client, count=1):
         stop(procs)
         for log in logs:
             log.close()
+
+
+@contextlib.contextmanager
+def blocks_computed_once():
+    """Within: each task's bodies are computed once (by the first task of this process that
+    asks for them) and handed out again, as copies, to every later task of this process with
+    the same bodies, settings, exponent and general-path factories (``timed_chunk`` as the
+    sweep's client and ``write_block`` call it). For modules whose claims are about the
+    outputs — which blocks are written, resumed, refused, and where — not about the values:
+    a block written at the wrong place, twice, or not at all still differs from the
+    reference, and a task with other bodies or settings is computed afresh. Processes
+    started by :func:`worker_processes` compute their blocks themselves."""
+    import copy
+    import pytest
+    import numpy as np
+    import twodisk_ros.sweep.run as run
+    from twodisk_ros.sweep import general, store
+    real = run.timed_chunk
+    assert store.timed_chunk is real
+    computed = {}
+
+    def once(b_values, delta_values, *settings):
+        key = (np.asarray(b_values, dtype=float).tobytes(),
+               np.asarray(delta_values, dtype=float).tobytes(), settings,
+               general.superellipse_body, general.lamina_mass)
+        if key not in computed:
+            computed[key] = real(b_values, delta_values, *settings)
+        return copy.deepcopy(computed[key])
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run, 'timed_chunk', once)
+        patch.setattr(store, 'timed_chunk', once)
+        yield

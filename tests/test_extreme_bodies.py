@@ -96,15 +96,32 @@ def test_thin_body_libration_stops_at_the_noise_floor():
     assert np.max(np.abs(motion.phase - full_phase)) <= 2e-8
 
 
-def _node_start(**values):
-    """The node's physics for these parameters, and the CPU time (s) of its first 0.5 s."""
-    from twodisk_ros.run.parameters import DEFAULTS      # the node's contract, no rclpy
-    from twodisk_ros.run.simulation import Simulation
-    begin = time.process_time()
-    simulation = Simulation(DEFAULTS.with_values(**values))
-    t = np.arange(1, 51) / 100.0                          # the first 0.5 s at 100 Hz
-    sample = simulation.sample(t)
-    return simulation, t, sample, time.process_time() - begin
+class _NodeStart:
+    """The node's motion for these parameters over its first 0.5 s at 100 Hz.
+
+    The flat free scene's path of :class:`~twodisk_ros.run.simulation.Simulation`: the
+    MotionStream of the run's description (``RunDescription.stream``, what Simulation's
+    FlatMotion samples) and the energy E = ½ J w² + V of each sample against E₀ (what
+    ``Simulation.invariant`` gives there). The node's pose and contact-force tables are not
+    built: no claim here reads them (at 2¹⁶ nodes they cost more than the motion itself).
+    """
+
+    def __init__(self, **values):
+        from twodisk_ros.run.description import RunDescription    # the node's contract
+        from twodisk_ros.run.parameters import DEFAULTS
+        from twodisk_ros.run.scene_simulation import flat_free
+        settings = DEFAULTS.with_values(**values)
+        assert flat_free(settings)                 # the path of Simulation's FlatMotion
+        run = RunDescription(settings)
+        self.dynamics, self.stream = run.dynamics, run.stream()
+        self.t = np.arange(1, 51) / 100.0
+        self.phase, _, self.angular_speed = self.stream.sample_with_speed(self.t)
+
+    def energy_drift(self):
+        """max |E − E₀| / (M g L) over the samples (Simulation.invariant's relative drift)."""
+        return max(abs(float(self.dynamics.energy_turning(u, w)) - self.stream.initial_energy)
+                   / self.dynamics.energy_scale
+                   for u, w in zip(self.phase, self.angular_speed))
 
 
 def test_thin_body_at_one_millimetre_starts_in_closed_form():
@@ -112,14 +129,15 @@ def test_thin_body_at_one_millimetre_starts_in_closed_form():
     # omega0 3 rad/s). E - V is 1e-5 of V there; its rounding left 1/|u̇| a flat spectral
     # floor of ~5e-12 that failed the band's resolution test, and DOP853 ran > 5 min of CPU
     # for its first 10 s. Measured now: 1.5 s (table building included).
-    simulation, t, sample, _ = _node_start(a=0.001, b=0.00001, delta=0.000999999)
+    node = _NodeStart(a=0.001, b=0.00001, delta=0.000999999)
+    t = node.t
     # bounded work: the closed form, no right-hand side of an ODE (DOP853: > 300 s before)
-    assert simulation.stream.solver == 'quadrature' and simulation.stream.nfev == 0
+    assert node.stream.solver == 'quadrature' and node.stream.nfev == 0
     # independent reference: the time to reach each sampled phase, by adaptive quadrature
     # of the closed forms (no table, no solver of the package). Its integrand carries the
     # rounding of E − V (1e-16 V / (E − V) ~ 1e-11 relative; quad warns of roundoff), so
     # the bound is 1e-10 relative (measured 3.4e-11)
-    dyn = simulation.dynamics
+    dyn = node.dynamics
     u0, u_dot0 = _start(dyn)
     energy = 0.5 * float(dyn.effective_mass(u0)) * u_dot0**2 + float(dyn.potential(u0))
 
@@ -128,14 +146,14 @@ def test_thin_body_at_one_millimetre_starts_in_closed_form():
                          / (2 * (energy - float(dyn.potential(v)))))
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', IntegrationWarning)
-        for t_k, u_k in zip(t[9::10], sample.phase[9::10]):
+        for t_k, u_k in zip(t[9::10], node.phase[9::10]):
             t_ref, _ = quad(inverse_speed, u0, u_k, limit=2000, epsabs=1e-14, epsrel=1e-13)
             assert abs(t_ref - t_k) <= 1e-10 * t_k
     # and DOP853 on the closed forms at rtol 1e-13 over 0.1 s: u to 1.5e-11 rad measured
     # (1e-12: 5.9e-11, the reference's own error), the claim of ~1e-11 for poses
     reference = simulate_phase(dyn, t[:10], u0, u_dot0, method='direct', tolerance=1e-13)
-    assert np.max(np.abs(sample.phase[:10] - reference.phase)) <= 1e-10
-    assert max(simulation.invariant(sample, i)[2] for i in range(len(t))) <= 1e-13
+    assert np.max(np.abs(node.phase[:10] - reference.phase)) <= 1e-10
+    assert node.energy_drift() <= 1e-13
 
 
 @pytest.mark.slow
@@ -145,21 +163,22 @@ def test_tiny_thin_body_rolling_over_the_barrier_runs_in_the_regular_chart():
     # w/|ω_u| through swings of three orders of magnitude (m(u) spans six): 171 560 right-hand
     # sides for the first 0.05 s, a 0.5 s batch of the node took 356 s. In the regular chart
     # (u, w) of the Sundman time: 26 264 for the whole 0.5 s (measured).
-    simulation, t, sample, _ = _node_start(a=0.001, b=0.00001, delta=0.000001, theta0=0.0)
-    stream = simulation.stream
+    node = _NodeStart(a=0.001, b=0.00001, delta=0.000001, theta0=0.0)
+    t = node.t
+    stream = node.stream
     assert stream.solver == 'DOP853'
     assert stream.nfev <= 100_000                          # ~1.7 million in t
-    # conservation: the energy of every sample against E0, relative (invariant()[2]). The
+    # conservation: the energy of every sample against E0, relative (invariant()[2]'s). The
     # tables' error near the separatrix bounds it (measured 1.4e-9; in t: 1.2e-7 by 0.05 s)
-    assert max(simulation.invariant(sample, i)[2] for i in range(len(t))) <= 1e-8
+    assert node.energy_drift() <= 1e-8
     # a second method: DOP853 in t on the closed forms (no table), rtol 1e-12, to the first
     # sample, before the first fast swing (past it the reference itself costs minutes):
     # measured 3.6e-11 rad apart, within the tables' 1e-10 of a pose
-    dyn = simulation.dynamics
+    dyn = node.dynamics
     u0, u_dot0 = _start(dyn, theta0=0.0)
     reference = simulate_phase(dyn, np.array([0.0, t[0]]), u0, u_dot0, method='direct',
                                tolerance=1e-12)
-    assert abs(sample.phase[0] - reference.phase[1]) <= 1e-10
+    assert abs(node.phase[0] - reference.phase[1]) <= 1e-10
 
 
 @pytest.mark.slow
@@ -168,25 +187,26 @@ def test_thin_body_at_rest_near_the_barrier_starts_without_a_10_s_chunk():
     # below the barrier, a libration the tables in φ cannot resolve (tail 2e-4 at 2¹⁴
     # nodes), so DOP853 on the tables. Its first 10 s chunk cost ~31 s of CPU before the
     # first sample; the stream now integrates only what is asked for. Measured: 2.8 s.
-    simulation, t, sample, _ = _node_start(a=0.1, b=0.001, delta=0.0999999, omega0=0.0)
-    assert simulation.stream.solver == 'DOP853'
+    node = _NodeStart(a=0.1, b=0.001, delta=0.0999999, omega0=0.0)
+    t = node.t
+    assert node.stream.solver == 'DOP853'
     # bounded work: the right-hand sides for the 0.5 s asked for (377 measured), not a
     # 10 s chunk's (~20 times as many)
-    assert simulation.stream.nfev <= 2000
+    assert node.stream.nfev <= 2000
     # reference: DOP853 on the closed forms (method direct) at rtol 1e-12, over the first
     # 0.2 s (its cost grows with the span: 3 s of CPU, 10 s for 0.5 s). The claim near the
     # separatrix (tests/test_libration.py): |δ − δ_ref| ≤ 3e-8 A; measured 5.9e-10 A by
     # 0.2 s, 1.5e-9 A by 0.5 s, the same against rtol 1e-13 (the tables' part, not the
     # reference's); the energy below holds the whole 0.5 s
-    dyn = simulation.dynamics
+    dyn = node.dynamics
     u0, _ = _start(dyn, omega0=0.0)
     early = t <= 0.2
     reference = simulate_phase(dyn, np.concatenate([[0.0], t[early]]), u0, 0.0,
                                method='direct', tolerance=1e-12)
     centre = reference.sol.centre
     amplitude = abs(u0 - centre)
-    assert np.max(np.abs(sample.phase[early] - reference.phase[1:])) <= 3e-8 * amplitude
-    assert max(simulation.invariant(sample, i)[2] for i in range(len(t))) <= 1e-11
+    assert np.max(np.abs(node.phase[early] - reference.phase[1:])) <= 3e-8 * amplitude
+    assert node.energy_drift() <= 1e-11
 
 
 def test_startup_estimate_names_the_costly_bodies():
