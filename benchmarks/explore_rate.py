@@ -29,6 +29,8 @@ import subprocess
 import sys
 import time
 
+from sections import replace_section
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 BEGIN, END = '<!-- explore:begin -->', '<!-- explore:end -->'
@@ -309,16 +311,6 @@ def section(r):
     return '\n'.join(lines) + '\n'
 
 
-def write(path, text):
-    old = open(path, encoding='utf-8').read() if os.path.exists(path) else ''
-    if BEGIN in old and END in old:
-        new = old[:old.index(BEGIN)] + text + old[old.index(END) + len(END) + 1:]
-    else:
-        new = old.rstrip('\n') + '\n\n' + text
-    with open(path, 'w', encoding='utf-8') as out:
-        out.write(new)
-
-
 def page(args):
     """The measures of the page of the code imported (fps, server CPU, latency)."""
     results = page_measures(2 if args.quick else 5, 1.0 if args.quick else 3.0)
@@ -365,7 +357,7 @@ def main():
     results['load_end'] = os.getloadavg()[0]
     print(json.dumps(results, indent=1))
     if not args.no_write:
-        write(args.out, section(results))
+        replace_section(args.out, section(results), BEGIN, END)
     return 0
 
 

@@ -29,6 +29,8 @@ import subprocess
 import sys
 import time
 
+from sections import replace_section
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 BEGIN, END = '<!-- hybrid:begin -->', '<!-- hybrid:end -->'
@@ -164,16 +166,6 @@ def section(cases, machine, date, commit):
     return '\n'.join(lines) + '\n'
 
 
-def write(path, text):
-    old = open(path, encoding='utf-8').read() if os.path.exists(path) else ''
-    if BEGIN in old and END in old:
-        new = old[:old.index(BEGIN)] + text + old[old.index(END) + len(END) + 1:]
-    else:
-        new = old.rstrip('\n') + '\n\n' + text
-    with open(path, 'w', encoding='utf-8') as out:
-        out.write(new)
-
-
 def main():
     args = _parser().parse_args()
     cpu = next((line.split(':', 1)[1].strip() for line in _run(['lscpu']).splitlines()
@@ -185,7 +177,7 @@ def main():
     cases = measure(args.quick)
     print(json.dumps(dict(machine=machine, date=date, commit=commit, cases=cases), indent=1))
     if not args.no_write:
-        write(args.out, section(cases, machine, date, commit))
+        replace_section(args.out, section(cases, machine, date, commit), BEGIN, END)
     return 0
 
 

@@ -33,7 +33,7 @@ from ..physics.stability.equilibria import NEUTRAL, STABLE, equilibria, stabilit
 
 __all__ = ['FIGURE3', 'FIGURE4', 'lamina_bodies', 'NAMES', 'plot_traces', 'plot_height',
            'plot_outline', 'plot_stability_map',
-           'write_figures', 'main']
+           'write_figures', 'main', 'save_figure']
 
 #: The paper's bodies (a, b, Δ) in m.
 FIGURE3 = (2.0, 1.0, 1.0)
@@ -307,13 +307,15 @@ NAMES = ('figure3.png', 'figure4.png', 'oloid_traces.png', 'height.png', 'stabil
          'laminae_traces.png')
 
 
-def _save(fig, path):
-    """Save through a temporary file renamed over ``path`` when complete; close ``fig``."""
+def save_figure(fig, path, dpi=DPI):
+    """Save ``fig`` (a pyplot figure) through a temporary file renamed over ``path`` when
+    complete, at ``dpi``, cropped to its content; close it; return ``path``."""
+    import matplotlib.pyplot as plt
     try:
         with replacing(path) as temporary:
-            fig.savefig(temporary, dpi=DPI, bbox_inches='tight')
+            fig.savefig(temporary, dpi=dpi, bbox_inches='tight')
     finally:
-        _pyplot().close(fig)
+        plt.close(fig)
     return path
 
 
@@ -334,14 +336,14 @@ def write_figures(out_dir):
                                    ('oloid_traces.png', 'Oloid', (1.0, 1.0, 0.5))]:
         fig, ax = plt.subplots(figsize=(8.0, 3.6))
         plot_traces(EllipseBody(*shape), 3, ax, name=title)
-        written.append(_save(fig, out / filename))
+        written.append(save_figure(fig, out / filename))
     fig, ax = plt.subplots(figsize=(7.5, 3.6))
     plot_height([('Oloid', EllipseBody.oloid()), ('Fig. 3 body', EllipseBody(*FIGURE3)),
                  ('Two-Circle-Roller', EllipseBody.two_circle_roller())], ax, annotate=1)
-    written.append(_save(fig, out / 'height.png'))
+    written.append(save_figure(fig, out / 'height.png'))
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     plot_stability_map(ax)
-    written.append(_save(fig, out / 'stability_map.png'))
+    written.append(save_figure(fig, out / 'stability_map.png'))
     bodies = lamina_bodies()
     fig, axes = plt.subplots(len(bodies), 2, figsize=(10.0, 4.3 * len(bodies)),
                              gridspec_kw={'width_ratios': (1, 3.2)})
@@ -350,7 +352,7 @@ def write_figures(out_dir):
         left.set_title(title.split(' (')[0], fontsize=9)
         plot_traces(LaminaBody(lamina, delta, arrangement), cycles, right, name=title)
     fig.tight_layout()
-    written.append(_save(fig, out / 'laminae_traces.png'))
+    written.append(save_figure(fig, out / 'laminae_traces.png'))
     return written
 
 

@@ -24,7 +24,8 @@ import sys
 
 import numpy as np
 
-from ..outputs import OutputError, check_output_dir, replacing
+from ..outputs import OutputError, check_output_dir
+from .figures import save_figure
 
 __all__ = ['NAMES', 'OMEGAS', 'main', 'plot_oloid', 'plot_square', 'tables']
 
@@ -41,14 +42,6 @@ def _pyplot():
         matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     return plt
-
-
-def _save(fig, path):
-    try:
-        with replacing(path) as temporary:
-            fig.savefig(temporary, dpi=DPI, bbox_inches='tight')
-    finally:
-        _pyplot().close(fig)
 
 
 def _shade(ax, stretches, label=None):
@@ -120,7 +113,7 @@ def plot_square(r, path):
     ax.set_title('(d) slip at the first vertex (0 while rolling)')
     ax.legend(loc='upper right', fontsize=7)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path, DPI)
 
 
 def _highest(flights):
@@ -182,7 +175,7 @@ def plot_oloid(o, path):
     ax.set_title(f'(c) the highest hop: {1e3 * rise:.3f} mm, ballistic {1e3 * ballistic:.3f} mm')
     ax.legend(loc='lower center', fontsize=7)
     fig.tight_layout()
-    _save(fig, path)
+    save_figure(fig, path, DPI)
 
 
 def tables(r, o):
