@@ -9,7 +9,6 @@ does no heavy work by refusing the heavy imports).
 """
 
 import configparser
-import json
 import os
 import re
 import subprocess
@@ -18,6 +17,7 @@ from pathlib import Path
 
 from package_helpers import console_scripts
 from PIL import Image
+from zygote import Zygote
 
 import pytest
 
@@ -87,29 +87,17 @@ def test_console_script_help_from_another_directory(tmp_path, name, flag):
 @pytest.fixture(scope='module')
 def forked_help(tmp_path_factory):
     """``--help`` of every program module and benchmark script, each in an empty directory
-    of its own, in children forked from one interpreter (tests/forked_help.py: the
-    interpreter's start-up paid once, not 31 times); label -> (result, its directory)."""
+    of its own, in children of one fork server (tests/zygote.py: the interpreter's start-up
+    paid once, not 31 times); label -> (result, its directory)."""
     root = tmp_path_factory.mktemp('help')
-    jobs = [(f'python -m {m} --help', 'module', m) for m in MODULES] + [
-        (f'benchmarks/{s} --help', 'script', str(REPO / 'benchmarks' / s)) for s in BENCHMARKS]
-    rows = []
-    for k, (label, kind, target) in enumerate(jobs):
-        cwd, out = root / f'cwd{k}', root / f'out{k}'
-        cwd.mkdir()
-        out.mkdir()
-        rows.append([label, kind, target, str(cwd), str(out)])
-    (root / 'jobs.json').write_text(json.dumps(rows), encoding='utf-8')
-    driver = subprocess.run([sys.executable, str(REPO / 'tests' / 'forked_help.py'),
-                             str(root / 'jobs.json')], env=dict(ENV, PYTHONPATH=str(REPO)),
-                            capture_output=True, text=True, timeout=600,
-                            stdin=subprocess.DEVNULL)
-    assert driver.returncode == 0, driver.stderr[-3000:]
+    jobs = [(f'python -m {m} --help', ['-m', m]) for m in MODULES] + [
+        (f'benchmarks/{s} --help', [str(REPO / 'benchmarks' / s)]) for s in BENCHMARKS]
     results = {}
-    for (label, _, _, cwd, out), (same, status) in zip(rows, json.loads(driver.stdout)):
-        assert same == label
-        results[label] = (subprocess.CompletedProcess(
-            label, status, (Path(out) / 'stdout').read_text(encoding='utf-8'),
-            (Path(out) / 'stderr').read_text(encoding='utf-8')), cwd)
+    with Zygote(dict(ENV, PYTHONPATH=str(REPO))) as zygote:
+        for k, (label, args) in enumerate(jobs):
+            cwd = root / f'cwd{k}'
+            cwd.mkdir()
+            results[label] = (zygote.run([*args, '--help'], cwd=cwd, timeout=60), cwd)
     return results
 
 
