@@ -20,7 +20,7 @@ import textwrap
 import numpy as np
 
 from ..model import palette
-from .frames import gif_frame as _gif_frame, render as _render
+from .frames import gif_frame as _gif_frame, one_palette as _one_palette, render as _render
 from ..runs import Run, RunError, library_run
 
 __all__ = ['VIEWS', 'CAMERAS', 'animate', 'drawn', 'frame_times', 'still']
@@ -392,12 +392,13 @@ def animate(run, path, *, start=0.0, stop=None, fps=15.0, view='3d', size=(640, 
     scene = _Scene(shown, figure, view, camera, forces and shown.force_a is not None, frames)
     try:
         if kind == 'gif':
-            # as matplotlib's PillowWriter, with each frame drawn by _render
+            # as matplotlib's PillowWriter, with each frame drawn by _render, in one palette
             pixels = tuple(int(x) for x in figure.canvas.get_width_height())
             images = []
             for frame in range(len(frames)):
                 scene.draw(frame)
                 images.append(_gif_frame(_render(scene), pixels))
+            images = _one_palette(images)
             images[0].save(os.fspath(path), format='GIF', save_all=True,
                            append_images=images[1:], duration=int(1000 / fps), loop=0)
             return len(frames)
