@@ -53,13 +53,14 @@ class HybridSimulation(Simulation):
     def __init__(self, settings, run=None, **kwargs):
         super().__init__(settings, run, **kwargs)
         from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
-        from .hybrid_rolling import DampedRolling
+        from .hybrid_rolling import SceneRolling
         s = self.settings
         rolling = None
-        if self.scene is not None:        # damping (level ground, no drive: parameters.py)
+        self.invalid = None               # (a slope's standing report: the engine's to show)
+        if self.scene is not None:        # slope, damping (no drive: parameters.py)
             start = self.initial_state()
-            rolling = DampedRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
-                                    start.angular_speed)
+            rolling = SceneRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
+                                   start.angular_speed)
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
                                    method=s.method, tolerance=s.tolerance, rolling=rolling,
                                    damping=s.damping).prepare()
