@@ -46,6 +46,7 @@ from ..engine.state import engine_state, nearest_rolling, quaternion_matrix
 from ..model.frames import disk_rims
 from ..physics.forces.validity import check_validity
 from ..physics.scenes.scene import quaternion_product
+from .hybrid_drive import DriveMoment
 from .hybrid_rolling import FreeRolling
 
 __all__ = ['HybridMotion', 'HybridSamples', 'ReturnRule', 'SCAN_STEP', 'SWITCH_TOLERANCE',
@@ -99,6 +100,8 @@ class Stretch:
     mismatch: object = None
     engine_state: tuple = None
     flights: list = field(default_factory=list)
+    yaw: float = 0.0             #: rad: a rolling stretch's heading in the slope frame
+    shift: tuple = (0.0, 0.0)    #: m: and its ground shift there
 
 
 @dataclass
@@ -112,7 +115,9 @@ class HybridSamples:
     and |tangential| / normal, NaN in the air); energy (n,) J; touching (n, 2) bool;
     velocity_g (n, 3) m/s and angular_velocity (n, 3) rad/s (world) of the engine's samples
     (NaN in rolling ones); dissipated (n,) J: the work done against the damping since the
-    rolling stretch's start (0 without damping; NaN in engine samples).
+    rolling stretch's start (0 without damping; NaN in engine samples); drive_work (n,) J: the
+    drive's work since the stretch's start (rolling: the scene's W_d; engine: the torque
+    drive's, :mod:`~twodisk_ros.run.hybrid_drive`; 0 without).
     """
 
     t: np.ndarray
@@ -134,6 +139,7 @@ class HybridSamples:
     velocity_g: np.ndarray
     angular_velocity: np.ndarray
     dissipated: np.ndarray
+    drive_work: np.ndarray
 
 
 def _tilt(slope):
@@ -188,10 +194,18 @@ class HybridMotion:
         later one restarts it (:mod:`~twodisk_ros.run.hybrid_rolling`).
     damping : float
         c (N m s): the engine's viscous torque −c ω (that of ``rolling``'s scene).
+    shift : (float, float)
+        m: the first rolling stretch's ground shift (a continued motion's, in the slope frame).
+    engine_start : (qpos, qvel), optional
+        Start in the engine from this state (slope frame) at t = 0 (a motion continued from
+        an engine sample); ``rolling`` then only gives the kind of rolling to return to.
+    reason : str, optional
+        The first stretch's reason (default: exact rolling from t = 0 s).
     """
 
     def __init__(self, dynamics, model, stream, mu, *, method='table', tolerance=1e-10,
-                 parameters=None, rule=None, engine=None, rolling=None, damping=0.0):
+                 parameters=None, rule=None, engine=None, rolling=None, damping=0.0,
+                 shift=(0.0, 0.0), engine_start=None, reason='exact rolling from t = 0 s'):
         self.dynamics, self.model, self.mu = dynamics, model, float(mu)
         self.method, self.tolerance = method, tolerance
         p = parameters or ContactParameters()
@@ -202,14 +216,25 @@ class HybridMotion:
         self.damping, self.slope = float(damping), float(source.slope)
         self._cos, self._sin = math.cos(self.slope), math.sin(self.slope)
         self._tilt = _tilt(self.slope) if self.slope else None
-        self.stretches = [Stretch('rolling', 0.0, math.inf, 'exact rolling from t = 0 s',
-                                  energy=source.initial_energy)]
         self._first = source          # each return restarts its kind of rolling
-        self._rolling = _Rolling(source, 0.0)
+        self._rolling = _Rolling(source, 0.0, shift, self.weight)
+        energy = source.initial_energy + self._rolling.offset
+        self.stretches = [Stretch('rolling', 0.0, math.inf, reason, energy=energy,
+                                  yaw=source.yaw, shift=tuple(shift))]
         self._engine = engine         # built at the first switch if None
         self._held_since = None       # engine: the return rule holds since (s)
         self._phase = float(source.state_at([0.0])[0][0])
         self._rims = self._normals = None
+        if engine_start is not None:
+            self.prepare()
+            self._start_engine(*engine_start, 0.0)
+            self.stretches[0].model, self.stretches[0].energy = 'engine', float(
+                self._engine_sample()['energy'])
+
+    @property
+    def engine(self):
+        """The :class:`~twodisk_ros.engine.run.Engine` (after :meth:`prepare`; to share)."""
+        return self._engine
 
     def set_friction(self, mu):
         """Take the friction coefficient μ (in (0, 10]) from now on: the rolling model is
@@ -228,9 +253,20 @@ class HybridMotion:
                                   self.dynamics.gravity, self.parameters, slope=self.slope,
                                   damping=self.damping)
         if self._normals is None:
-            cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
-            self._normals = self.dynamics.body.phase_geometry(cycle).ground_normal
+            self._cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
+            self._normals = self.dynamics.body.phase_geometry(self._cycle).ground_normal
         return self
+
+    def _start_engine(self, qpos, qvel, t):
+        """The engine from (qpos, qvel) (slope frame) at t (s), with this run's μ and, for a
+        torque drive, its moment (:mod:`~twodisk_ros.run.hybrid_drive`)."""
+        e = self._engine
+        e.model.geom_friction[:, 0] = self.mu     # (a shared engine: this run's)
+        kind, torque = self._first.drive
+        e.set_moment(DriveMoment(self.dynamics.body, self._cycle, self._normals, torque)
+                     if kind == 'torque' and torque else None)
+        e.set_state(qpos, qvel, t)
+        self._held_since, self._rolling = None, None
 
     # -- rolling --------------------------------------------------------------------------
     def _bad(self, forces):
@@ -259,7 +295,7 @@ class HybridMotion:
         r = self._rolling
         count = max(2, int(math.ceil((ts[-1] - r.checked) / SCAN_STEP)) + 1)
         grid = np.union1d(np.linspace(r.checked, ts[-1], count), ts)
-        u, u_dot, w, w_dot, work = r.source.states(grid - r.t0)
+        u, u_dot, w, w_dot, work, drive = r.source.states(grid - r.t0)
         bad = self._bad(r.source.forces(u, u_dot, w, w_dot))
         found, side = None, 'right'
         if bad.any():
@@ -276,10 +312,10 @@ class HybridMotion:
         end = len(ts) if found is None else int(np.searchsorted(ts, found[0], side))
         at = np.searchsorted(grid, ts[:end])
         return (self._rolling_samples(u[at], u_dot[at], w[at],
-                                      None if w_dot is None else w_dot[at], work[at])
+                                      None if w_dot is None else w_dot[at], work[at], drive[at])
                 if end else None), found
 
-    def _rolling_samples(self, u, u_dot, w, w_dot, work):
+    def _rolling_samples(self, u, u_dot, w, w_dot, work, drive_work):
         r = self._rolling
         g, a, b, q = r.source.poses(u)
         f = r.source.forces(u, u_dot, w, w_dot)
@@ -293,16 +329,16 @@ class HybridMotion:
                     normal_b=f.normal_b, mu_required=f.mu_required, energy=r.energy(u, w),
                     touching=np.ones((len(u), 2), dtype=bool),
                     velocity_g=np.full((len(u), 3), np.nan),
-                    angular_velocity=np.full((len(u), 3), np.nan), dissipated=work)
+                    angular_velocity=np.full((len(u), 3), np.nan), dissipated=work,
+                    drive_work=drive_work)
 
     def _to_engine(self, t_switch, report):
         r = self._rolling
         u, _, w = (float(x[0]) for x in r.source.state_at([t_switch - r.t0])[:3])
         state = engine_state(self.dynamics, u, w, r.yaw, r.shift[:2])
         self.prepare()
-        self._engine.model.geom_friction[:, 0] = self.mu     # (a shared engine: this run's)
-        self._engine.set_state(state.qpos, state.qvel, t_switch)
-        self._phase, self._held_since, self._rolling = u, None, None
+        self._start_engine(state.qpos, state.qvel, t_switch)
+        self._phase = u
         self.stretches[-1].t_end = t_switch
         what = {'lift-off A': 'lift-off of A: N_A reaches 0 N',
                 'lift-off B': 'lift-off of B: N_B reaches 0 N'}.get(
@@ -346,7 +382,7 @@ class HybridMotion:
                                slope=self.slope)
         source = self._first.restart(near.phase, near.angular_speed, near.yaw, self.method,
                                      self.tolerance)
-        _, u_dot, _, w_dot, _ = source.state_at([0.0])
+        _, u_dot, _, w_dot = source.state_at([0.0])[:4]
         if self._bad(source.forces(np.array([near.phase]), u_dot,
                                    np.array([near.angular_speed]), w_dot))[0]:
             self._held_since = None       # rolling would not hold there: hold again
@@ -363,6 +399,7 @@ class HybridMotion:
             f'height {near.height_mismatch:.3g} m, velocity {near.velocity_mismatch:.3g} m/s, '
             f'energy added {near.energy_mismatch:.3g} J)', mismatch=near,
             energy=float(self._rolling.energy(near.phase, near.angular_speed)),
+            yaw=near.yaw, shift=(float(near.shift[0]), float(near.shift[1])),
             engine_state=(qpos, qvel)))
         return True
 
@@ -427,7 +464,8 @@ class HybridMotion:
                     force_b=force[1], normal_a=normal[0], normal_b=normal[1],
                     mu_required=float(np.nanmax(ratio)) if np.any(np.isfinite(ratio))
                     else math.nan, energy=energy, touching=c.touching, velocity_g=v.copy(),
-                    angular_velocity=omega, dissipated=math.nan)
+                    angular_velocity=omega, dissipated=math.nan,
+                    drive_work=e.moment_work)
 
     # -- sampling -------------------------------------------------------------------------
     def sample(self, t):
