@@ -69,8 +69,18 @@ def slope():
             dynamics, terms, stream, start.phase, start.angular_speed))
 
     slips = slipping()
-    t_slip = np.concatenate([np.arange(0.0, 1.2, 0.2), np.arange(1.2, 1.47, 2e-3)])
-    return dict(settings=settings, t=t, hybrid=hybrid.sample(t), simulation=hybrid,
+    t_slip = np.concatenate([np.arange(0.0, 1.2, 0.2), np.arange(1.2, 1.47, 4e-3)])
+    first = hybrid.sample(t)
+    stretches = len(hybrid.hybrid.stretches)
+    # run-time friction change (the node's update): μ 5 → 0.5 at 1.5 s; rolling needed up to
+    # 0.63 before (at 1.38 s): the switch must be the first crossing of 0.5 after the change
+    lower = settings.with_values(friction=0.5)
+    hybrid.update(lower)
+    t_after = np.arange(1.5, 1.6, 0.01)      # (the switch is at 1.548 s)
+    after = hybrid.sample(t_after)
+    return dict(settings=settings, t=t, hybrid=first, simulation=hybrid, lower=lower,
+                stretches=stretches,
+                t_after=t_after, after=after,
                 rolling=rolling.sample(t, forces=True), dynamics=dynamics, model=model,
                 engine=engine, terms=terms, slips=slips, slipping=slipping, t_slip=t_slip,
                 s_slip=slips.sample(t_slip))
@@ -82,7 +92,7 @@ def test_rolling_that_holds_on_a_slope_is_the_rolling_runs_bit_for_bit(slope):
     forces (the hybrid's from (u, w, ẇ), the rolling run's from (u, u̇, ü): two forms of the
     same tables) agree to 1e-12 M g (rounding of terms of size M g and m u̇²)."""
     h, r = slope['hybrid'], slope['rolling']
-    assert not h.hybrid.engine.any() and len(slope['simulation'].hybrid.stretches) == 1
+    assert not h.hybrid.engine.any() and slope['stretches'] == 1
     for name in ('phase', 'phase_rate', 'position_g', 'contact_a', 'contact_b', 'quaternion'):
         assert np.array_equal(getattr(h, name), getattr(r, name)), name
     weight = slope['simulation'].weight
@@ -249,3 +259,68 @@ def test_the_inspectors_engine_check_reads_forces_and_points_in_the_slope_frame(
     assert not check([5 * normal, 5 * normal], on_ground, slope=0.0)     # read level: fails
     assert not check([5 * normal, 5 * normal + 1.1 * downhill], on_ground)   # 0.22 > 0.2
     assert not check([5 * normal, 5 * normal], [0.1 * downhill, -3e-3 * normal])
+
+
+def test_a_friction_change_at_run_time_switches_at_the_new_mu(slope):
+    """μ 5 → 0.5 at 1.5 s (HybridSimulation.update, the node's path for a friction change):
+    the engine takes over at the first time after the change where the slope scene's forces
+    (a fresh closed-form stream, forces from (u, u̇, ü): SceneMotion's path) need more than
+    0.5: valid on a 1 ms grid from 1.5 s to 1e-9 s before the switch, not 1e-9 s after it
+    (the bisection's 1e-12 s); the engine's contacts have μ = 0.5; a later change reaches
+    the engine inside its stretch."""
+    from twodisk_ros.physics.forces.validity import check_validity
+    simulation, lower = slope['simulation'], slope['lower']
+    stretches = simulation.hybrid.stretches
+    assert [x.model for x in stretches[:2]] == ['rolling', 'engine'], stretches
+    switch = stretches[1].t_start
+    assert 1.5 < switch < 1.6
+    start = simulation.initial_state()
+    terms = simulation.scene.terms
+    stream = scene_stream(slope['dynamics'], terms.scene, start.phase, None, terms=terms,
+                          angular_speed=start.angular_speed)
+    t = np.concatenate([[0.0], np.arange(1.5, switch - 1e-9, 1e-3),
+                        [switch - 1e-9, switch + 1e-9]])
+    fresh = stream.samples(t)
+    forces = terms.forces(fresh.phase[1:], fresh.phase_rate[1:], fresh.phase_acceleration[1:])
+    report = check_validity(t[1:], forces, lower.friction)
+    assert not report.valid and report.index == len(t) - 2, report
+    engine = simulation.hybrid.engine
+    assert np.all(engine.model.geom_friction[:, 0] == 0.5)
+    simulation.update(lower.with_values(friction=0.3))
+    assert np.all(engine.model.geom_friction[:, 0] == 0.3)
+
+
+def test_a_reset_starts_the_hybrid_again_with_the_runs_engine(slope):
+    """The node's reset (Simulation.restarted) after an engine stretch: one rolling stretch
+    from t = 0 again, the same engine object (no second 0.5 s build); sampled at the first
+    run's times, its samples before its own first switch (μ is 0.3 now) are the first run's
+    bit for bit, and the engine takes over from the rolling pose there (G within the
+    distance G moves in one sample)."""
+    simulation = slope['simulation']
+    reset = simulation.restarted()
+    assert reset.hybrid.engine is simulation.hybrid.engine
+    assert [x.model for x in reset.hybrid.stretches] == ['rolling']
+    blocks = []               # (in blocks of 10, as the node samples, up to its switch)
+    for k in range(0, len(slope['t']), 10):
+        blocks.append(reset.sample(slope['t'][k:k + 10]))
+        if blocks[-1].hybrid.engine.any():
+            break
+    again = _joined(blocks)
+    switch = reset.hybrid.stretches[1].t_start
+    before = again.t <= switch
+    assert before.sum() >= 50 and again.hybrid.engine[~before].any()
+    for name in ('phase', 'position_g', 'quaternion'):
+        assert np.array_equal(getattr(again, name)[before],
+                              getattr(slope['hybrid'], name)[:len(again.t)][before]), name
+    k = int(np.argmax(~before))
+    step = np.linalg.norm(again.position_g[k - 1] - again.position_g[k - 2])
+    assert np.linalg.norm(again.position_g[k] - again.position_g[k - 1]) < 2 * step
+
+
+def _joined(blocks):
+    """The samples of consecutive blocks as one (t, phase, position_g, quaternion, engine)."""
+    from types import SimpleNamespace
+    cat = {name: np.concatenate([getattr(b, name) for b in blocks])
+           for name in ('t', 'phase', 'position_g', 'quaternion')}
+    return SimpleNamespace(**cat, hybrid=SimpleNamespace(
+        engine=np.concatenate([b.hybrid.engine for b in blocks])))
