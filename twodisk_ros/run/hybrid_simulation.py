@@ -24,7 +24,11 @@ from ..physics.motion.dynamics import PhaseState
 from ..physics.scenes.scene import quaternion_product
 from .simulation import Sample, Simulation, continuous_quaternions
 
-__all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'simulation_of']
+__all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'SCENE_FIXED', 'simulation_of']
+
+#: the refusal of a runtime scene change (one line)
+SCENE_FIXED = ('contact_model hybrid takes no scene changes at run time (set slope, damping '
+               'and drive at the start; commands, friction, reset and pause work)')
 
 #: m: an engine stretch's energy may exceed its start by M g × this (G sinks 1.4e-5 m into
 #: the ground with the engine's defaults, engine/model.py)
@@ -188,8 +192,7 @@ class HybridSimulation(Simulation):
     def check_scene_change(self, settings):
         """A hybrid run's scene is fixed at its start: a runtime change of it is refused."""
         if settings.scene_differs(self.settings):
-            raise ValueError('contact_model hybrid takes no scene changes at run time (set '
-                             'damping at the start)')
+            raise ValueError(SCENE_FIXED)
 
     def restarted(self):
         """The motion from the start again (a reset), with this run's engine."""
@@ -201,8 +204,7 @@ class HybridSimulation(Simulation):
         the new drive from its state, at its stretch's heading and shift; from an engine
         sample the engine from the sample's state (pose, v_G, ω), with the new drive."""
         if settings.physics_differs(self.settings) or settings.scene_differs(self.settings):
-            raise ValueError('contact_model hybrid takes no scene changes at run time (set '
-                             'slope, damping and drive at the start)')
+            raise ValueError(SCENE_FIXED)
         h, t = sample.hybrid, float(sample.t[i])
         start = PhaseState(float(sample.phase[i]), float(sample.phase_rate[i]),
                            self.angular_speed(sample, i))
