@@ -83,3 +83,29 @@ def test_hybrid_takes_damping_and_slope_and_still_refuses_rolling_resistance():
     with pytest.raises(ValueError, match='rolling_resistance 0') as error:
         DEFAULTS.with_values(contact_model='hybrid', rolling_resistance=0.01).checked()
     assert '\n' not in str(error.value)
+
+
+def test_a_damped_hybrid_at_a_heading_is_placed_as_the_rolling_run():
+    """Level ground with damping at heading0 = 1 rad: while rolling holds the hybrid publishes
+    the rolling run's poses (the scene's, turned by φ0 = heading0) bit for bit and forces that
+    go with them (to 1e-12 M g: from (u, w, ẇ) instead of (u, u̇, ü)). Before, the hybrid
+    placed the cycle unturned (G 1 rad about the vertical away from the rolling run's) while
+    its forces were turned."""
+    from twodisk_ros.run.simulation import Simulation
+    settings = DEFAULTS.with_values(**{**OLOID, 'damping': C, 'heading0': 1.0}).checked()
+    rolling = Simulation(settings)
+    t = np.arange(0.0, 0.5, 0.01)
+    expected = rolling.sample(t, forces=True)
+    start = rolling.initial_state()
+    hybrid = Simulation(settings)            # its own stream (the hybrid's first stretch)
+    motion = HybridMotion(hybrid.dynamics, hybrid.forces, None, settings.friction,
+                          rolling=SceneRolling(hybrid.dynamics, hybrid.scene.terms,
+                                               hybrid.stream, start.phase,
+                                               start.angular_speed))
+    s = motion.sample(t)
+    assert not s.engine.any()
+    for name in ('phase', 'position_g', 'contact_a', 'contact_b'):
+        assert np.array_equal(getattr(s, name), getattr(expected, name)), name
+    assert np.array_equal(s.quaternion, expected.quaternion)
+    weight = hybrid.weight
+    assert np.max(np.abs(s.force_a - expected.forces.force_a)) <= 1e-12 * weight
