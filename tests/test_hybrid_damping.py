@@ -14,7 +14,7 @@ from twodisk_ros.engine.model import ContactParameters
 from twodisk_ros.engine.run import Engine
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import check_validity
-from twodisk_ros.physics.scenes.motion import SceneStream
+from twodisk_ros.physics.scenes.motion import SceneStream, scene_stream
 from twodisk_ros.physics.scenes.terms import SceneTerms
 from twodisk_ros.plotting.hybrid_results import OLOID, description
 from twodisk_ros.run.hybrid import HybridMotion
@@ -96,16 +96,16 @@ def test_a_damped_hybrid_at_a_heading_is_placed_as_the_rolling_run():
     rolling = Simulation(settings)
     t = np.arange(0.0, 0.5, 0.01)
     expected = rolling.sample(t, forces=True)
-    start = rolling.initial_state()
-    hybrid = Simulation(settings)            # its own stream (the hybrid's first stretch)
-    motion = HybridMotion(hybrid.dynamics, hybrid.forces, None, settings.friction,
-                          rolling=SceneRolling(hybrid.dynamics, hybrid.scene.terms,
-                                               hybrid.stream, start.phase,
+    start, terms, dynamics = rolling.initial_state(), rolling.scene.terms, rolling.dynamics
+    stream = scene_stream(dynamics, terms.scene, start.phase, None, tolerance=settings.tolerance,
+                          terms=terms, angular_speed=start.angular_speed)   # SceneMotion's
+    motion = HybridMotion(dynamics, rolling.forces, None, settings.friction,
+                          rolling=SceneRolling(dynamics, terms, stream, start.phase,
                                                start.angular_speed))
     s = motion.sample(t)
     assert not s.engine.any()
     for name in ('phase', 'position_g', 'contact_a', 'contact_b'):
         assert np.array_equal(getattr(s, name), getattr(expected, name)), name
     assert np.array_equal(s.quaternion, expected.quaternion)
-    weight = hybrid.weight
+    weight = rolling.weight
     assert np.max(np.abs(s.force_a - expected.forces.force_a)) <= 1e-12 * weight

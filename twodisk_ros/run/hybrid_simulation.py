@@ -10,9 +10,9 @@ and why (:meth:`HybridSimulation.contact_status`), the node publishes each switc
 ``events`` (:meth:`HybridSimulation.switches`).
 
 The invariant: in a rolling stretch the energy E + W − W_d against the stretch's start
-(exact rolling keeps it); in an engine stretch only an increase of E − W_d counts, beyond :data:`ENGINE_SINK`
-× M g (the soft contact's sinking, whose spring energy E does not hold): the engine loses
-energy where the plates' polygons roll over a vertex (docs/physics.md).
+(exact rolling keeps it); in an engine stretch only an increase of E − W_d counts, beyond
+:data:`ENGINE_SINK` × M g (the soft contact's sinking, whose spring energy E does not hold):
+the engine loses energy where the plates' polygons roll over a vertex (docs/physics.md).
 """
 
 from dataclasses import dataclass
