@@ -14,11 +14,11 @@ from twodisk_ros.engine.model import ContactParameters
 from twodisk_ros.engine.run import Engine
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.forces.validity import check_validity
-from twodisk_ros.physics.scenes.motion import SceneStream
+from twodisk_ros.physics.scenes.motion import SceneStream, scene_stream
 from twodisk_ros.physics.scenes.terms import SceneTerms
 from twodisk_ros.plotting.hybrid_results import OLOID, description
 from twodisk_ros.run.hybrid import HybridMotion
-from twodisk_ros.run.hybrid_rolling import DampedRolling
+from twodisk_ros.run.hybrid_rolling import SceneRolling
 from twodisk_ros.run.parameters import DEFAULTS
 from twodisk_ros.run.scene_simulation import scene_of
 
@@ -40,7 +40,7 @@ def damped():
     engine = Engine(dynamics.body, dynamics.mass, dynamics.gravity,
                     ContactParameters(mu=MU, resolution=64), damping=C)
     motion = HybridMotion(dynamics, model, None, MU, engine=engine, damping=C,
-                          rolling=DampedRolling(dynamics, terms, stream(), start.phase, W0))
+                          rolling=SceneRolling(dynamics, terms, stream(), start.phase, W0))
     t = np.arange(0.0, 0.07, 1e-3)
     return dict(terms=terms, stream=stream, motion=motion, t=t, samples=motion.sample(t),
                 dynamics=dynamics)
@@ -77,11 +77,35 @@ def test_the_switch_is_where_the_damped_forces_leave_the_rolling_model(damped):
     assert not report.valid and report.index == 1 and report.kind == 'slip', report
 
 
-def test_hybrid_takes_damping_and_still_refuses_slope_and_rolling_resistance():
-    hybrid = DEFAULTS.with_values(contact_model='hybrid', damping=C).checked()
-    assert hybrid.damping == C
-    for changes, words in ((dict(slope=0.1), 'slope 0'),
-                           (dict(rolling_resistance=0.01), 'rolling_resistance 0')):
-        with pytest.raises(ValueError, match=words) as error:
-            DEFAULTS.with_values(contact_model='hybrid', **changes).checked()
-        assert '\n' not in str(error.value)
+def test_hybrid_takes_damping_and_slope_and_still_refuses_rolling_resistance():
+    hybrid = DEFAULTS.with_values(contact_model='hybrid', damping=C, slope=0.1).checked()
+    assert (hybrid.damping, hybrid.slope) == (C, 0.1)
+    with pytest.raises(ValueError, match='rolling_resistance 0') as error:
+        DEFAULTS.with_values(contact_model='hybrid', rolling_resistance=0.01).checked()
+    assert '\n' not in str(error.value)
+
+
+def test_a_damped_hybrid_at_a_heading_is_placed_as_the_rolling_run():
+    """Level ground with damping at heading0 = 1 rad: while rolling holds the hybrid publishes
+    the rolling run's poses (the scene's, turned by φ0 = heading0) bit for bit and forces that
+    go with them (to 1e-12 M g: from (u, w, ẇ) instead of (u, u̇, ü)). Before, the hybrid
+    placed the cycle unturned (G 1 rad about the vertical away from the rolling run's) while
+    its forces were turned."""
+    from twodisk_ros.run.simulation import Simulation
+    settings = DEFAULTS.with_values(**{**OLOID, 'damping': C, 'heading0': 1.0}).checked()
+    rolling = Simulation(settings)
+    t = np.arange(0.0, 0.5, 0.01)
+    expected = rolling.sample(t, forces=True)
+    start, terms, dynamics = rolling.initial_state(), rolling.scene.terms, rolling.dynamics
+    stream = scene_stream(dynamics, terms.scene, start.phase, None, tolerance=settings.tolerance,
+                          terms=terms, angular_speed=start.angular_speed)   # SceneMotion's
+    motion = HybridMotion(dynamics, rolling.forces, None, settings.friction,
+                          rolling=SceneRolling(dynamics, terms, stream, start.phase,
+                                               start.angular_speed))
+    s = motion.sample(t)
+    assert not s.engine.any()
+    for name in ('phase', 'position_g', 'contact_a', 'contact_b'):
+        assert np.array_equal(getattr(s, name), getattr(expected, name)), name
+    assert np.array_equal(s.quaternion, expected.quaternion)
+    weight = rolling.weight
+    assert np.max(np.abs(s.force_a - expected.forces.force_a)) <= 1e-12 * weight

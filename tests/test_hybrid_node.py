@@ -118,7 +118,8 @@ def test_a_scene_change_at_run_time_is_refused_in_one_line(recording):
     refused = recording[3]
     assert not refused.successful
     assert refused.reason == ('contact_model hybrid takes no scene changes at run time (set '
-                              'damping at the start)')
+                              'slope, damping and drive at the start; commands, friction, '
+                              'reset and pause work)')
 
 
 def test_the_engine_check_fails_outside_the_cone_and_through_the_ground():

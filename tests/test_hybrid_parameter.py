@@ -32,8 +32,11 @@ def test_contact_model_default_and_recorded():
     settings, problems = parse_recorded({k: v for k, v in hybrid.as_strings().items()
                                          if k != 'contact_model'})   # an older recording
     assert problems == [] and settings.contact_model == 'rolling'
-    with pytest.raises(ValueError, match='drive none'):
-        hybrid.with_values(drive='speed').checked()
+    assert hybrid.with_values(drive='speed').checked().drive == 'speed'   # drives it takes
+    with pytest.raises(ValueError, match='rolling_resistance 0'):
+        hybrid.with_values(rolling_resistance=0.01).checked()
+    with pytest.raises(ValueError, match='mode dynamic'):
+        hybrid.with_values(mode='kinematic').checked()
 
 
 @pytest.mark.parametrize('friction', [0.0, float('inf'), 20.0])

@@ -60,6 +60,10 @@ class Engine:
     before every step from that step's ω (explicit: ω decays by the factor 1 − c h / I about a
     principal axis of moment I per step h; MuJoCo's integrator handles contacts and gravity
     as without it). c = 0 and β = 0 leave the engine as it was.
+
+    :meth:`set_moment` adds a moment M (world, N m) computed from the state before every step
+    (a drive's torque, run/hybrid.py); ``moment_work`` (J) accumulates its work M · ω h per
+    step (explicit, as the moment is applied).
     """
 
     def __init__(self, body, mass_properties, gravity=9.81, parameters=None, *, slope=0.0,
@@ -76,11 +80,26 @@ class Engine:
         self._ground = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, 'ground')
         self.damping = float(damping)
         self._body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, 'body')
+        self._moment = None
+        self.moment_work = 0.0       #: J: the work of the moment of :meth:`set_moment`
+
+    def set_moment(self, moment):
+        """Apply ``moment(qpos, rotation)`` → M (3,) (N m, world; rotation body → world) before
+        every step from now on (None: no moment); ``moment_work`` starts again at 0 J."""
+        self._moment, self.moment_work = moment, 0.0
+        self.data.xfrc_applied[self._body, 3:6] = 0.0
 
     def _step(self):
-        """One mj_step, with the damping torque −c ω (world frame) of the state before it."""
+        """One mj_step, with the damping torque −c ω (world frame) of the state before it and
+        the moment of :meth:`set_moment`."""
         d = self.data
-        if self.damping:
+        if self._moment is not None:
+            rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
+            omega = rotation @ d.qvel[3:6]
+            moment = np.asarray(self._moment(d.qpos, rotation), dtype=float)
+            self.moment_work += float(moment @ omega) * float(self.model.opt.timestep)
+            d.xfrc_applied[self._body, 3:6] = moment - self.damping * omega
+        elif self.damping:
             rotation = quaternion_matrix(d.qpos[3:7] / np.linalg.norm(d.qpos[3:7]))
             d.xfrc_applied[self._body, 3:6] = -self.damping * (rotation @ d.qvel[3:6])
         self._mujoco.mj_step(self.model, d)

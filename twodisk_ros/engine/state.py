@@ -17,9 +17,10 @@ n_e · dn/du = 0 near the closest of a grid, so the pose is matched to rounding 
 rolling pose); the heading is the rotation about Z that brings the rolling orientation
 closest to R (together they leave only the tilt angle between n(u) and n_e), the shift puts
 G over the engine's G; w keeps the engine's energy, ½ J(u) w² + M g z_G(u) = E (J the
-moment of inertia about the contact line), signed as ω · ω_u. What cannot be matched is
-reported: the tilt angle (rad), G's height offset z − z_G(u) (m), the energy added (J, > 0
-only when E < M g z_G(u), then w = 0) and the velocity the rolling state does not keep.
+moment of inertia about the contact line), signed as ω · ω_u (on a slope: in the slope
+frame, with g cos β, :func:`nearest_rolling`). What cannot be matched is reported: the tilt
+angle (rad), G's height offset z − z_G(u) (m), the energy added (J, > 0 only when
+E < M g z_G(u), then w = 0) and the velocity the rolling state does not keep.
 """
 
 from dataclasses import dataclass
@@ -143,7 +144,7 @@ def _closest_phase(body, normal, near):
     return brentq(lambda v: float(slope(v)), lo, hi, xtol=1e-15, rtol=8.9e-16)
 
 
-def nearest_rolling(dynamics, qpos, qvel, near_phase=0.0):
+def nearest_rolling(dynamics, qpos, qvel, near_phase=0.0, slope=0.0):
     """The rolling state closest to MuJoCo's (qpos, qvel), and its mismatch.
 
     Parameters
@@ -154,6 +155,12 @@ def nearest_rolling(dynamics, qpos, qvel, near_phase=0.0):
     near_phase : float
         The phase is sought in [near_phase − π, near_phase + π] (rad): pass the last rolling
         phase to keep u continuous.
+    slope : float
+        β (rad): (qpos, qvel) are in the slope frame (x downhill in the ground, z its normal;
+        gravity g (sin β, 0, −cos β)). The rolling state shares G's downhill coordinate x,
+        so the slope's potential M g (z cos β − x sin β) differs between them only by
+        M g cos β (z − z_G(u)): w keeps ½ J w² + M g cos β z_G(u) = ½ M v² + ½ ωᵀIω +
+        M g cos β z (0: the level ground's balance, bit for bit).
 
     Returns
     -------
@@ -178,6 +185,11 @@ def nearest_rolling(dynamics, qpos, qvel, near_phase=0.0):
     energy = (0.5 * mass.mass * (v @ v) + 0.5 * omega @ mass.inertia @ omega
               + mass.mass * dynamics.gravity * qpos[2])
     potential = float(dynamics.potential(np.array([u]))[0])
+    if slope:
+        cos = math.cos(slope)
+        energy = (0.5 * mass.mass * (v @ v) + 0.5 * omega @ mass.inertia @ omega
+                  + mass.mass * dynamics.gravity * cos * qpos[2])
+        potential *= cos
     inertia = float(dynamics.contact_line_inertia(np.array([u]))[0])
     omega_u = body.phase_angular_velocity(np.array([u]))[0]
     speed = math.sqrt(max(2.0 * (energy - potential) / inertia, 0.0))

@@ -7,7 +7,9 @@ leave them out (:func:`split_series`), and :func:`engine_check` checks what the 
 with unilateral contacts and Coulomb friction must satisfy, from the recorded wrenches and
 contact points:
 
-* unilateral: the ground only pushes, N = F·e_z ≥ 0 at each disk;
+* unilateral: the ground only pushes, N = F·n ≥ 0 at each disk (n the ground's normal: e_z,
+  on a slope β the recorded ``ground_normal`` (sin β, 0, cos β); the forces and points are
+  taken to the slope frame, R_y(β)ᵀ p, the tangential part is the rest);
 * Coulomb: |F_tangential| ≤ μ N (μ the recorded ``friction``), to 1e-6 of M g (MuJoCo's
   solver meets its elliptic cone to its tolerance; a disk's total of several contact forces
   inside the cone is inside it too);
@@ -99,11 +101,19 @@ def engine_check(engine, intervals, parameters, weight, size):
     if not intervals:
         return None
     mu = float(parameters.get('friction', 'inf'))
+    slope = float(parameters.get('slope', 0.0))
+    c, s = math.cos(slope), math.sin(slope)
+    to_slope = np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])    # R_y(β)ᵀ
+
+    def ground(values):
+        values = np.asarray(values, dtype=float)
+        return values @ to_slope.T if slope else values
+
     worst, where, count = 0.0, '', 0
     for disk in 'ab':
         wrench, point = engine.get('wrench_' + disk), engine.get('contact_' + disk)
         if wrench is not None and len(wrench):
-            force = np.asarray(wrench.values['force'])
+            force = ground(wrench.values['force'])
             normal = force[:, 2]
             tangential = np.linalg.norm(force[:, :2], axis=1)
             cone = tangential - (mu * np.maximum(normal, 0) if math.isfinite(mu) else np.inf)
@@ -115,7 +125,7 @@ def engine_check(engine, intervals, parameters, weight, size):
                 if excess[i] > worst:
                     worst, where = float(excess[i]), f'{name} at stamp {wrench.stamp_ns[i]}'
         if point is not None and len(point):
-            depth = -np.asarray(point.values['point'])[:, 2] / size - DEPTH_TOLERANCE
+            depth = -ground(point.values['point'])[:, 2] / size - DEPTH_TOLERANCE
             i = int(np.argmax(depth))
             if depth[i] > worst:
                 worst, where = float(depth[i]), f'contact {disk.upper()} below the ground ' \

@@ -256,7 +256,7 @@ class Roller(Node):
 
     def restart_motion(self):
         """The motion from the initial state of the current parameters, at the next tick."""
-        self._restart(type(self.simulation)(self.settings, self.simulation.run))
+        self._restart(self.simulation.restarted())
 
     def continue_motion(self, drive, command=None):
         """The motion continued from the last published sample under ``drive``/``command``

@@ -22,6 +22,13 @@ ContactParameters`):
   from it if rolling holds there (else the hold starts again). The mismatch of the map is
   the stretch's ``mismatch``.
 
+On a slope β (a :class:`~twodisk_ros.run.hybrid_rolling.SceneRolling` of a slope scene)
+the engine's world is the slope frame S (gravity g (sin β, 0, −cos β)); each rolling stretch
+is placed in S by its heading and shift, the return map keeps the slope's potential
+(``nearest_rolling(..., slope=β)``) and the next stretch is the scene at the new heading;
+everything is published in the gravity frame W = R_y(β) S, E with V = M g × G's height
+along gravity (docs/physics.md "The free-body engine").
+
 Engine samples are the engine's state at their own time (a last shorter step lands on it).
 They carry the engine's pose, its contact force per disk (0 for a disk in the air) and
 contact point (the force-weighted contact point; for a disk in the air its lowest rim
@@ -38,6 +45,8 @@ from ..engine.run import Engine
 from ..engine.state import engine_state, nearest_rolling, quaternion_matrix
 from ..model.frames import disk_rims
 from ..physics.forces.validity import check_validity
+from ..physics.scenes.scene import quaternion_product
+from .hybrid_drive import DriveMoment
 from .hybrid_rolling import FreeRolling
 
 __all__ = ['HybridMotion', 'HybridSamples', 'ReturnRule', 'SCAN_STEP', 'SWITCH_TOLERANCE',
@@ -91,6 +100,8 @@ class Stretch:
     mismatch: object = None
     engine_state: tuple = None
     flights: list = field(default_factory=list)
+    yaw: float = 0.0             #: rad: a rolling stretch's heading in the slope frame
+    shift: tuple = (0.0, 0.0)    #: m: and its ground shift there
 
 
 @dataclass
@@ -104,7 +115,9 @@ class HybridSamples:
     and |tangential| / normal, NaN in the air); energy (n,) J; touching (n, 2) bool;
     velocity_g (n, 3) m/s and angular_velocity (n, 3) rad/s (world) of the engine's samples
     (NaN in rolling ones); dissipated (n,) J: the work done against the damping since the
-    rolling stretch's start (0 without damping; NaN in engine samples).
+    rolling stretch's start (0 without damping; NaN in engine samples); drive_work (n,) J: the
+    drive's work since the stretch's start (rolling: the scene's W_d; engine: the torque
+    drive's, :mod:`~twodisk_ros.run.hybrid_drive`; 0 without).
     """
 
     t: np.ndarray
@@ -126,28 +139,33 @@ class HybridSamples:
     velocity_g: np.ndarray
     angular_velocity: np.ndarray
     dissipated: np.ndarray
+    drive_work: np.ndarray
 
 
-def _yaw_matrix(yaw):
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def _times_quaternion(yaw, q):
-    """q_z(yaw) ⊗ q for quaternions q (n, 4) x, y, z, w."""
-    c, s = math.cos(0.5 * yaw), math.sin(0.5 * yaw)
-    x, y, z, w = q.T
-    return np.stack([c * x - s * y, c * y + s * x, c * z + s * w, c * w - s * z], axis=1)
+def _tilt(slope):
+    """R_y(β): slope-frame vectors → the gravity frame (3 × 3; Scene.slope_to_gravity)."""
+    c, s = math.cos(slope), math.sin(slope)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 class _Rolling:
-    """A rolling stretch: its motion from t0 (:mod:`~twodisk_ros.run.hybrid_rolling`), placed
-    by yaw (rad) and shift (m, (2,))."""
+    """A rolling stretch: its motion from t0 (:mod:`~twodisk_ros.run.hybrid_rolling`, placed
+    at its heading ``source.yaw`` in the slope frame), shifted by ``shift`` (m, (2,), in the
+    ground); ``offset`` (J) = −M g sin β shift_x: the slope's potential of the shift, which
+    the source's V (origin at its own A(u = 0)) does not hold."""
 
-    def __init__(self, source, t0, yaw=0.0, shift=(0.0, 0.0)):
-        self.source, self.t0, self.yaw = source, float(t0), float(yaw)
+    def __init__(self, source, t0, shift=(0.0, 0.0), weight=0.0):
+        self.source, self.t0 = source, float(t0)
         self.shift = np.array([shift[0], shift[1], 0.0])
+        self.yaw = source.yaw
+        self.world_shift = self.shift if not source.slope else _tilt(source.slope) @ self.shift
+        self.offset = -weight * math.sin(source.slope) * self.shift[0]
         self.checked = float(t0)      # rolling holds up to here (s)
+
+    def energy(self, u, w):
+        """E (J) at the states, on the run's potential (origin: the first stretch's A)."""
+        energy = self.source.energy(u, w)
+        return energy + self.offset if self.offset else energy
 
 
 class HybridMotion:
@@ -176,10 +194,18 @@ class HybridMotion:
         later one restarts it (:mod:`~twodisk_ros.run.hybrid_rolling`).
     damping : float
         c (N m s): the engine's viscous torque −c ω (that of ``rolling``'s scene).
+    shift : (float, float)
+        m: the first rolling stretch's ground shift (a continued motion's, in the slope frame).
+    engine_start : (qpos, qvel), optional
+        Start in the engine from this state (slope frame) at t = 0 (a motion continued from
+        an engine sample); ``rolling`` then only gives the kind of rolling to return to.
+    reason : str, optional
+        The first stretch's reason (default: exact rolling from t = 0 s).
     """
 
     def __init__(self, dynamics, model, stream, mu, *, method='table', tolerance=1e-10,
-                 parameters=None, rule=None, engine=None, rolling=None, damping=0.0):
+                 parameters=None, rule=None, engine=None, rolling=None, damping=0.0,
+                 shift=(0.0, 0.0), engine_start=None, reason='exact rolling from t = 0 s'):
         self.dynamics, self.model, self.mu = dynamics, model, float(mu)
         self.method, self.tolerance = method, tolerance
         p = parameters or ContactParameters()
@@ -187,15 +213,28 @@ class HybridMotion:
         self.rule = rule or ReturnRule.for_body(dynamics.body.size, dynamics.gravity)
         self.weight = dynamics.mass.mass * dynamics.gravity
         source = rolling or FreeRolling(dynamics, model, stream)
-        self.damping = float(damping)
-        self.stretches = [Stretch('rolling', 0.0, math.inf, 'exact rolling from t = 0 s',
-                                  energy=source.initial_energy)]
+        self.damping, self.slope = float(damping), float(source.slope)
+        self._cos, self._sin = math.cos(self.slope), math.sin(self.slope)
+        self._tilt = _tilt(self.slope) if self.slope else None
         self._first = source          # each return restarts its kind of rolling
-        self._rolling = _Rolling(source, 0.0)
+        self._rolling = _Rolling(source, 0.0, shift, self.weight)
+        energy = source.initial_energy + self._rolling.offset
+        self.stretches = [Stretch('rolling', 0.0, math.inf, reason, energy=energy,
+                                  yaw=source.yaw, shift=tuple(shift))]
         self._engine = engine         # built at the first switch if None
         self._held_since = None       # engine: the return rule holds since (s)
         self._phase = float(source.state_at([0.0])[0][0])
         self._rims = self._normals = None
+        if engine_start is not None:
+            self.prepare()
+            self._start_engine(*engine_start, 0.0)
+            self.stretches[0].model, self.stretches[0].energy = 'engine', float(
+                self._engine_sample()['energy'])
+
+    @property
+    def engine(self):
+        """The :class:`~twodisk_ros.engine.run.Engine` (after :meth:`prepare`; to share)."""
+        return self._engine
 
     def set_friction(self, mu):
         """Take the friction coefficient μ (in (0, 10]) from now on: the rolling model is
@@ -211,11 +250,23 @@ class HybridMotion:
         realtime run does not pay it while publishing."""
         if self._engine is None:
             self._engine = Engine(self.dynamics.body, self.dynamics.mass,
-                                  self.dynamics.gravity, self.parameters, damping=self.damping)
+                                  self.dynamics.gravity, self.parameters, slope=self.slope,
+                                  damping=self.damping)
         if self._normals is None:
-            cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
-            self._normals = self.dynamics.body.phase_geometry(cycle).ground_normal
+            self._cycle = 2 * np.pi * np.arange(PHASE_GRID) / PHASE_GRID
+            self._normals = self.dynamics.body.phase_geometry(self._cycle).ground_normal
         return self
+
+    def _start_engine(self, qpos, qvel, t):
+        """The engine from (qpos, qvel) (slope frame) at t (s), with this run's μ and, for a
+        torque drive, its moment (:mod:`~twodisk_ros.run.hybrid_drive`)."""
+        e = self._engine
+        e.model.geom_friction[:, 0] = self.mu     # (a shared engine: this run's)
+        kind, torque = self._first.drive
+        e.set_moment(DriveMoment(self.dynamics.body, self._cycle, self._normals, torque)
+                     if kind == 'torque' and torque else None)
+        e.set_state(qpos, qvel, t)
+        self._held_since, self._rolling = None, None
 
     # -- rolling --------------------------------------------------------------------------
     def _bad(self, forces):
@@ -244,7 +295,7 @@ class HybridMotion:
         r = self._rolling
         count = max(2, int(math.ceil((ts[-1] - r.checked) / SCAN_STEP)) + 1)
         grid = np.union1d(np.linspace(r.checked, ts[-1], count), ts)
-        u, u_dot, w, w_dot, work = r.source.states(grid - r.t0)
+        u, u_dot, w, w_dot, work, drive = r.source.states(grid - r.t0)
         bad = self._bad(r.source.forces(u, u_dot, w, w_dot))
         found, side = None, 'right'
         if bad.any():
@@ -261,36 +312,33 @@ class HybridMotion:
         end = len(ts) if found is None else int(np.searchsorted(ts, found[0], side))
         at = np.searchsorted(grid, ts[:end])
         return (self._rolling_samples(u[at], u_dot[at], w[at],
-                                      None if w_dot is None else w_dot[at], work[at])
+                                      None if w_dot is None else w_dot[at], work[at], drive[at])
                 if end else None), found
 
-    def _rolling_samples(self, u, u_dot, w, w_dot, work):
+    def _rolling_samples(self, u, u_dot, w, w_dot, work, drive_work):
         r = self._rolling
-        poses = self.dynamics.cycle.poses(u)
-        rz = _yaw_matrix(r.yaw)
+        g, a, b, q = r.source.poses(u)
         f = r.source.forces(u, u_dot, w, w_dot)
+        force_a, force_b = r.source.world_forces(f)
         if len(u):
             self._phase = float(u[-1])
         return dict(engine=np.zeros(len(u), dtype=bool), phase=u, phase_rate=u_dot,
-                    angular_speed=w, position_g=poses.position_g @ rz.T + r.shift,
-                    contact_a=poses.contact_a @ rz.T + r.shift,
-                    contact_b=poses.contact_b @ rz.T + r.shift,
-                    quaternion=_times_quaternion(r.yaw, poses.quaternion),
-                    force_a=f.force_a @ rz.T, force_b=f.force_b @ rz.T, normal_a=f.normal_a,
-                    normal_b=f.normal_b, mu_required=f.mu_required,
-                    energy=r.source.energy(u, w),
+                    angular_speed=w, position_g=g + r.world_shift,
+                    contact_a=a + r.world_shift, contact_b=b + r.world_shift, quaternion=q,
+                    force_a=force_a, force_b=force_b, normal_a=f.normal_a,
+                    normal_b=f.normal_b, mu_required=f.mu_required, energy=r.energy(u, w),
                     touching=np.ones((len(u), 2), dtype=bool),
                     velocity_g=np.full((len(u), 3), np.nan),
-                    angular_velocity=np.full((len(u), 3), np.nan), dissipated=work)
+                    angular_velocity=np.full((len(u), 3), np.nan), dissipated=work,
+                    drive_work=drive_work)
 
     def _to_engine(self, t_switch, report):
         r = self._rolling
         u, _, w = (float(x[0]) for x in r.source.state_at([t_switch - r.t0])[:3])
         state = engine_state(self.dynamics, u, w, r.yaw, r.shift[:2])
         self.prepare()
-        self._engine.model.geom_friction[:, 0] = self.mu     # (a shared engine: this run's)
-        self._engine.set_state(state.qpos, state.qvel, t_switch)
-        self._phase, self._held_since, self._rolling = u, None, None
+        self._start_engine(state.qpos, state.qvel, t_switch)
+        self._phase = u
         self.stretches[-1].t_end = t_switch
         what = {'lift-off A': 'lift-off of A: N_A reaches 0 N',
                 'lift-off B': 'lift-off of B: N_B reaches 0 N'}.get(
@@ -298,7 +346,7 @@ class HybridMotion:
         what, why = what.split(': ')
         self.stretches.append(Stretch('engine', t_switch, math.inf,
                                       f'{what} at t = {t_switch:.9g} s ({why})',
-                                      energy=float(self.dynamics.energy_turning(u, w))))
+                                      energy=float(r.energy(u, w))))
 
     # -- engine ---------------------------------------------------------------------------
     def _advance(self, t):
@@ -330,15 +378,16 @@ class HybridMotion:
     def _try_return(self, now):
         e = self._engine
         qpos, qvel = e.data.qpos.copy(), e.data.qvel.copy()
-        near = nearest_rolling(self.dynamics, qpos, qvel, near_phase=self._phase)
-        source = self._first.restart(near.phase, near.angular_speed, self.method,
+        near = nearest_rolling(self.dynamics, qpos, qvel, near_phase=self._phase,
+                               slope=self.slope)
+        source = self._first.restart(near.phase, near.angular_speed, near.yaw, self.method,
                                      self.tolerance)
-        _, u_dot, _, w_dot, _ = source.state_at([0.0])
+        _, u_dot, _, w_dot = source.state_at([0.0])[:4]
         if self._bad(source.forces(np.array([near.phase]), u_dot,
                                    np.array([near.angular_speed]), w_dot))[0]:
             self._held_since = None       # rolling would not hold there: hold again
             return False
-        self._rolling = _Rolling(source, now, near.yaw, near.shift)
+        self._rolling = _Rolling(source, now, near.shift, self.weight)
         self._phase = near.phase
         stretch = self.stretches[-1]
         stretch.t_end = now
@@ -349,21 +398,23 @@ class HybridMotion:
             f'rolling again at t = {now:.9g} s (mismatch: tilt {near.angle_mismatch:.3g} rad, '
             f'height {near.height_mismatch:.3g} m, velocity {near.velocity_mismatch:.3g} m/s, '
             f'energy added {near.energy_mismatch:.3g} J)', mismatch=near,
-            energy=float(self.dynamics.energy_turning(near.phase, near.angular_speed)),
+            energy=float(self._rolling.energy(near.phase, near.angular_speed)),
+            yaw=near.yaw, shift=(float(near.shift[0]), float(near.shift[1])),
             engine_state=(qpos, qvel)))
         return True
 
     def _grid_rolling(self, normal, omega, energy):
         """(u, w) published for an engine sample: the phase of :data:`PHASE_GRID` per cycle
         within π of the last one whose rolling pose has the closest ground normal to
-        ``normal`` (body frame), and w from the energy E (J) as the return map does
-        (:func:`~twodisk_ros.engine.state.nearest_rolling` solves for u exactly: 30 ms)."""
+        ``normal`` (body frame), and w from E = ½ M v² + ½ ωᵀIω + M g cos β z (J) as the
+        return map does (:func:`~twodisk_ros.engine.state.nearest_rolling` solves for u
+        exactly: 30 ms)."""
         k0 = int(np.floor(self._phase / (2 * np.pi) * PHASE_GRID))
         ks = k0 + np.arange(-PHASE_GRID // 2, PHASE_GRID // 2 + 1)
         k = int(ks[np.argmax(self._normals[ks % PHASE_GRID] @ normal)])
         u = 2 * np.pi * k / PHASE_GRID
         d = self.dynamics
-        twice = 2.0 * (energy - float(d.potential(np.array([u]))[0]))
+        twice = 2.0 * (energy - self._cos * float(d.potential(np.array([u]))[0]))
         speed = math.sqrt(max(twice, 0.0) / float(d.contact_line_inertia(np.array([u]))[0]))
         omega_u = d.body.phase_angular_velocity(np.array([u]))[0]
         return u, math.copysign(speed, float(omega @ omega_u))
@@ -383,23 +434,38 @@ class HybridMotion:
         points = [c.point[k] if np.all(np.isfinite(c.point[k]))
                   else self._lowest_rim_point(rotation, qpos[:3], k) for k in range(2)]
         v, omega = qvel[:3], qvel[3:]
-        energy = (0.5 * mass.mass * (v @ v) + 0.5 * omega @ mass.inertia @ omega
-                  + mass.mass * self.dynamics.gravity * qpos[2])
+        kinetic = 0.5 * mass.mass * (v @ v) + 0.5 * omega @ mass.inertia @ omega
+        weight = mass.mass * self.dynamics.gravity
+        energy = kinetic + weight * qpos[2]
+        if self.slope:      # the slope frame's: V = M g (z cos β − x sin β)
+            energy = kinetic + weight * self._cos * qpos[2]
         phase, speed = self._grid_rolling(rotation[2], omega, energy)
+        if self.slope:
+            energy -= weight * self._sin * qpos[0]
         self._phase = phase
         normal = c.force[:, 2]
         with np.errstate(divide='ignore', invalid='ignore'):
             ratio = np.where(c.touching & (normal > 0),
                              np.linalg.norm(c.force[:, :2], axis=1) / normal, np.nan)
         u_dot = self.dynamics.initial_phase_rate(phase, speed)
+        g, force, omega = qpos[:3].copy(), c.force, rotation @ omega
+        quaternion = np.array([q[1], q[2], q[3], q[0]])
+        if self.slope:      # slope frame → gravity frame (the published world)
+            tilt = self._tilt
+            g, points, force, v, omega = (x @ tilt.T for x in (g, np.array(points), force, v,
+                                                               omega))
+            half = 0.5 * self.slope
+            quaternion = quaternion_product([0.0, math.sin(half), 0.0, math.cos(half)],
+                                            quaternion)
         return dict(engine=True, phase=phase, phase_rate=u_dot,
-                    angular_speed=speed, position_g=qpos[:3].copy(),
+                    angular_speed=speed, position_g=g,
                     contact_a=points[0], contact_b=points[1],
-                    quaternion=np.array([q[1], q[2], q[3], q[0]]), force_a=c.force[0],
-                    force_b=c.force[1], normal_a=normal[0], normal_b=normal[1],
+                    quaternion=quaternion, force_a=force[0],
+                    force_b=force[1], normal_a=normal[0], normal_b=normal[1],
                     mu_required=float(np.nanmax(ratio)) if np.any(np.isfinite(ratio))
                     else math.nan, energy=energy, touching=c.touching, velocity_g=v.copy(),
-                    angular_velocity=rotation @ omega, dissipated=math.nan)
+                    angular_velocity=omega, dissipated=math.nan,
+                    drive_work=e.moment_work)
 
     # -- sampling -------------------------------------------------------------------------
     def sample(self, t):

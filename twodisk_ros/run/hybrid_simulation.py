@@ -3,23 +3,32 @@
 :class:`HybridSimulation` is the :class:`~twodisk_ros.run.simulation.Simulation` of the flat
 free scene whose samples come from :class:`~twodisk_ros.run.hybrid.HybridMotion`: exact
 rolling while it holds, MuJoCo's free body from the instant it stops holding, rolling again
-once both contacts roll. Nothing is marked invalid: ``/diagnostics`` says which model runs
+once both contacts roll; on a slope, with damping, and with a drive whose commands continue
+the motion from the last sample, rolling or engine (:meth:`HybridSimulation.continued`).
+Nothing is marked invalid: ``/diagnostics`` says which model runs
 and why (:meth:`HybridSimulation.contact_status`), the node publishes each switch on
 ``events`` (:meth:`HybridSimulation.switches`).
 
-The invariant: in a rolling stretch the energy against the stretch's start (exact rolling
-conserves it); in an engine stretch only an increase counts, beyond :data:`ENGINE_SINK`
-× M g (the soft contact's sinking, whose spring energy E does not hold): the engine loses
-energy where the plates' polygons roll over a vertex (docs/physics.md).
+The invariant: in a rolling stretch the energy E + W − W_d against the stretch's start
+(exact rolling keeps it); in an engine stretch only an increase of E − W_d counts, beyond
+:data:`ENGINE_SINK` × M g (the soft contact's sinking, whose spring energy E does not hold):
+the engine loses energy where the plates' polygons roll over a vertex (docs/physics.md).
 """
 
 from dataclasses import dataclass
+import math
 
 import numpy as np
 
+from ..physics.motion.dynamics import PhaseState
+from ..physics.scenes.scene import quaternion_product
 from .simulation import Sample, Simulation, continuous_quaternions
 
-__all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'simulation_of']
+__all__ = ['ENGINE_SINK', 'HybridForces', 'HybridSimulation', 'SCENE_FIXED', 'simulation_of']
+
+#: the refusal of a runtime scene change (one line)
+SCENE_FIXED = ('contact_model hybrid takes no scene changes at run time (set slope, damping '
+               'and drive at the start; commands, friction, reset and pause work)')
 
 #: m: an engine stretch's energy may exceed its start by M g × this (G sinks 1.4e-5 m into
 #: the ground with the engine's defaults, engine/model.py)
@@ -48,21 +57,34 @@ def simulation_of(settings, run=None, **kwargs):
 
 
 class HybridSimulation(Simulation):
-    """:class:`~twodisk_ros.run.simulation.Simulation` under ``contact_model:=hybrid``."""
+    """:class:`~twodisk_ros.run.simulation.Simulation` under ``contact_model:=hybrid``.
 
-    def __init__(self, settings, run=None, **kwargs):
+    ``engine``: an Engine of the same body, mass, g, slope and damping to reuse (a reset's,
+    a command's); ``resume``: (yaw rad, shift m, engine state or None, reason) of a motion
+    continued from a sample (:meth:`continued`)."""
+
+    def __init__(self, settings, run=None, *, engine=None, resume=None, **kwargs):
         super().__init__(settings, run, **kwargs)
         from .hybrid import HybridMotion   # (MuJoCo and the meshes: only for hybrid runs)
-        from .hybrid_rolling import DampedRolling
+        from .hybrid_rolling import FreeRolling, SceneRolling, rolling_source
         s = self.settings
-        rolling = None
-        if self.scene is not None:        # damping (level ground, no drive: parameters.py)
-            start = self.initial_state()
-            rolling = DampedRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
-                                    start.angular_speed)
+        rolling, options = None, {}
+        self.invalid = None               # (a slope's standing report: the engine's to show)
+        start = self.initial_state()
+        if resume is not None:
+            yaw, shift, engine_start, reason = resume
+            rolling = rolling_source(self.dynamics, self.forces, self.scene.terms,
+                                     self.scene.scene, start.phase, start.angular_speed, yaw,
+                                     s.method, s.tolerance)
+            options = dict(shift=shift, engine_start=engine_start, reason=reason)
+        elif self.scene is not None and self.scene.scene.flat_free:   # a torque drive at 0
+            rolling = FreeRolling(self.dynamics, self.forces, self.stream)
+        elif self.scene is not None:        # slope, damping, drive (parameters.py)
+            rolling = SceneRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
+                                   start.angular_speed, self.forces)
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,
                                    method=s.method, tolerance=s.tolerance, rolling=rolling,
-                                   damping=s.damping).prepare()
+                                   damping=s.damping, engine=engine, **options).prepare()
         self.announced = 1          # stretches already published as events
 
     def sample(self, t, forces=False, time_offset=0.0):
@@ -156,10 +178,11 @@ class HybridSimulation(Simulation):
         energy = float(sample.hybrid.energy[i])
         stretch = self.stretch_at(float(sample.t[i]))
         scale = self.dynamics.energy_scale
+        drive = float(sample.hybrid.drive_work[i])
         if sample.hybrid.engine[i]:
-            rise = energy - stretch.energy - ENGINE_SINK * self.weight
+            rise = energy - drive - stretch.energy - ENGINE_SINK * self.weight
             return 'energy', energy, max(rise, 0.0) / scale
-        balance = energy + float(sample.hybrid.dissipated[i])
+        balance = energy + float(sample.hybrid.dissipated[i]) - drive
         return 'energy', energy, abs(balance - stretch.energy) / scale
 
     def energy(self, sample, i):
@@ -169,9 +192,44 @@ class HybridSimulation(Simulation):
     def check_scene_change(self, settings):
         """A hybrid run's scene is fixed at its start: a runtime change of it is refused."""
         if settings.scene_differs(self.settings):
-            raise ValueError('contact_model hybrid takes no scene changes at run time (set '
-                             'damping at the start)')
+            raise ValueError(SCENE_FIXED)
+
+    def restarted(self):
+        """The motion from the start again (a reset), with this run's engine."""
+        return HybridSimulation(self.settings, self.run, engine=self.hybrid.engine)
 
     def continued(self, settings, sample, i, *, drive=None, command=None):
-        """A hybrid run has no commands or scene changes (drive none): refused."""
-        raise ValueError('contact_model hybrid takes no commands or scene changes')
+        """The hybrid motion continued from sample i under ``drive``/``command`` (a command
+        or its time-out; the same scene otherwise): from a rolling sample exact rolling of
+        the new drive from its state, at its stretch's heading and shift; from an engine
+        sample the engine from the sample's state (pose, v_G, ω), with the new drive."""
+        if settings.physics_differs(self.settings) or settings.scene_differs(self.settings):
+            raise ValueError(SCENE_FIXED)
+        h, t = sample.hybrid, float(sample.t[i])
+        start = PhaseState(float(sample.phase[i]), float(sample.phase_rate[i]),
+                           self.angular_speed(sample, i))
+        if h.engine[i]:
+            resume = (self.scene.terms.phi0, (0.0, 0.0), self._engine_state(h, i),
+                      f'free body (MuJoCo) continued at t = {t:.9g} s of the last motion')
+        else:
+            stretch = self.stretch_at(t)
+            resume = (stretch.yaw, stretch.shift, None,
+                      f'exact rolling continued at t = {t:.9g} s of the last motion')
+        return HybridSimulation(settings, self.run if self.run.settings == settings else None,
+                                drive=drive, command=command, start=start,
+                                terms=self.scene.terms, orientation=sample.quaternion[i],
+                                engine=self.hybrid.engine, resume=resume)
+
+    def _engine_state(self, h, i):
+        """(qpos, qvel) in the slope frame of engine sample i of HybridSamples h (published
+        in the gravity frame: R_y(β)ᵀ, q_y(−β) ⊗ q; ω to the body frame)."""
+        half, c, s = 0.5 * self.settings.slope, math.cos(self.settings.slope), math.sin(
+            self.settings.slope)
+        back = np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+        x, y, z, w = quaternion_product([0.0, -math.sin(half), 0.0, math.cos(half)],
+                                        h.quaternion[i])
+        q = np.array([w, x, y, z]) / math.sqrt(w * w + x * x + y * y + z * z)
+        from ..engine.state import quaternion_matrix   # (scipy.spatial: hybrid runs only)
+        rotation_world = back.T @ quaternion_matrix(q)
+        return (np.concatenate([back @ h.position_g[i], q]),
+                np.concatenate([back @ h.velocity_g[i], rotation_world.T @ h.angular_velocity[i]]))

@@ -147,8 +147,9 @@ PARAMETERS = (
               'hybrid (exact rolling while it holds; from the instant a contact would lift off '
               'or slip, a free rigid body with unilateral contacts and Coulomb friction '
               'in MuJoCo, back to exact rolling once both contacts roll again); hybrid needs '
-              'mode dynamic, drive none, slope 0, no rolling resistance (damping acts on '
-              'both: -c omega on the engine\'s body) and 0 < friction <= 10',
+              'mode dynamic, no rolling resistance (slope, damping and the torque drive act '
+              'on both: gravity tilted, -c omega and the torque about AB on the engine\'s '
+              'body; the speed drive\'s motor is off in the engine) and 0 < friction <= 10',
               choices=CONTACT_MODELS, physics=True),
     Parameter('rate', float, 100.0, 'Hz', 'publishing rate', 1e-3, 1e5, read_only=True),
     Parameter('duration', float, 0.0, 's', 'simulated time, 0 = until stopped', 0.0, 1e7,
@@ -266,12 +267,11 @@ def _check_together(s, outline=None):
         raise ValueError(f'damping must be <= {DAMPING_RATE:g}/s x mass x max(a, b)^2 = '
                          f'{damping_limit:.6g} N m s for this body (a spin-down faster than '
                          f'~1 ms is not simulated), got {s.damping!r}')
-    if s.contact_model == 'hybrid' and (s.mode, s.drive, s.slope,
-                                        s.rolling_resistance) != ('dynamic', 'none', 0, 0):
-        raise ValueError('contact_model hybrid needs mode dynamic, drive none, slope 0 and '
-                         'rolling_resistance 0 (the free body has no motor, slope or rolling '
-                         f'resistance; damping it has), got mode {s.mode}, drive {s.drive}, '
-                         f'slope {s.slope!r}, rolling_resistance {s.rolling_resistance!r}')
+    if s.contact_model == 'hybrid' and (s.mode, s.rolling_resistance) != ('dynamic', 0):
+        raise ValueError('contact_model hybrid needs mode dynamic and rolling_resistance 0 '
+                         '(rolling resistance\'s dead band has no free-body counterpart; '
+                         'slope, damping and drives it has), got mode '
+                         f'{s.mode}, rolling_resistance {s.rolling_resistance!r}')
     if s.contact_model == 'hybrid' and not 0 < s.friction <= HYBRID_FRICTION_MAX:
         raise ValueError(f'friction must be in (0, {HYBRID_FRICTION_MAX:g}] for contact_model '
                          'hybrid (the engine\'s Coulomb friction; 0 and .inf are exact '

@@ -152,6 +152,10 @@ class Simulation:
             f'{eq.stability}' + (f', period={period:.9g} s' if period else '')))
             for k, (eq, period) in enumerate(self.equilibria)]
 
+    def restarted(self):
+        """The motion of these settings from their start again (a reset)."""
+        return type(self)(self.settings, self.run)
+
     def continued(self, settings, sample, i, *, drive=None, command=None):
         """A Simulation of ``settings`` (same motion parameters) continuing from sample i.
 

@@ -22,7 +22,8 @@ All periodic parts are tabulated once per cycle in one quintic Hermite table (sp
 derivatives), like the dynamics' tables; the non-periodic parts are the phase factors.
 """
 
-from dataclasses import dataclass
+from copy import copy
+from dataclasses import dataclass, replace
 import math
 
 import numpy as np
@@ -160,17 +161,8 @@ class SceneTerms:
         self._table = HermiteTable.periodic(columns, first, spectral_derivative(first))
         self.turn_scale = float(np.max(speed))      #: max |ω_u| over the cycle
         self._equilibria = None
-        # V = V_p(u) + drift u/2π: the periodic part tabulated once from G's composed
-        # positions, the drift of one cycle composed (exact for a turn of 2π per cycle)
-        v = self.weight * (self.cos_b * height - self.sin_b * self.downhill(u))
-        self.drift = float(self.weight * (self.cos_b * height[0] - self.sin_b * self.downhill(
-            TWO_PI)) - v[0])
-        jet = np.column_stack([m_u, v - self.drift * u / TWO_PI])
-        slope = spectral_derivative(jet)
-        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope), inertia_line,
-                               spectral_derivative(inertia_line), spectral_derivative(speed)])
-        first = spectral_derivative(jet)
-        self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
+        self._energy_columns = (u, m_u, height, speed, inertia_line)
+        self._build_energy(*self._energy_columns)
         # a cycle that turns by T ≠ 2π (an egg: the path curves) has no drift: G circles the
         # fixed point C = shift/(1 − e^{iT}) of the cycle's map, Z_G = C + e^{iλu} q(u) with q
         # periodic; V is then bounded, not periodic plus linear, and is evaluated from q
@@ -184,6 +176,37 @@ class SceneTerms:
             q = np.column_stack([q.real, q.imag])
             first = spectral_derivative(q)
             self._orbit = HermiteTable.periodic(q, first, spectral_derivative(first))
+
+    def _build_energy(self, u, m_u, height, speed, inertia_line):
+        """The narrow table of :meth:`energy_jet` at the nodes u: the only part of the tables
+        that depends on φ0 (through V's downhill coordinate)."""
+        # V = V_p(u) + drift u/2π: the periodic part tabulated once from G's composed
+        # positions, the drift of one cycle composed (exact for a turn of 2π per cycle)
+        v = self.weight * (self.cos_b * height - self.sin_b * self.downhill(u))
+        self.drift = float(self.weight * (self.cos_b * height[0] - self.sin_b * self.downhill(
+            TWO_PI)) - v[0])
+        jet = np.column_stack([m_u, v - self.drift * u / TWO_PI])
+        slope = spectral_derivative(jet)
+        jet = np.column_stack([jet, slope, speed, spectral_derivative(slope), inertia_line,
+                               spectral_derivative(inertia_line), spectral_derivative(speed)])
+        first = spectral_derivative(jet)
+        self._energy_table = HermiteTable.periodic(jet, first, spectral_derivative(first))
+
+    def turned(self, phi0):
+        """These terms with the cycle frame turned by φ0 (rad) about the normal in the slope
+        frame (a rolling stretch placed at another heading, run/hybrid.py): the wide table is
+        shared (its columns are in the cycle frame), V's table is rebuilt (ms, not the
+        build's 0.1 s); the scene's heading0 is the one giving φ0."""
+        return copy(self)._turn(float(phi0))
+
+    def _turn(self, phi0):
+        """Turn this copy (:meth:`turned`) to φ0 (rad); returns it."""
+        shift = complex(self.cycle.displacement.shift)
+        travel = math.atan2(shift.imag, shift.real) if shift != 0 else 0.0
+        self.scene = replace(self.scene, heading0=phi0 + travel)
+        self.phi0, self._equilibria = phi0, None
+        self._build_energy(*self._energy_columns)
+        return self
 
     # -- the table ----------------------------------------------------------------------------
     def rows(self, u):
