@@ -225,6 +225,12 @@ def test_combine_equals_call(nodes, columns, seed):
     assert_allclose(table.combine(index, weights), table(x), rtol=0, atol=COMBINE_RTOL * scale)
     # the power basis (RollingCycle's path): the same interpolant, from coefficients of t
     assert_allclose(table.expand(*table.powers(x)), table(x), rtol=0, atol=COMBINE_RTOL * scale)
+    # the same in reused work arrays (RollingCycle's blocks), a shorter block after a longer one
+    scratch = table.scratch(x.size)
+    assert_allclose(table.expand_into(x, scratch), table(x), rtol=0, atol=COMBINE_RTOL * scale)
+    assert_allclose(table.expand_into(x[::-3], scratch), table(x[::-3]), rtol=0,
+                    atol=COMBINE_RTOL * scale)
     # the nodes themselves are reproduced exactly
     assert_array_equal(table.combine(*table.weights(x[200:])), values)
     assert_array_equal(table.expand(*table.powers(x[200:-1])), values[:-1])
+    assert_array_equal(table.expand_into(x[200:-1], scratch), values[:-1])

@@ -221,10 +221,10 @@ class RollingCycle:
     """
 
     MAX_RESOLUTION = 2**17
-    #: Samples evaluated at once by positions and poses (the gathered node data, 96 B per
-    #: sample and column, stays in cache; 8192 measured fastest among 1024 … 16384 on the
-    #: 2-core benchmark machine).
-    BLOCK = 8192
+    #: Samples evaluated at once by positions and poses (the gathered coefficients, 576 B per
+    #: sample, stay in cache: 2.4 MB; 4096 measured fastest among 2048 … 8192 on the 2-core
+    #: benchmark machine once the work arrays are reused, 8192 before).
+    BLOCK = 4096
 
     def __init__(self, body, resolution=None, oversampling=4):
         self.body = check_rolling_body(body)
@@ -234,6 +234,8 @@ class RollingCycle:
             tail = self._tails(resolution)
         self.resolution = int(resolution)
         self.spectral_tail = tail
+        #: :meth:`_cycle_terms` of single cycles k ((k, sign of k) → its scalars), filled on use
+        self._one_cycle_terms = {}
         self._build(self.resolution * int(oversampling))
 
     @classmethod
@@ -332,8 +334,15 @@ class RollingCycle:
             empty = np.empty(cycles.shape, complex)
             return empty, empty, empty, cycles
         low, high = float(cycles.min()), float(cycles.max())
-        if low == high:              # one cycle (most blocks): scalars
-            return tuple(x[0] for x in self._cycle_terms_of(np.array([low])))
+        if low == high:              # one cycle (most blocks): scalars, kept per cycle
+            key = (low, math.copysign(1.0, low))     # −0.0 (u = −0.0) apart from 0.0
+            terms = self._one_cycle_terms.get(key)
+            if terms is None:
+                if len(self._one_cycle_terms) >= 4096:
+                    self._one_cycle_terms.clear()
+                terms = tuple(x[0] for x in self._cycle_terms_of(np.array([low])))
+                self._one_cycle_terms[key] = terms
+            return terms
         if high - low <= 4096:       # few distinct cycles: evaluate once each, then gather
             index = (cycles - low).astype(np.intp)
             return tuple(x[index] for x in self._cycle_terms_of(np.arange(low, high + 1.0)))
@@ -351,9 +360,12 @@ class RollingCycle:
         u = np.asarray(u, dtype=float)
         flat = u.reshape(-1)
         parts = [np.empty((flat.size,) + shape) for shape in trailing]
+        size = min(flat.size, self.BLOCK)
+        # work arrays shared by the blocks: the table's, then the cycles, rest and norms
+        work = (self._table.scratch(size),) + tuple(np.empty(size) for _ in range(3))
         for start in range(0, flat.size, self.BLOCK):
             part = slice(start, start + self.BLOCK)
-            evaluate(flat[part], [array[part] for array in parts])
+            evaluate(flat[part], [array[part] for array in parts], work)
         return tuple(x.reshape(u.shape + shape) for x, shape in zip(parts, trailing))
 
     def positions(self, u):
@@ -395,10 +407,15 @@ class RollingCycle:
         parts = self._blocks(u, self._poses, [(3,), (3,), (3,), (4,), ()])
         return RollingPoses(*parts)
 
-    def _evaluate(self, u):
-        """The table's rows at phases u and the cycles' terms of :meth:`_cycle_terms`."""
-        cycles, rest = self._split(u)
-        return (self._table.expand(*self._table.powers(rest)),) + self._cycle_terms(cycles)
+    def _evaluate(self, u, work):
+        """The table's rows at phases u (1-d) and the cycles' terms of :meth:`_cycle_terms`,
+        in the work arrays of :meth:`_blocks` (the operations of :meth:`_split`)."""
+        cycles, rest = work[1][:u.size], work[2][:u.size]
+        np.divide(u, TWO_PI, out=cycles)
+        np.floor(cycles, out=cycles)
+        np.multiply(cycles, TWO_PI, out=rest)
+        np.subtract(u, rest, out=rest)
+        return (self._table.expand_into(rest, work[0]),) + self._cycle_terms(cycles)
 
     @staticmethod
     def _world(f, spin, shift, g, a, b):
@@ -411,17 +428,19 @@ class RollingCycle:
             point[:, 2] = 0.0
         g[:, 2] = f[:, 6]
 
-    def _positions(self, u, out):
-        f, spin, shift, _, _ = self._evaluate(u)
+    def _positions(self, u, out, work):
+        f, spin, shift, _, _ = self._evaluate(u, work)
         self._world(f, spin, shift, *out)
 
-    def _poses(self, u, out):
-        f, spin, shift, half, turn = self._evaluate(u)
+    def _poses(self, u, out, work):
+        f, spin, shift, half, turn = self._evaluate(u, work)
         self._world(f, spin, shift, *out[:3])
         # q_z(kT) ⊗ q(u − 2πk) (±, the cycle sign): (x + iy) turns by e^{ikT/2}, (z + iw)
         # by e^{−ikT/2}; then renormalised
-        within, q = f[:, 7:11], out[3]
-        scale = 1.0 / np.sqrt(np.einsum('ij,ij->i', within, within))
+        within, q, scale = f[:, 7:11], out[3], work[3][:u.size]
+        np.einsum('ij,ij->i', within, within, out=scale)
+        np.sqrt(scale, out=scale)
+        np.divide(1.0, scale, out=scale)
         pairs, turned = within.view(np.complex128), q.view(np.complex128)
         np.multiply(pairs[:, 0], half, out=turned[:, 0])
         np.multiply(pairs[:, 1], np.conj(half), out=turned[:, 1])

@@ -197,6 +197,40 @@ class HermiteTable:
         out = np.matmul(powers.reshape(flat.size, 1, 6), data)
         return out.reshape(index.shape + self.values.shape[1:])
 
+    def scratch(self, size):
+        """Work arrays for :meth:`expand_into` on blocks of up to ``size`` points."""
+        return _Scratch(size, self._coefficients().shape[1])
+
+    def expand_into(self, x, scratch):
+        """``expand(*powers(x))`` for a 1-d block x of at most ``scratch.size`` points, computed
+        in the work arrays of :meth:`scratch` (no allocation, the temporaries stay in cache):
+        the same operations, so the same result bit for bit.
+
+        Returns
+        -------
+        ndarray, shape (x.size, columns)
+            A view into ``scratch``, valid until its next use.
+        """
+        m = x.size
+        s, floor, index = scratch.s[:m], scratch.floor[:m], scratch.index[:m]
+        p, rows, f = scratch.powers[:m], scratch.rows[:m], scratch.values[:m]
+        np.subtract(x, self.start, out=s)
+        np.divide(s, self.step, out=s)
+        np.floor(s, out=floor)
+        np.maximum(floor, 0.0, out=floor)
+        np.minimum(floor, self.last_index, out=floor)
+        np.copyto(index, floor, casting='unsafe')
+        t = p[:, 1]
+        np.subtract(s, floor, out=t)
+        np.multiply(t, t, out=p[:, 2])
+        np.multiply(p[:, 2], t, out=p[:, 3])
+        np.multiply(p[:, 2], p[:, 2], out=p[:, 4])
+        np.multiply(p[:, 4], t, out=p[:, 5])
+        # indices are in range: mode='clip' spares take the copy of `out` that 'raise' makes
+        self._coefficients().take(index, axis=0, out=rows, mode='clip')
+        np.matmul(p[:, None, :], rows.reshape(m, 6, -1), out=f[:, None, :])
+        return f
+
     def _coefficients(self):
         if self._power_rows is None:
             c = power_coefficients(*(x[:-1] for x in (self.values, self.first, self.second)),
@@ -213,6 +247,21 @@ class HermiteTable:
         """
         closed = [np.concatenate([x, x[:1]]) for x in (values, first, second)]
         return cls(0.0, 2.0 * np.pi / len(values), *closed)
+
+
+class _Scratch:
+    """Work arrays of :meth:`HermiteTable.expand_into` for up to ``size`` points of a table of
+    ``width`` = 6 × columns coefficients per interval (~8 × (width + columns + 10) bytes per
+    point)."""
+
+    def __init__(self, size, width):
+        self.size = int(size)
+        self.s, self.floor = np.empty(self.size), np.empty(self.size)
+        self.index = np.empty(self.size, dtype=np.intp)
+        self.powers = np.empty((self.size, 6))
+        self.powers[:, 0] = 1.0
+        self.rows = np.empty((self.size, width))
+        self.values = np.empty((self.size, width // 6))
 
 
 def power_coefficients(y0, d0, s0, y1, d1, s1):
