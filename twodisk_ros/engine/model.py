@@ -210,8 +210,8 @@ def landing_depth_factor(damping_ratio):
     frequency ω0 = 1 / (τ ζ) and damping ratio ζ. From x(0) = 0, ẋ(0) = v its largest x is
     (v / ω0) exp(−ζ φ / s) with s = √|1 − ζ²| and φ = atan(s / ζ) (ζ < 1) or artanh(s / ζ)
     (ζ > 1); ζ = 1: v τ / e. Nearer the surface than ``width`` d < dmax softens the spring by
-    d / dmax: at most dmax / d0 more (:data:`IMPEDANCE`). Gravity's (1 − d) a0 adds the sag
-    of the resting body (1.4e-5 m at g, engine/model.py's defaults).
+    d / dmax: at most dmax / d0 more (:data:`IMPEDANCE`). Gravity's (1 − d) a0 adds what the
+    body sinks from rest (G 1.4e-5 m with the defaults, module docstring).
     """
     zeta = _number('damping_ratio', damping_ratio, 1e-3, 10.0, '(1 is critical)')
     if zeta == 1.0:

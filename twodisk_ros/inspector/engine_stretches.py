@@ -14,13 +14,23 @@ contact points:
   solver meets its elliptic cone to its tolerance; a disk's total of several contact forces
   inside the cone is inside it too);
 * no contact point deeper below the ground than its landing allows (:func:`depth_bounds`):
-  δ0 + c τ v_max, δ0 = 1e-2 of the body's size (the sink under a sustained load: 1.4e-5 m at
-  rest, 1.9e-4 m where the oloid spun on one rim after a 3 N m spin-up), τ the soft contact's
+  δ0 + c τ v_max, δ0 = 1e-2 of the body's size (the sink under a sustained load: G 1.4e-5 m at
+  rest; a recorded point 1.9e-4 m deep, half the 3.9e-4 m penetration, where the oloid rocked
+  on rim A alone after a 3 N m spin-up), τ the soft contact's
   time constant and c = f(ζ) dmax / (2 d0) (:func:`~twodisk_ros.engine.model.
   landing_depth_factor`: a landing at normal speed v sinks by v τ f(ζ); the recorded point is
   MuJoCo's contact point, midway between the surfaces, so half as deep), v_max the fastest
   any body point can move with the kinetic energy the recording holds in the 10 τ before
   the sample (:func:`approach_speed_bound`).
+
+  Why not the approach speed itself: the recording has no velocities, and its samples (100
+  Hz) do not resolve a landing that lasts a few τ: the contact point's height differences
+  gave 0.12 m/s before a touchdown at 3.5 m/s. The energy bound does hold, loosely (the spin
+  about the normal counts too): for the oloid after a 3 N m spin-up v_max was 2.5–4.6 × the
+  touchdown's normal speed at the landings deeper than 1 mm (8.7 against 3.5 m/s, 33
+  against 9.2), and a landing's deepest sample used 15–25 % of its c τ v_max. The drive's
+  work between the last sample and the touchdown is not counted (0.8 J of the 4.6 J at the
+  3.5 m/s landing under 3 N m: v_max 9 % short of the energy's, inside that margin).
 """
 
 from dataclasses import replace
