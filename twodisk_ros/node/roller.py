@@ -186,14 +186,10 @@ class Roller(Node):
         return self.stamp_of(self._motion_tick)
 
     def _metadata(self):
-        """The recording's metadata: the run's (parameters, a points run's outline; hybrid:
-        the engine's contact parameters)."""
+        """The recording's metadata: the run's (parameters, a points run's outline)."""
         metadata = self.simulation.run.metadata()
         metadata.update(self.settings.as_strings())   # (friction, frames: changed in place)
         metadata.update(frame_metadata(self.settings))
-        if self.settings.contact_model == 'hybrid':   # the engine's contact (the inspector's)
-            from ..engine.model import contact_metadata
-            metadata.update(contact_metadata())
         metadata['version'] = __version__
         return metadata
 
