@@ -43,7 +43,7 @@ from .results import Check
 
 __all__ = ['ENGINE_EVENT', 'RESTART_EVENTS', 'ROLLING_EVENT', 'approach_speed_bound',
            'contact_parameters', 'depth_bounds', 'engine_check', 'engine_intervals',
-           'rolling_starts', 'split_series', 'starts_anew']
+           'recorded_energies', 'rolling_starts', 'split_series', 'starts_anew']
 
 ENGINE_EVENT = 'contact_model engine:'
 ROLLING_EVENT = 'contact_model rolling:'
@@ -140,7 +140,7 @@ def approach_speed_bound(kinetic, mass, inertia, reach):
     return np.sqrt(2.0 * np.maximum(kinetic, 0.0) * (1.0 / mass + reach * reach / i_min))
 
 
-def _energies(engine, model, slope, to_slope):
+def recorded_energies(engine, model, slope, to_slope):
     """(stamps ns, E J, V J) of the engine samples with a pose and a rolling_state: E the
     energy the published nearest rolling state keeps (½ m(u) u̇² + V(u) cos β: the engine's,
     hybrid.py), V = M g cos β × G's height over the ground, so T = E − V."""
@@ -168,7 +168,7 @@ def depth_bounds(stamps, engine, model, parameters, size, slope, to_slope):
     tau, zeta, d0, dmax, source = contact_parameters(parameters)
     c = 0.5 * landing_depth_factor(min(max(zeta, 1e-3), 10.0)) * dmax / d0
     floor = DEPTH_TOLERANCE * size
-    found = _energies(engine, model, slope, to_slope)
+    found = recorded_energies(engine, model, slope, to_slope)
     if found is None or not len(found[0]):
         return np.full(len(stamps), floor), (f'{DEPTH_TOLERANCE:g} of the size (no engine '
                                              f'energies recorded for a landing bound)')
