@@ -201,7 +201,7 @@ def engine_check(engine, intervals, parameters, weight, size, model=None):
         return values @ to_slope.T if slope else values
 
     worst, where, count = 0.0, '', 0
-    said = f'{DEPTH_TOLERANCE:g} of the size'
+    said, closest = f'{DEPTH_TOLERANCE:g} of the size', None
     for disk in 'ab':
         wrench, point = engine.get('wrench_' + disk), engine.get('contact_' + disk)
         if wrench is not None and len(wrench):
@@ -221,6 +221,10 @@ def engine_check(engine, intervals, parameters, weight, size, model=None):
                                        to_slope)
             deep = -ground(point.values['point'])[:, 2]
             depth = (deep - bound) / size
+            j = int(np.argmax(deep / bound))
+            if deep[j] > 0 and (closest is None or deep[j] / bound[j] > closest[0]):
+                closest = (deep[j] / bound[j], f'contact {disk.upper()} {deep[j]:.3g} m deep at '
+                                               f'stamp {point.stamp_ns[j]}, {bound[j]:.3g} m allowed')
             i = int(np.argmax(depth))
             if depth[i] > worst:
                 worst, where = float(depth[i]), (
@@ -231,6 +235,8 @@ def engine_check(engine, intervals, parameters, weight, size, model=None):
               f'left out of the rolling checks',
               f'unilateral N >= 0, Coulomb |F_t| <= mu N (mu = {mu:g}) to {CONE_TOLERANCE:g} '
               f'M g, contact points no deeper than {said}']
+    if closest is not None:
+        detail.append(f'closest to its depth bound: {closest[1]} ({100 * closest[0]:.0f} %)')
     if where:
         detail.append(f'worst: {where}')
     return Check('engine_stretches', 'MuJoCo stretches: unilateral contacts, Coulomb '
