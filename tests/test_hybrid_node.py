@@ -110,6 +110,10 @@ def test_the_inspector_checks_engine_stretches_on_their_own(recording):
     assert all(c.passed for c in inspection.checks), [
         (c.name, c.detail) for c in inspection.checks if not c.passed]
     assert inspection.summary['run']['recovered_samples'] == 101
+    # the engine's contact parameters are in the metadata (the landing depth bound's)
+    meta = recording[0].metadata['twodisk_ros']
+    assert (meta['engine_time_constant'], meta['engine_damping_ratio']) == ('0.005', '1.0')
+    assert 'tau = 0.005 s, zeta = 1, recorded' in checks['engine_stretches'].detail[1]
 
 
 def test_a_scene_change_at_run_time_is_refused_in_one_line(recording):

@@ -44,8 +44,8 @@ import numpy as np
 
 from twodisk_ros.model.mesh import mesh_parts
 
-__all__ = ['ContactParameters', 'INTEGRATORS', 'CONES', 'engine_xml', 'build_model',
-           'gravity_vector']
+__all__ = ['ContactParameters', 'INTEGRATORS', 'CONES', 'IMPEDANCE', 'engine_xml', 'build_model',
+           'contact_metadata', 'gravity_vector', 'landing_depth_factor']
 
 #: MuJoCo integrators accepted (its names).
 INTEGRATORS = ('implicitfast', 'Euler', 'implicit', 'RK4')
@@ -54,6 +54,9 @@ CONES = ('elliptic', 'pyramidal')
 #: Allowed time steps (s): finer steps are slower than useful, coarser ones unstable for
 #: contacts stiff enough to keep penetration below a tenth of a millimetre.
 TIMESTEP_RANGE = (1e-5, 5e-3)
+#: (d0, dmax, width m): MuJoCo's default solimp, which :func:`engine_xml` leaves in force: the
+#: impedance d rises from d0 at the surface to dmax at ``width`` deep
+IMPEDANCE = (0.9, 0.95, 0.001)
 
 
 def _number(name, value, low, high, unit):
@@ -196,3 +199,35 @@ def build_model(body, mass_properties, gravity=9.81, parameters=None, slope=0.0)
     import mujoco
     return mujoco.MjModel.from_xml_string(engine_xml(body, mass_properties, gravity, parameters,
                                                      slope))
+
+
+def landing_depth_factor(damping_ratio):
+    """f(ζ): the largest penetration of a landing at normal speed v is v τ f(ζ) (m, τ the
+    time constant, s) while d = dmax.
+
+    MuJoCo's soft contact drives the penetration x (m) to a = −d b ẋ − d k x + (1 − d) a0
+    with b = 2 / (dmax τ), k = d / (dmax² τ² ζ²): at d = dmax a damped spring of natural
+    frequency ω0 = 1 / (τ ζ) and damping ratio ζ. From x(0) = 0, ẋ(0) = v its largest x is
+    (v / ω0) exp(−ζ φ / s) with s = √|1 − ζ²| and φ = atan(s / ζ) (ζ < 1) or artanh(s / ζ)
+    (ζ > 1); ζ = 1: v τ / e. Nearer the surface than ``width`` d < dmax softens the spring by
+    d / dmax: at most dmax / d0 more (:data:`IMPEDANCE`). Gravity's (1 − d) a0 adds what the
+    body sinks from rest (G 1.4e-5 m with the defaults, module docstring).
+    """
+    zeta = _number('damping_ratio', damping_ratio, 1e-3, 10.0, '(1 is critical)')
+    if zeta == 1.0:
+        return math.exp(-1.0)
+    s = math.sqrt(abs(1.0 - zeta * zeta))
+    phase = math.atan2(s, zeta) if zeta < 1.0 else math.atanh(s / zeta)
+    return zeta * math.exp(-zeta * phase / s)
+
+
+def contact_metadata(parameters=None):
+    """{key: text}: the engine's contact parameters for a recording's metadata (the
+    inspector's landing depth bound, inspector/engine_stretches.py); ``parameters`` a
+    :class:`ContactParameters` (None: the defaults, the node's)."""
+    p = ContactParameters() if parameters is None else parameters
+    return {'engine_time_constant': repr(float(p.time_constant)),
+            'engine_damping_ratio': repr(float(p.damping_ratio)),
+            'engine_timestep': repr(float(p.timestep)),
+            'engine_impedance': ' '.join(repr(float(x)) for x in IMPEDANCE)
+            + ' (MuJoCo solimp d0 dmax width m)'}

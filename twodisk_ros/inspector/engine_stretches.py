@@ -13,10 +13,24 @@ contact points:
 * Coulomb: |F_tangential| ≤ μ N (μ the recorded ``friction``), to 1e-6 of M g (MuJoCo's
   solver meets its elliptic cone to its tolerance; a disk's total of several contact forces
   inside the cone is inside it too);
-* no contact point below the ground by more than 1e-2 of the body's size: the engine's soft
-  contact gives under an impact by about the impact speed × its time constant (5 ms: 1.1 mm
-  measured for the rounded square landing at 15 rad/s, 5.5e-3 of its size), and sinks
-  1.4e-5 m at rest.
+* no contact point deeper below the ground than its landing allows (:func:`depth_bounds`):
+  δ0 + c τ v_max, δ0 = 1e-2 of the body's size (the sink under a sustained load: G 1.4e-5 m at
+  rest; a recorded point 1.9e-4 m deep, half the 3.9e-4 m penetration, where the oloid rocked
+  on rim A alone after a 3 N m spin-up), τ the soft contact's
+  time constant and c = f(ζ) dmax / (2 d0) (:func:`~twodisk_ros.engine.model.
+  landing_depth_factor`: a landing at normal speed v sinks by v τ f(ζ); the recorded point is
+  MuJoCo's contact point, midway between the surfaces, so half as deep), v_max the fastest
+  any body point can move with the kinetic energy the recording holds in the 10 τ before
+  the sample (:func:`approach_speed_bound`).
+
+  Why not the approach speed itself: the recording has no velocities, and its samples (100
+  Hz) do not resolve a landing that lasts a few τ: the contact point's height differences
+  gave 0.12 m/s before a touchdown at 3.5 m/s. The energy bound does hold, loosely (the spin
+  about the normal counts too): for the oloid after a 3 N m spin-up v_max was 2.5–4.6 × the
+  touchdown's normal speed at the landings deeper than 1 mm (8.7 against 3.5 m/s, 33
+  against 9.2), and a landing's deepest sample used 15–25 % of its c τ v_max. The drive's
+  work between the last sample and the touchdown is not counted (0.8 J of the 4.6 J at the
+  3.5 m/s landing under 3 N m: v_max 9 % short of the energy's, inside that margin).
 """
 
 from dataclasses import replace
@@ -24,10 +38,12 @@ import math
 
 import numpy as np
 
+from ..engine.model import IMPEDANCE, ContactParameters, landing_depth_factor
 from .results import Check
 
-__all__ = ['ENGINE_EVENT', 'RESTART_EVENTS', 'ROLLING_EVENT', 'engine_check',
-           'engine_intervals', 'rolling_starts', 'split_series', 'starts_anew']
+__all__ = ['ENGINE_EVENT', 'RESTART_EVENTS', 'ROLLING_EVENT', 'approach_speed_bound',
+           'contact_parameters', 'depth_bounds', 'engine_check', 'engine_intervals',
+           'recorded_energies', 'rolling_starts', 'split_series', 'starts_anew']
 
 ENGINE_EVENT = 'contact_model engine:'
 ROLLING_EVENT = 'contact_model rolling:'
@@ -36,7 +52,8 @@ RESTART_EVENTS = ('reset', 'restart')
 #: roles sampled at the node's rate (the rest, e.g. diagnostics and paths, are kept whole)
 _PER_SAMPLE = ('pose', 'contact_a', 'contact_b', 'rolling_state', 'wrench_a', 'wrench_b')
 CONE_TOLERANCE = 1e-6      #: of M g: the engine's friction cone
-DEPTH_TOLERANCE = 1e-2     #: of the body's size: contact points below the ground
+DEPTH_TOLERANCE = 1e-2     #: of the body's size: δ0, contact points below the ground
+LANDING_WINDOW = 10.0      #: time constants: a landing's depth after them is < 5e-4 v τ
 
 
 def starts_anew(text):
@@ -95,9 +112,83 @@ def split_series(series, intervals):
     return rolling, engine
 
 
-def engine_check(engine, intervals, parameters, weight, size):
+def contact_parameters(parameters):
+    """(τ s, ζ, d0, dmax, source) of the engine's soft contact from the recording's metadata
+    (``engine_time_constant``, ``engine_damping_ratio``, ``engine_impedance``); a recording
+    made before they were recorded ran the defaults (the node never set them): source says
+    which."""
+    default = ContactParameters()
+    try:
+        impedance = parameters['engine_impedance'].split()
+        values = (float(parameters['engine_time_constant']),
+                  float(parameters['engine_damping_ratio']),
+                  float(impedance[0]), float(impedance[1]))
+        if all(math.isfinite(x) and x > 0 for x in values) and values[2] <= values[3] < 1:
+            return (*values, 'recorded')
+    except (KeyError, ValueError, IndexError, AttributeError):
+        pass
+    return (default.time_constant, default.damping_ratio, IMPEDANCE[0], IMPEDANCE[1],
+            'not recorded: the engine defaults')
+
+
+def approach_speed_bound(kinetic, mass, inertia, reach):
+    """The fastest speed (m/s) any point within ``reach`` (m) of G can have with kinetic
+    energy ``kinetic`` (J, array): |v_G + ω × r| ≤ |v_G| + |ω| ρ with ½ M v_G² + ½ I_min ω²
+    ≤ T, largest at √(2 T (1/M + ρ²/I_min)) (Cauchy–Schwarz; M kg, I_min the smallest
+    principal moment about G, kg m²)."""
+    i_min = float(np.min(np.linalg.eigvalsh(np.asarray(inertia, dtype=float))))
+    return np.sqrt(2.0 * np.maximum(kinetic, 0.0) * (1.0 / mass + reach * reach / i_min))
+
+
+def recorded_energies(engine, model, slope, to_slope):
+    """(stamps ns, E J, V J) of the engine samples with a pose and a rolling_state: E the
+    energy the published nearest rolling state keeps (½ m(u) u̇² + V(u) cos β: the engine's,
+    hybrid.py), V = M g cos β × G's height over the ground, so T = E − V."""
+    state, pose = engine.get('rolling_state'), engine.get('pose')
+    if model is None or state is None or pose is None or not len(state) or not len(pose):
+        return None
+    stamps, k, j = np.intersect1d(state.stamp_ns, pose.stamp_ns, return_indices=True)
+    u = np.asarray(state.values['position'], dtype=float)[k, 2]
+    u_dot = np.asarray(state.values['velocity'], dtype=float)[k, 2]
+    dynamics, cos = model.dynamics, math.cos(slope)
+    potential = dynamics.potential(np.mod(u, 2 * math.pi))
+    energy = dynamics.energy(u, u_dot) + (cos - 1.0) * potential
+    height = (np.asarray(pose.values['position'], dtype=float)[j] @ to_slope.T)[:, 2]
+    ok = np.isfinite(energy) & np.isfinite(height)
+    return stamps[ok], energy[ok], dynamics.mass.mass * dynamics.gravity * cos * height[ok]
+
+
+def depth_bounds(stamps, engine, model, parameters, size, slope, to_slope):
+    """(bound m per contact sample at ``stamps`` ns, one line on it): δ0 + c τ v_max with
+    δ0 = DEPTH_TOLERANCE × size, c = f(ζ) dmax / (2 d0) (module docstring) and v_max of
+    :func:`approach_speed_bound` with T ≤ max E − min V over the samples from the last one
+    before ``LANDING_WINDOW`` τ ahead of the sample to it (a landing's touchdown in that
+    window starts from such a state; gravity's work on the way is in min V). Without the
+    rolling_state or poses (or a model) the bound is δ0."""
+    tau, zeta, d0, dmax, source = contact_parameters(parameters)
+    c = 0.5 * landing_depth_factor(min(max(zeta, 1e-3), 10.0)) * dmax / d0
+    floor = DEPTH_TOLERANCE * size
+    found = recorded_energies(engine, model, slope, to_slope)
+    if found is None or not len(found[0]):
+        return np.full(len(stamps), floor), (f'{DEPTH_TOLERANCE:g} of the size (no engine '
+                                             f'energies recorded for a landing bound)')
+    times, energy, potential = found
+    window = int(round(LANDING_WINDOW * tau * 1e9))
+    first = np.maximum(np.searchsorted(times, stamps - window) - 1, 0)
+    last = np.searchsorted(times, stamps, side='right')
+    kinetic = np.array([np.max(energy[a:b]) - np.min(potential[a:b]) if b > a else 0.0
+                        for a, b in zip(first, last)])
+    mass = model.dynamics.mass
+    speed = approach_speed_bound(kinetic, mass.mass, mass.inertia, model.body.size)
+    return floor + c * tau * speed, (
+        f'{DEPTH_TOLERANCE:g} of the size + c tau v_max (c = f(zeta) dmax / (2 d0) = {c:.4g}, '
+        f'tau = {tau:g} s, zeta = {zeta:g}, {source}; v_max from the kinetic energy)')
+
+
+def engine_check(engine, intervals, parameters, weight, size, model=None):
     """The ``engine_stretches`` check (module docstring): the worst violation / M g or
-    / size; None if there are no engine stretches."""
+    / size; None if there are no engine stretches. ``model``: the recording's
+    :class:`~twodisk_ros.inspector.model.RecordedModel` (None: the depth bound is δ0 alone)."""
     if not intervals:
         return None
     mu = float(parameters.get('friction', 'inf'))
@@ -110,6 +201,7 @@ def engine_check(engine, intervals, parameters, weight, size):
         return values @ to_slope.T if slope else values
 
     worst, where, count = 0.0, '', 0
+    said, closest = f'{DEPTH_TOLERANCE:g} of the size', None
     for disk in 'ab':
         wrench, point = engine.get('wrench_' + disk), engine.get('contact_' + disk)
         if wrench is not None and len(wrench):
@@ -125,16 +217,26 @@ def engine_check(engine, intervals, parameters, weight, size):
                 if excess[i] > worst:
                     worst, where = float(excess[i]), f'{name} at stamp {wrench.stamp_ns[i]}'
         if point is not None and len(point):
-            depth = -ground(point.values['point'])[:, 2] / size - DEPTH_TOLERANCE
+            bound, said = depth_bounds(point.stamp_ns, engine, model, parameters, size, slope,
+                                       to_slope)
+            deep = -ground(point.values['point'])[:, 2]
+            depth = (deep - bound) / size
+            j = int(np.argmax(deep / bound))
+            if deep[j] > 0 and (closest is None or deep[j] / bound[j] > closest[0]):
+                closest = (deep[j] / bound[j], f'contact {disk.upper()} {deep[j]:.3g} m deep at '
+                                               f'stamp {point.stamp_ns[j]}, {bound[j]:.3g} m allowed')
             i = int(np.argmax(depth))
             if depth[i] > worst:
-                worst, where = float(depth[i]), f'contact {disk.upper()} below the ground ' \
-                                                f'at stamp {point.stamp_ns[i]}'
+                worst, where = float(depth[i]), (
+                    f'contact {disk.upper()} {deep[i]:.3g} m below the ground at stamp '
+                    f'{point.stamp_ns[i]} (its landing allows {bound[i]:.3g} m)')
     spans = ', '.join(f'{start} … {"end" if end is None else end}' for start, end in intervals)
     detail = [f'{len(intervals)} engine stretch(es) (stamps, ns: {spans}), {count} samples, '
               f'left out of the rolling checks',
               f'unilateral N >= 0, Coulomb |F_t| <= mu N (mu = {mu:g}) to {CONE_TOLERANCE:g} '
-              f'M g, contact points no deeper than {DEPTH_TOLERANCE:g} of the size']
+              f'M g, contact points no deeper than {said}']
+    if closest is not None:
+        detail.append(f'closest to its depth bound: {closest[1]} ({100 * closest[0]:.0f} %)')
     if where:
         detail.append(f'worst: {where}')
     return Check('engine_stretches', 'MuJoCo stretches: unilateral contacts, Coulomb '

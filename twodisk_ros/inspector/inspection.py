@@ -170,7 +170,7 @@ def _inspect(path):
     checks.extend(more)
     if intervals and model is not None:
         checks.append(engine_check(engine, intervals, parameters, model.dynamics.mass.mass
-                                   * model.dynamics.gravity, model.body.size))
+                                   * model.dynamics.gravity, model.body.size, model))
     more, tf_summary = tf_check(recording, whole, parameters, stamp0)
     checks.extend(more)
     summary = _summary(recording, chosen, parameters, samples, model, t0_ns, t1_ns)

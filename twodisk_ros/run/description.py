@@ -158,9 +158,14 @@ class RunDescription:
 
         Every parameter (:meth:`as_strings`), and for shape points the fitted outline
         (:func:`~twodisk_ros.run.shape.outline_metadata`), so the recording is checked
-        without the shape file.
+        without the shape file; under ``contact_model`` hybrid the engine's contact
+        parameters (:func:`~twodisk_ros.engine.model.contact_metadata`: the inspector's
+        landing depth bound).
         """
         values = self.settings.as_strings()
         if self.settings.shape == 'points':
             values.update(shapes.outline_metadata(self.lamina))
+        if self.settings.contact_model == 'hybrid':
+            from ..engine.model import contact_metadata    # (the node's engine: defaults)
+            values.update(contact_metadata())
         return values
