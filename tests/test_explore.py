@@ -266,10 +266,11 @@ def test_a_simplified_trace_keeps_the_points_a_circle_needs():
 
 
 def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served):
-    """2 s of the oloid: the finished trace nodes have fewer points than samples, and every
-    sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of the
-    polyline drawn (the nodes' segments, sent as float32: 1e-6 m of rounding allowed)."""
-    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D
+    """2 s of the oloid: the node of the finished traces (A, B and G told apart by their
+    colours) has fewer points than samples, and every sample of A, B and G (the frames' own)
+    lies within TRACE_TOLERANCE x size of the polyline drawn (sent as float32: 1e-6 m of
+    rounding allowed); the current chunk's node goes on from the finished one's last point."""
+    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D, Traces, rgb255
     motion = LiveMotion(oloid)
     scene = Scene3D(served, motion)
     frames = [motion.advance(0.1, 10) for _ in range(20)]
@@ -277,15 +278,19 @@ def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, ser
         scene.show(frame)
     traces = scene.traces
     assert len(traces.nodes) >= 2
-    for k, key in enumerate(('contact_a', 'contact_b', 'position_g')):
+    done, now = traces.handles['done'], traces.handles['now']
+    for key, (_, colour) in zip(('contact_a', 'contact_b', 'position_g'), Traces.KEYS):
         samples = np.concatenate([getattr(f, key) for f in frames])
-        segments = np.concatenate([handles[k].points for handles, _ in traces.nodes])
+        segments = done.points[np.all(done.colors == rgb255(colour), axis=(1, 2))]
         drawn = np.concatenate([segments[:, 0], segments[-1:, 1]]).astype(float)
         assert np.array_equal(segments[1:, 0], segments[:-1, 1])      # one chain
         covered = samples[:sum(n for _, n in traces.nodes) + 1]
         assert len(drawn) < 0.7 * len(covered)
         tolerance = TRACE_TOLERANCE * scene.size + 1e-6
         assert _distance_to_polyline(covered, drawn).max() <= tolerance
+        current = now.points[np.all(now.colors == rgb255(colour), axis=(1, 2))]
+        assert np.array_equal(current[0, 0], segments[-1, 1])
+        assert np.array_equal(current[-1, 1], samples[-1].astype(np.float32))
 
 
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):

@@ -82,8 +82,11 @@ def simplified(points, tolerance):
 
 
 class Traces:
-    """Traces of A, B and G as line nodes of at most :data:`TRACE_CHUNK` points each; at most
-    ``length`` points per trace are kept (older nodes removed)."""
+    """Traces of A, B and G in two line nodes: the finished chunks of :data:`TRACE_CHUNK`
+    points (simplified, oldest dropped so that about ``length`` points per trace are kept)
+    and the current chunk, each node holding the three traces in their colours. Software GL
+    pays for every draw call (a node is one), far more than for the segments in it
+    (docs/benchmarks.md): one node per chunk and trace cost the page half its frame rate."""
 
     KEYS = (('a', palette.A), ('b', palette.B), ('g', palette.G))
 
@@ -91,17 +94,14 @@ class Traces:
         self.scene, self.width = scene, TRACE_WIDTH * size
         self.tolerance = TRACE_TOLERANCE * size
         self.length = max(2, int(length))
-        self.nodes = []       # [(handles, count)] finished chunks, oldest first
+        self.nodes = []       # [(segments per key, count)] finished chunks, oldest first
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
-        self.handles = None
+        self.handles = None   # {'done': node of the finished chunks, 'now': the current one}
         self.serial = 0
 
     def clear(self):
-        for handles, _ in self.nodes:
-            for h in handles:
-                h.remove()
         if self.handles is not None:
-            for h in self.handles:
+            for h in self.handles.values():
                 h.remove()
         self.nodes, self.handles = [], None
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
@@ -111,33 +111,44 @@ class Traces:
         self.current = [np.concatenate([c, np.asarray(p, dtype=float)])
                         for c, p in zip(self.current, (a, b, g))]
 
+    def _send(self, which, per_key):
+        """(Re)send node ``which`` with the segments (k, 2, 3) of each trace."""
+        segments = np.concatenate(per_key).astype(np.float32)
+        colours = np.concatenate([np.broadcast_to(np.asarray(rgb255(colour), np.uint8),
+                                                  part.shape)
+                                  for (_, colour), part in zip(self.KEYS, per_key)])
+        if self.handles is None:
+            self.handles = {}
+        # a node of the same name replaces the old one in the same message (no frame without)
+        self.handles[which] = self.scene.add_line_segments(
+            f'/world/traces/{which}', segments, colours, thickness=TRACE_PX,
+            thickness_units='screen')
+
     def publish(self):
-        """Send the current chunk; start a new one when it is full; drop the oldest."""
+        """Send the current chunk; when it is full, move it (simplified) to the finished
+        node, start a new one and drop the oldest chunks."""
         if len(self.current[0]) < 2:
             return
-        if self.handles is not None:
-            for h in self.handles:
-                h.remove()
-        self.handles = []
         count = len(self.current[0])
-        for (key, colour), points in zip(self.KEYS, self.current):
-            if count >= TRACE_CHUNK:         # its last sending: only the points needed
+        finished = count >= TRACE_CHUNK
+        per_key = []
+        for points in self.current:
+            if finished:                     # kept for good: only the points needed
                 points = points[simplified(points, self.tolerance)]
-            segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
-            self.handles.append(self.scene.add_line_segments(
-                f'/world/trace_{key}/{self.serial}', segments, rgb255(colour),
-                thickness=TRACE_PX, thickness_units='screen'))
-        if count >= TRACE_CHUNK:
-            self.nodes.append((self.handles, count - 1))
-            self.handles = None
-            self.serial += 1
-            self.current = [c[-1:] for c in self.current]
+            per_key.append(np.stack([points[:-1], points[1:]], axis=1))
+        if not finished:
+            self._send('now', per_key)
+            return
+        self.nodes.append((per_key, count - 1))
+        self.serial += 1
+        self.current = [c[-1:] for c in self.current]
         kept = sum(n for _, n in self.nodes)
         while self.nodes and kept - self.nodes[0][1] >= self.length:
-            handles, n = self.nodes.pop(0)
-            kept -= n
-            for h in handles:
-                h.remove()
+            kept -= self.nodes.pop(0)[1]
+        self._send('done', [np.concatenate([node[k] for node, _ in self.nodes])
+                            for k in range(len(self.KEYS))])
+        if 'now' in self.handles:            # the finished chunk is in the other node now
+            self.handles.pop('now').remove()
 
 
 class Scene3D:
