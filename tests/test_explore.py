@@ -265,12 +265,24 @@ def test_a_simplified_trace_keeps_the_points_a_circle_needs():
     assert simplified(cusp, tolerance).tolist() == [0, 49, 98]
 
 
+def _centre_line(mesh, lift):
+    """The centre line (starts and ends of its segments, (k, 3) each) of a strip of
+    scene3d.ribbon: the midpoints of the pairs of vertices across each of its two crossed
+    rectangles (they must agree to float32 rounding), less its lift."""
+    v = np.asarray(mesh.vertices, dtype=float).reshape(-1, 8, 3)
+    mid = 0.5 * (v[:, 0::2] + v[:, 1::2])                   # (k, 4, 3)
+    assert np.abs(mid[:, 0] - mid[:, 1]).max() <= 1e-6
+    assert np.abs(mid[:, 2] - mid[:, 3]).max() <= 1e-6
+    return mid[:, 0] - lift, mid[:, 2] - lift
+
+
 def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served):
-    """2 s of the oloid: the node of the finished traces (A, B and G told apart by their
-    colours) has fewer points than samples, and every sample of A, B and G (the frames' own)
-    lies within TRACE_TOLERANCE x size of the polyline drawn (sent as float32: 1e-6 m of
-    rounding allowed); the current chunk's node goes on from the finished one's last point."""
-    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D, Traces, rgb255
+    """2 s of the oloid: the strips of the finished traces have fewer points than samples,
+    and every sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of
+    the centre line drawn (sent as float32: 1e-6 m of rounding allowed), two rectangles
+    TRACE_WIDTH x size wide across it at +-45 deg to the ground; the current chunk's strip goes on from the finished
+    one's last point to the last sample."""
+    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, TRACE_WIDTH, Scene3D
     motion = LiveMotion(oloid)
     scene = Scene3D(served, motion)
     frames = [motion.advance(0.1, 10) for _ in range(20)]
@@ -278,19 +290,30 @@ def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, ser
         scene.show(frame)
     traces = scene.traces
     assert len(traces.nodes) >= 2
-    done, now = traces.handles['done'], traces.handles['now']
-    for key, (_, colour) in zip(('contact_a', 'contact_b', 'position_g'), Traces.KEYS):
+    for k, key in enumerate(('contact_a', 'contact_b', 'position_g')):
         samples = np.concatenate([getattr(f, key) for f in frames])
-        segments = done.points[np.all(done.colors == rgb255(colour), axis=(1, 2))]
-        drawn = np.concatenate([segments[:, 0], segments[-1:, 1]]).astype(float)
-        assert np.array_equal(segments[1:, 0], segments[:-1, 1])      # one chain
+        done, now = traces.handles['done'][k], traces.handles['now'][k]
+        starts, ends = _centre_line(done, traces.lift)
+        assert np.abs(ends[:-1] - starts[1:]).max() <= 1e-6              # one chain
+        drawn = np.concatenate([starts, ends[-1:]])
         covered = samples[:sum(n for _, n in traces.nodes) + 1]
         assert len(drawn) < 0.7 * len(covered)
         tolerance = TRACE_TOLERANCE * scene.size + 1e-6
         assert _distance_to_polyline(covered, drawn).max() <= tolerance
-        current = now.points[np.all(now.colors == rgb255(colour), axis=(1, 2))]
-        assert np.array_equal(current[0, 0], segments[-1, 1])
-        assert np.array_equal(current[-1, 1], samples[-1].astype(np.float32))
+        v = np.asarray(done.vertices, dtype=float).reshape(-1, 8, 3)
+        across = v[:, [1, 3]] - v[:, [0, 2]]                # (k, 2, 3): the two rectangles
+        assert np.allclose(np.linalg.norm(across, axis=2), TRACE_WIDTH * scene.size, atol=1e-6)
+        # at +-45 deg to the ground, across the segment's course on the ground (cosines:
+        # float32 vertices near 0.3 m give 3e-8 m differences over a width of 2e-3 m)
+        up = across @ traces.normal / (TRACE_WIDTH * scene.size)
+        assert np.allclose(np.sort(up, axis=1), [-math.sqrt(0.5), math.sqrt(0.5)], atol=1e-4)
+        course = (ends - starts) - np.outer((ends - starts) @ traces.normal, traces.normal)
+        course /= np.linalg.norm(course, axis=1, keepdims=True)
+        assert np.abs(np.einsum('kjc,kc->kj', across, course)).max() <= 1e-4 * TRACE_WIDTH \
+            * scene.size
+        current, last = _centre_line(now, traces.lift)
+        assert np.abs(current[0] - ends[-1]).max() <= 1e-6
+        assert np.abs(last[-1] - samples[-1]).max() <= 1e-6
 
 
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):

@@ -17,21 +17,25 @@ import numpy as np
 from ..model import palette
 from ..model.mesh import mesh_parts
 
-__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'simplified', 'wxyz']
+__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'ribbon',
+           'simplified', 'wxyz']
 
 #: Rim vertices per disk (and hull steps) of the drawn meshes.
 MESH_RESOLUTION = 128
-#: Traces: points per line node before a new node starts (a finished node is never resent).
+#: Traces: points per chunk; a full chunk is simplified and moved to the finished traces.
 TRACE_CHUNK = 64
 #: A finished trace node keeps only the points needed to stay within this distance (× body
 #: size) of all its samples: about 0.2 px at the default camera on an 800 px high page, and
 #: software GL's cost of a frame grows with the segments drawn (docs/benchmarks.md).
 TRACE_TOLERANCE = 1e-3
-#: Widths (× body size, world units) of the contact segment and of the traces.
-SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.008
-#: Width of the traces on screen (px): screen-unit lines skip the world-unit lines' second
-#: antialiasing pass, which software GL pays for at every frame (docs/benchmarks.md).
-TRACE_PX = 2.0
+#: Widths (× body size, world units) of the contact segment and of the traces: a trace is a
+#: strip of two crossed rectangles (:func:`ribbon`), about 2 px wide at the default camera on
+#: an 800 px high page. viser's lines are instanced quads, one instance per segment, and software GL pays
+#: for every instance: the traces as lines cost the page most of its frame (docs/benchmarks.md).
+SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.02
+#: The traces' strips run this far (× their width) above the points, so that they stay above
+#: the ground (their lower edges 0.35 width below their centre lines).
+TRACE_LIFT = 0.4
 #: Force arrows: |F| / (M g) × body size long; shaft and head radius, head length (× size).
 SHAFT, HEAD, HEAD_LENGTH = 0.008, 0.02, 0.05
 
@@ -81,28 +85,54 @@ def simplified(points, tolerance):
     return np.asarray(keep)
 
 
+def ribbon(points, normal, width):
+    """(vertices (8 (n - 1), 3), faces (4 (n - 1), 3)) of a strip along the polyline
+    ``points`` (n, 3) that shows about 0.7 ``width`` wide from any side: each segment is two
+    rectangles ``width`` wide crossing on it, at ±45° to the plane of unit ``normal``
+    (vertices 8 i + 2 j, 8 i + 2 j + 1 across rectangle j at the segment's start, 8 i + 4 +
+    2 j, 8 i + 5 + 2 j at its end: their midpoints are the polyline). A segment along
+    ``normal`` or of no length has no width."""
+    p = np.asarray(points, dtype=float)
+    d = p[1:] - p[:-1]
+    side = np.cross(normal, d)
+    length = np.linalg.norm(side, axis=1, keepdims=True)
+    side = np.divide(side, length, out=np.zeros_like(side), where=length > 0)
+    up = np.where(length > 0, np.asarray(normal, dtype=float), 0.0)
+    half = 0.5 * width * math.sqrt(0.5)
+    across = (half * (side + up), half * (side - up))
+    vertices = np.stack([p[:-1] - across[0], p[:-1] + across[0], p[:-1] - across[1],
+                         p[:-1] + across[1], p[1:] - across[0], p[1:] + across[0],
+                         p[1:] - across[1], p[1:] + across[1]], axis=1)
+    k = 8 * np.arange(len(d))[:, None]
+    faces = np.concatenate([k + [0, 1, 4], k + [4, 1, 5], k + [2, 3, 6], k + [6, 3, 7]])
+    return vertices.reshape(-1, 3), faces
+
+
 class Traces:
-    """Traces of A, B and G in two line nodes: the finished chunks of :data:`TRACE_CHUNK`
-    points (simplified, oldest dropped so that about ``length`` points per trace are kept)
-    and the current chunk, each node holding the three traces in their colours. Software GL
-    pays for every draw call (a node is one), far more than for the segments in it
-    (docs/benchmarks.md): one node per chunk and trace cost the page half its frame rate."""
+    """Traces of A, B and G as strips (:func:`ribbon`, meshes in their colours) in two parts:
+    the finished chunks of :data:`TRACE_CHUNK` points (simplified, oldest dropped so that
+    about ``length`` points per trace are kept) and the current chunk. Software GL pays for
+    every draw call and every line instance (docs/benchmarks.md): six meshes draw what took
+    some 45 nodes of line segments, one instance per segment."""
 
     KEYS = (('a', palette.A), ('b', palette.B), ('g', palette.G))
 
-    def __init__(self, scene, size, length):
+    def __init__(self, scene, size, length, normal=(0.0, 0.0, 1.0)):
         self.scene, self.width = scene, TRACE_WIDTH * size
+        self.normal = np.asarray(normal, dtype=float)
+        self.lift = TRACE_LIFT * self.width * self.normal
         self.tolerance = TRACE_TOLERANCE * size
         self.length = max(2, int(length))
         self.nodes = []       # [(segments per key, count)] finished chunks, oldest first
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
-        self.handles = None   # {'done': node of the finished chunks, 'now': the current one}
+        self.handles = None   # {'done': meshes of the finished chunks, 'now': the current}
         self.serial = 0
 
     def clear(self):
         if self.handles is not None:
-            for h in self.handles.values():
-                h.remove()
+            for meshes in self.handles.values():
+                for h in meshes:
+                    h.remove()
         self.nodes, self.handles = [], None
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
 
@@ -112,17 +142,19 @@ class Traces:
                         for c, p in zip(self.current, (a, b, g))]
 
     def _send(self, which, per_key):
-        """(Re)send node ``which`` with the segments (k, 2, 3) of each trace."""
-        segments = np.concatenate(per_key).astype(np.float32)
-        colours = np.concatenate([np.broadcast_to(np.asarray(rgb255(colour), np.uint8),
-                                                  part.shape)
-                                  for (_, colour), part in zip(self.KEYS, per_key)])
+        """(Re)send part ``which``: each trace's polyline (segments (k, 2, 3)) as a strip."""
         if self.handles is None:
             self.handles = {}
-        # a node of the same name replaces the old one in the same message (no frame without)
-        self.handles[which] = self.scene.add_line_segments(
-            f'/world/traces/{which}', segments, colours, thickness=TRACE_PX,
-            thickness_units='screen')
+        meshes = []
+        for (key, colour), segments in zip(self.KEYS, per_key):
+            points = np.concatenate([segments[:, 0], segments[-1:, 1]]) + self.lift
+            vertices, faces = ribbon(points, self.normal, self.width)
+            # a node of the same name replaces the old one in the same message
+            meshes.append(self.scene.add_mesh_simple(
+                f'/world/traces/{which}_{key}', vertices.astype(np.float32),
+                faces.astype(np.uint32), color=rgb255(colour), side='double',
+                cast_shadow=False, receive_shadow=False))
+        self.handles[which] = meshes
 
     def publish(self):
         """Send the current chunk; when it is full, move it (simplified) to the finished
@@ -147,8 +179,9 @@ class Traces:
             kept -= self.nodes.pop(0)[1]
         self._send('done', [np.concatenate([node[k] for node, _ in self.nodes])
                             for k in range(len(self.KEYS))])
-        if 'now' in self.handles:            # the finished chunk is in the other node now
-            self.handles.pop('now').remove()
+        if 'now' in self.handles:            # the finished chunk is in the other part now
+            for h in self.handles.pop('now'):
+                h.remove()
 
 
 class Scene3D:
@@ -207,7 +240,7 @@ class Scene3D:
                 plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
         if self.traces is not None:
             self.traces.clear()
-        self.traces = Traces(self.scene, self.size, s.path_length)
+        self.traces = Traces(self.scene, self.size, s.path_length, self.normal)
 
     def shift(self, position_g):
         """Minus the foot of G on the ground (m): the translation of ``/world``."""
