@@ -156,6 +156,43 @@ def page_measures(repeats, fps_seconds):
     return result
 
 
+def empty_page_fps(fps_seconds):
+    """Frames a second of an empty page of the same client (the served one, with explore/
+    client.py's script): no node but one frame without axes, moved 30 times a second so
+    that the page draws every frame, at the two sizes: what software GL costs here before
+    anything is drawn."""
+    import threading
+    from chromium import Chromium
+    from twodisk_ros.explore.cli import _server, stop_server
+    server = _server('127.0.0.1', 0)
+    node = server.scene.add_frame('/moved', show_axes=False)
+    stop = threading.Event()
+
+    def move():
+        k = 0
+        while not stop.wait(1.0 / 30):
+            k += 1
+            node.position = (1e-3 * (k % 2), 0.0, 0.0)
+    thread = threading.Thread(target=move, daemon=True)
+    thread.start()
+    fps = {}
+    try:
+        for width, height in ((1280, 800), (800, 500)):
+            browser = Chromium(width, height)
+            try:
+                browser.goto(f'http://127.0.0.1:{server.get_port()}/')
+                browser.wait_for("document.querySelector('canvas') !== null", timeout=60)
+                time.sleep(2.0)
+                fps[f'{width}x{height}'] = browser.fps(fps_seconds)
+            finally:
+                browser.close()
+    finally:
+        stop.set()
+        thread.join()
+        stop_server(server)
+    return fps
+
+
 def _latencies(browser, explorer, body_pixels, repeats):
     """End on the slider of a (0.1 → 0.3 m) until a frame of the page's screencast (the
     compositor's frames, each with its own timestamp) shows at least twice the body's pixels
@@ -272,6 +309,8 @@ def section(r):
         *[f'| page frames a second, {size} | {value:.1f} fps'
           + _before(r, lambda run, size=size: f'{run["fps"][size]:.1f}') + ' | >= 30 fps |'
           for size, value in fps.items()],
+        *[f'| an empty page of the same client (one node moved 30 times a second), {size} | '
+          f'{value:.1f} fps{blank} | - |' for size, value in r.get('empty_fps', {}).items()],
         f'| server CPU at real time (oloid, one page connected) | {100 * r["server_cpu"]:.1f} '
         '% of a core' + _before(r, lambda run: f'{100 * run["server_cpu"]:.1f} %')
         + ' | <= 25 % |',
@@ -350,6 +389,7 @@ def main():
     if args.baseline:                 # before, after, before again: the machine's load drifts
         again = baseline(args)
         results['baseline'] = {'dir': args.baseline, 'runs': [before, again]}
+    results['empty_fps'] = empty_page_fps(1.0 if args.quick else 3.0)
     results['restart_repeats'] = 2 if args.quick else 4
     results['restart_s'] = restart_times(results['restart_repeats'])
     results['lesson_seconds'] = 5.0 if args.quick else 20.0

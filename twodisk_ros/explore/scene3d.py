@@ -22,16 +22,19 @@ __all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'ribb
 
 #: Rim vertices per disk (and hull steps) of the drawn meshes.
 MESH_RESOLUTION = 128
-#: Traces: points per chunk; a full chunk is simplified and moved to the finished traces.
-TRACE_CHUNK = 64
+#: Traces: points per chunk; a full chunk is simplified and moved to the finished traces, in
+#: groups of TRACE_GROUP chunks (a group's meshes are resent while it fills, never after, and
+#: dropped whole when the trace is longer than its length without it).
+TRACE_CHUNK, TRACE_GROUP = 64, 4
 #: A finished trace node keeps only the points needed to stay within this distance (× body
 #: size) of all its samples: about 0.2 px at the default camera on an 800 px high page, and
 #: software GL's cost of a frame grows with the segments drawn (docs/benchmarks.md).
 TRACE_TOLERANCE = 1e-3
 #: Widths (× body size, world units) of the contact segment and of the traces: a trace is a
 #: strip of two crossed rectangles (:func:`ribbon`), about 2 px wide at the default camera on
-#: an 800 px high page. viser's lines are instanced quads, one instance per segment, and software GL pays
-#: for every instance: the traces as lines cost the page most of its frame (docs/benchmarks.md).
+#: an 800 px high page. viser's lines are instanced quads, one instance per segment, and
+#: software GL pays for every instance: the traces as lines cost the page most of its frame
+#: (docs/benchmarks.md).
 SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.02
 #: The traces' strips run this far (× their width) above the points, so that they stay above
 #: the ground (their lower edges 0.35 width below their centre lines).
@@ -109,11 +112,13 @@ def ribbon(points, normal, width):
 
 
 class Traces:
-    """Traces of A, B and G as strips (:func:`ribbon`, meshes in their colours) in two parts:
-    the finished chunks of :data:`TRACE_CHUNK` points (simplified, oldest dropped so that
-    about ``length`` points per trace are kept) and the current chunk. Software GL pays for
-    every draw call and every line instance (docs/benchmarks.md): six meshes draw what took
-    some 45 nodes of line segments, one instance per segment."""
+    """Traces of A, B and G as strips (:func:`ribbon`, meshes in their colours): the current
+    chunk (part ``'now'``) and the finished chunks of :data:`TRACE_CHUNK` points, simplified,
+    in groups of :data:`TRACE_GROUP` (parts ``('done', group)``); the oldest group is dropped
+    while the others keep ``length`` points per trace (so up to TRACE_GROUP × TRACE_CHUNK
+    more are kept). Software GL pays for every draw call and every line instance
+    (docs/benchmarks.md): some 15 meshes draw what took some 45 nodes of line segments, one
+    instance per segment."""
 
     KEYS = (('a', palette.A), ('b', palette.B), ('g', palette.G))
 
@@ -123,9 +128,9 @@ class Traces:
         self.lift = TRACE_LIFT * self.width * self.normal
         self.tolerance = TRACE_TOLERANCE * size
         self.length = max(2, int(length))
-        self.nodes = []       # [(segments per key, count)] finished chunks, oldest first
+        self.nodes = []       # [(segments per key, count, group)] finished chunks, oldest first
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
-        self.handles = None   # {'done': meshes of the finished chunks, 'now': the current}
+        self.handles = None   # {part: its meshes, one per trace}
         self.serial = 0
 
     def clear(self):
@@ -150,8 +155,9 @@ class Traces:
             points = np.concatenate([segments[:, 0], segments[-1:, 1]]) + self.lift
             vertices, faces = ribbon(points, self.normal, self.width)
             # a node of the same name replaces the old one in the same message
+            name = which if which == 'now' else f'done{which[1]}'
             meshes.append(self.scene.add_mesh_simple(
-                f'/world/traces/{which}_{key}', vertices.astype(np.float32),
+                f'/world/traces/{name}_{key}', vertices.astype(np.float32),
                 faces.astype(np.uint32), color=rgb255(colour), side='double',
                 cast_shadow=False, receive_shadow=False))
         self.handles[which] = meshes
@@ -171,14 +177,22 @@ class Traces:
         if not finished:
             self._send('now', per_key)
             return
-        self.nodes.append((per_key, count - 1))
+        group = self.serial // TRACE_GROUP
+        self.nodes.append((per_key, count - 1, group))
         self.serial += 1
         self.current = [c[-1:] for c in self.current]
-        kept = sum(n for _, n in self.nodes)
-        while self.nodes and kept - self.nodes[0][1] >= self.length:
-            kept -= self.nodes.pop(0)[1]
-        self._send('done', [np.concatenate([node[k] for node, _ in self.nodes])
-                            for k in range(len(self.KEYS))])
+        kept = sum(node[1] for node in self.nodes)
+        while self.nodes[0][2] != group:
+            oldest = [node for node in self.nodes if node[2] == self.nodes[0][2]]
+            if kept - sum(node[1] for node in oldest) < self.length:
+                break
+            kept -= sum(node[1] for node in oldest)
+            del self.nodes[:len(oldest)]
+            for h in self.handles.pop(('done', oldest[0][2])):
+                h.remove()
+        self._send(('done', group), [np.concatenate([node[0][k] for node in self.nodes
+                                                     if node[2] == group])
+                                     for k in range(len(self.KEYS))])
         if 'now' in self.handles:            # the finished chunk is in the other part now
             for h in self.handles.pop('now'):
                 h.remove()
