@@ -340,14 +340,36 @@ def section(r):
         *[f'| {name} | {v.get("theta0", math.nan):.3f} | {v.get("a", math.nan):.3f} |'
           for name, v in r['restart_s'].items()],
         '',
-        'The page\'s frame cost under software GL grows with the triangles drawn: the '
-        'traces are most of them, so a finished trace node keeps only the points needed to '
-        'pass within 1e-3 body sizes of every sample (about 0.2 px). '
-        'Software GL draws the page slowly: the frame rate is that of SwiftShader on the '
-        "machine's shared cores, not of a browser with a GPU. The on-screen latency is "
-        'measured by screenshots (each one waits for a frame), so it includes at least one '
-        'frame of the software renderer.', END]
+        *_where_the_time_goes(r), END]
     return '\n'.join(lines) + '\n'
+
+
+def _where_the_time_goes(r):
+    """The section's closing paragraphs: what a frame costs and why, and the targets."""
+    empty = r.get('empty_fps', {})
+    reach = ', '.join(f'{size}: {value:.0f} fps' for size, value in empty.items())
+    below = [size for size, value in empty.items() if value < 30]
+    return [
+        'Where a frame goes under software GL: the browser\'s GPU process (SwiftShader) '
+        'takes most of the CPU of a frame, the page\'s renderer (JavaScript, the panel, '
+        'the plots) a fifth to a third of it. Two defaults cost most: viser\'s client asks '
+        'WebGL for multisampling, which SwiftShader pays about twice for (the page\'s script, '
+        'explore/client.py, turns it off when the browser names a software renderer; a '
+        'browser with a GPU keeps it), and viser\'s lines are instanced quads, one instance '
+        'per segment, whose cost in SwiftShader grows with the instances: the traces (about '
+        '1000 segments in some 45 line nodes) took most of the frame, and are now meshes '
+        '(strips of two crossed rectangles, about 15 meshes; a finished chunk keeps only the '
+        'points needed to pass within 1e-3 body sizes of every sample). The environment map '
+        'and shadow maps were already off; the grid, the two disks\' meshes, the arrows and '
+        'the plots (redrawn 5 times a second) cost the rest.', '',
+        f'The targets under software GL on this 2-core machine: an empty page of the same '
+        f'client draws {reach} (rows above), which bounds the page\'s rate'
+        + (f'; at {" and ".join(below)} it is below 30 fps before anything is drawn, so 30 fps '
+           'cannot be reached there with software GL' if below else '')
+        + '. The slider\'s latency is measured on the page\'s screencast frames (each '
+        'with its own timestamp), so it includes the frames of the software renderer until '
+        'the new body shows; the server\'s share (key press to the first frame sent) '
+        'includes the new body\'s build (table above) on the loaded machine.']
 
 
 def page(args):
