@@ -359,7 +359,9 @@ def _where_the_time_goes(r):
         'per segment, whose cost in SwiftShader grows with the instances: the traces (about '
         '1000 segments in some 45 line nodes) took most of the frame, and are now meshes '
         '(strips of two crossed rectangles, about 15 meshes; a finished chunk keeps only the '
-        'points needed to pass within 1e-3 body sizes of every sample). The environment map '
+        'points needed to pass within 1e-3 body sizes of every sample), but for the current '
+        'chunk of each trace (at most 64 segments, resent at every frame sent): a line costs '
+        'the server a quarter of a strip\'s vertices to build and send. The environment map '
         'and shadow maps were already off; the grid, the two disks\' meshes, the arrows and '
         'the plots (redrawn 5 times a second) cost the rest.', '',
         f'The targets under software GL on this 2-core machine: an empty page of the same '

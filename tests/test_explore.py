@@ -281,8 +281,8 @@ def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, ser
     """2 s of the oloid: the strips of the finished traces have fewer points than samples,
     and every sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of
     the centre line drawn (sent as float32: 1e-6 m of rounding allowed), two rectangles
-    TRACE_WIDTH x size wide across it at +-45 deg to the ground; the current chunk's strip
-    goes on from the finished one's last point to the last sample. Chunks of 32 points in
+    TRACE_WIDTH x size wide across it at +-45 deg to the ground; the current chunk's lines
+    go on from the finished one's last point to the last sample. Chunks of 32 points in
     groups of 2, so that 2 s of 100 samples a second make several groups."""
     from twodisk_ros.explore import scene3d
     from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, TRACE_WIDTH, Scene3D
@@ -319,10 +319,11 @@ def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, ser
         assert np.abs(np.einsum('kjc,kc->kj', across, course)).max() <= 1e-4 * TRACE_WIDTH \
             * scene.size
         last = ends[-1]
-        if 'now' in traces.handles:                   # the current chunk's strip
-            current, now = _centre_line(traces.handles['now'][k], traces.lift)
-            assert np.abs(current[0] - last).max() <= 1e-6
-            last = now[-1]
+        if 'now' in traces.handles:                   # the current chunk's lines
+            now = np.asarray(traces.handles['now'][k].points, dtype=float) - traces.lift
+            assert np.abs(now[0, 0] - last).max() <= 1e-6
+            assert np.abs(now[1:, 0] - now[:-1, 1]).max() <= 1e-6          # one chain
+            last = now[-1, 1]
         assert np.abs(last - samples[-1]).max() <= 1e-6
 
 

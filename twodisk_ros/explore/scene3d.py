@@ -36,6 +36,10 @@ TRACE_TOLERANCE = 1e-3
 #: software GL pays for every instance: the traces as lines cost the page most of its frame
 #: (docs/benchmarks.md).
 SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.02
+#: Width on screen (px) of the current chunk of a trace, drawn as lines: it is resent at
+#: every frame sent, and a line costs the server a quarter of a strip's vertices to build and
+#: send (the strips of the finished chunks are sent once a chunk).
+TRACE_PX = 2.0
 #: The traces' strips run this far (× their width) above the points, so that they stay above
 #: the ground (their lower edges 0.35 width below their centre lines).
 TRACE_LIFT = 0.4
@@ -112,8 +116,9 @@ def ribbon(points, normal, width):
 
 
 class Traces:
-    """Traces of A, B and G as strips (:func:`ribbon`, meshes in their colours): the current
-    chunk (part ``'now'``) and the finished chunks of :data:`TRACE_CHUNK` points, simplified,
+    """Traces of A, B and G in their colours: the current chunk (part ``'now'``, resent at
+    every frame: lines, cheap to send) and, as strips (:func:`ribbon`, meshes sent once a
+    chunk), the finished chunks of :data:`TRACE_CHUNK` points, simplified,
     in groups of :data:`TRACE_GROUP` (parts ``('done', group)``); the oldest group is dropped
     while the others keep ``length`` points per trace (so up to TRACE_GROUP × TRACE_CHUNK
     more are kept). Software GL pays for every draw call and every line instance
@@ -147,15 +152,21 @@ class Traces:
                         for c, p in zip(self.current, (a, b, g))]
 
     def _send(self, which, per_key):
-        """(Re)send part ``which``: each trace's polyline (segments (k, 2, 3)) as a strip."""
+        """(Re)send part ``which``: each trace's polyline (segments (k, 2, 3)), the current
+        chunk as screen-width lines, a group of finished chunks as a strip."""
         if self.handles is None:
             self.handles = {}
         meshes = []
         for (key, colour), segments in zip(self.KEYS, per_key):
+            if which == 'now':
+                meshes.append(self.scene.add_line_segments(
+                    f'/world/traces/now_{key}', (segments + self.lift).astype(np.float32),
+                    rgb255(colour), thickness=TRACE_PX, thickness_units='screen'))
+                continue
             points = np.concatenate([segments[:, 0], segments[-1:, 1]]) + self.lift
             vertices, faces = ribbon(points, self.normal, self.width)
             # a node of the same name replaces the old one in the same message
-            name = which if which == 'now' else f'done{which[1]}'
+            name = f'done{which[1]}'
             meshes.append(self.scene.add_mesh_simple(
                 f'/world/traces/{name}_{key}', vertices.astype(np.float32),
                 faces.astype(np.uint32), color=rgb255(colour), side='double',
