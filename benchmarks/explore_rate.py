@@ -156,6 +156,43 @@ def page_measures(repeats, fps_seconds):
     return result
 
 
+def empty_page_fps(fps_seconds):
+    """Frames a second of an empty page of the same client (the served one, with explore/
+    client.py's script): no node but one frame without axes, moved 30 times a second so
+    that the page draws every frame, at the two sizes: what software GL costs here before
+    anything is drawn."""
+    import threading
+    from chromium import Chromium
+    from twodisk_ros.explore.cli import _server, stop_server
+    server = _server('127.0.0.1', 0)
+    node = server.scene.add_frame('/moved', show_axes=False)
+    stop = threading.Event()
+
+    def move():
+        k = 0
+        while not stop.wait(1.0 / 30):
+            k += 1
+            node.position = (1e-3 * (k % 2), 0.0, 0.0)
+    thread = threading.Thread(target=move, daemon=True)
+    thread.start()
+    fps = {}
+    try:
+        for width, height in ((1280, 800), (800, 500)):
+            browser = Chromium(width, height)
+            try:
+                browser.goto(f'http://127.0.0.1:{server.get_port()}/')
+                browser.wait_for("document.querySelector('canvas') !== null", timeout=60)
+                time.sleep(2.0)
+                fps[f'{width}x{height}'] = browser.fps(fps_seconds)
+            finally:
+                browser.close()
+    finally:
+        stop.set()
+        thread.join()
+        stop_server(server)
+    return fps
+
+
 def _latencies(browser, explorer, body_pixels, repeats):
     """End on the slider of a (0.1 → 0.3 m) until a frame of the page's screencast (the
     compositor's frames, each with its own timestamp) shows at least twice the body's pixels
@@ -272,6 +309,8 @@ def section(r):
         *[f'| page frames a second, {size} | {value:.1f} fps'
           + _before(r, lambda run, size=size: f'{run["fps"][size]:.1f}') + ' | >= 30 fps |'
           for size, value in fps.items()],
+        *[f'| an empty page of the same client (one node moved 30 times a second), {size} | '
+          f'{value:.1f} fps{blank} | - |' for size, value in r.get('empty_fps', {}).items()],
         f'| server CPU at real time (oloid, one page connected) | {100 * r["server_cpu"]:.1f} '
         '% of a core' + _before(r, lambda run: f'{100 * run["server_cpu"]:.1f} %')
         + ' | <= 25 % |',
@@ -301,14 +340,38 @@ def section(r):
         *[f'| {name} | {v.get("theta0", math.nan):.3f} | {v.get("a", math.nan):.3f} |'
           for name, v in r['restart_s'].items()],
         '',
-        'The page\'s frame cost under software GL grows with the triangles drawn: the '
-        'traces are most of them, so a finished trace node keeps only the points needed to '
-        'pass within 1e-3 body sizes of every sample (about 0.2 px). '
-        'Software GL draws the page slowly: the frame rate is that of SwiftShader on the '
-        "machine's shared cores, not of a browser with a GPU. The on-screen latency is "
-        'measured by screenshots (each one waits for a frame), so it includes at least one '
-        'frame of the software renderer.', END]
+        *_where_the_time_goes(r), END]
     return '\n'.join(lines) + '\n'
+
+
+def _where_the_time_goes(r):
+    """The section's closing paragraphs: what a frame costs and why, and the targets."""
+    empty = r.get('empty_fps', {})
+    reach = ', '.join(f'{size}: {value:.0f} fps' for size, value in empty.items())
+    below = [size for size, value in empty.items() if value < 30]
+    return [
+        'Where a frame goes under software GL: the browser\'s GPU process (SwiftShader) '
+        'takes most of the CPU of a frame, the page\'s renderer (JavaScript, the panel, '
+        'the plots) a fifth to a third of it. Two defaults cost most: viser\'s client asks '
+        'WebGL for multisampling, which SwiftShader pays about twice for (the page\'s script, '
+        'explore/client.py, turns it off when the browser names a software renderer; a '
+        'browser with a GPU keeps it), and viser\'s lines are instanced quads, one instance '
+        'per segment, whose cost in SwiftShader grows with the instances: the traces (about '
+        '1000 segments in some 45 line nodes) took most of the frame, and are now meshes '
+        '(strips of two crossed rectangles, about 15 meshes; a finished chunk keeps only the '
+        'points needed to pass within 1e-3 body sizes of every sample), but for the current '
+        'chunk of each trace (at most 64 segments, resent at every frame sent): a line costs '
+        'the server a quarter of a strip\'s vertices to build and send. The environment map '
+        'and shadow maps were already off; the grid, the two disks\' meshes, the arrows and '
+        'the plots (redrawn 5 times a second) cost the rest.', '',
+        f'The targets under software GL on this 2-core machine: an empty page of the same '
+        f'client draws {reach} (rows above), which bounds the page\'s rate'
+        + (f'; at {" and ".join(below)} it is below 30 fps before anything is drawn, so 30 fps '
+           'cannot be reached there with software GL' if below else '')
+        + '. The slider\'s latency is measured on the page\'s screencast frames (each '
+        'with its own timestamp), so it includes the frames of the software renderer until '
+        'the new body shows; the server\'s share (key press to the first frame sent) '
+        'includes the new body\'s build (table above) on the loaded machine.']
 
 
 def page(args):
@@ -350,6 +413,7 @@ def main():
     if args.baseline:                 # before, after, before again: the machine's load drifts
         again = baseline(args)
         results['baseline'] = {'dir': args.baseline, 'runs': [before, again]}
+    results['empty_fps'] = empty_page_fps(1.0 if args.quick else 3.0)
     results['restart_repeats'] = 2 if args.quick else 4
     results['restart_s'] = restart_times(results['restart_repeats'])
     results['lesson_seconds'] = 5.0 if args.quick else 20.0

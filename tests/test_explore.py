@@ -265,27 +265,90 @@ def test_a_simplified_trace_keeps_the_points_a_circle_needs():
     assert simplified(cusp, tolerance).tolist() == [0, 49, 98]
 
 
-def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served):
-    """2 s of the oloid: the finished trace nodes have fewer points than samples, and every
-    sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of the
-    polyline drawn (the nodes' segments, sent as float32: 1e-6 m of rounding allowed)."""
-    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, Scene3D
+def _centre_line(mesh, lift):
+    """The centre line (starts and ends of its segments, (k, 3) each) of a strip of
+    scene3d.ribbon: the midpoints of the pairs of vertices across each of its two crossed
+    rectangles (they must agree to float32 rounding), less its lift."""
+    v = np.asarray(mesh.vertices, dtype=float).reshape(-1, 8, 3)
+    mid = 0.5 * (v[:, 0::2] + v[:, 1::2])                   # (k, 4, 3)
+    assert np.abs(mid[:, 0] - mid[:, 1]).max() <= 1e-6
+    assert np.abs(mid[:, 2] - mid[:, 3]).max() <= 1e-6
+    return mid[:, 0] - lift, mid[:, 2] - lift
+
+
+def test_the_drawn_traces_pass_within_their_tolerance_of_every_sample(oloid, served,
+                                                                      monkeypatch):
+    """2 s of the oloid: the strips of the finished traces have fewer points than samples,
+    and every sample of A, B and G (the frames' own) lies within TRACE_TOLERANCE x size of
+    the centre line drawn (sent as float32: 1e-6 m of rounding allowed), two rectangles
+    TRACE_WIDTH x size wide across it at +-45 deg to the ground; the current chunk's lines
+    go on from the finished one's last point to the last sample. Chunks of 32 points in
+    groups of 2, so that 2 s of 100 samples a second make several groups."""
+    from twodisk_ros.explore import scene3d
+    from twodisk_ros.explore.scene3d import TRACE_TOLERANCE, TRACE_WIDTH, Scene3D
+    monkeypatch.setattr(scene3d, 'TRACE_GROUP', 2)
+    monkeypatch.setattr(scene3d, 'TRACE_CHUNK', 32)
     motion = LiveMotion(oloid)
     scene = Scene3D(served, motion)
     frames = [motion.advance(0.1, 10) for _ in range(20)]
     for frame in frames:
         scene.show(frame)
     traces = scene.traces
-    assert len(traces.nodes) >= 2
+    groups = sorted(part[1] for part in traces.handles if part != 'now')
+    assert len(traces.nodes) >= 3 and groups == list(range(len(groups))) and len(groups) >= 2
     for k, key in enumerate(('contact_a', 'contact_b', 'position_g')):
         samples = np.concatenate([getattr(f, key) for f in frames])
-        segments = np.concatenate([handles[k].points for handles, _ in traces.nodes])
-        drawn = np.concatenate([segments[:, 0], segments[-1:, 1]]).astype(float)
-        assert np.array_equal(segments[1:, 0], segments[:-1, 1])      # one chain
-        covered = samples[:sum(n for _, n in traces.nodes) + 1]
+        lines = [_centre_line(traces.handles['done', g][k], traces.lift) for g in groups]
+        starts, ends = (np.concatenate(part) for part in zip(*lines))
+        assert np.abs(ends[:-1] - starts[1:]).max() <= 1e-6              # one chain
+        drawn = np.concatenate([starts, ends[-1:]])
+        covered = samples[:sum(node[1] for node in traces.nodes) + 1]
         assert len(drawn) < 0.7 * len(covered)
         tolerance = TRACE_TOLERANCE * scene.size + 1e-6
         assert _distance_to_polyline(covered, drawn).max() <= tolerance
+        v = np.concatenate([np.asarray(traces.handles['done', g][k].vertices, dtype=float)
+                            for g in groups]).reshape(-1, 8, 3)
+        across = v[:, [1, 3]] - v[:, [0, 2]]                # (k, 2, 3): the two rectangles
+        assert np.allclose(np.linalg.norm(across, axis=2), TRACE_WIDTH * scene.size, atol=1e-6)
+        # at +-45 deg to the ground, across the segment's course on the ground (cosines:
+        # float32 vertices near 0.3 m give 3e-8 m differences over a width of 2e-3 m)
+        up = across @ traces.normal / (TRACE_WIDTH * scene.size)
+        assert np.allclose(np.sort(up, axis=1), [-math.sqrt(0.5), math.sqrt(0.5)], atol=1e-4)
+        course = (ends - starts) - np.outer((ends - starts) @ traces.normal, traces.normal)
+        course /= np.linalg.norm(course, axis=1, keepdims=True)
+        assert np.abs(np.einsum('kjc,kc->kj', across, course)).max() <= 1e-4 * TRACE_WIDTH \
+            * scene.size
+        last = ends[-1]
+        if 'now' in traces.handles:                   # the current chunk's lines
+            now = np.asarray(traces.handles['now'][k].points, dtype=float) - traces.lift
+            assert np.abs(now[0, 0] - last).max() <= 1e-6
+            assert np.abs(now[1:, 0] - now[:-1, 1]).max() <= 1e-6          # one chain
+            last = now[-1, 1]
+        assert np.abs(last - samples[-1]).max() <= 1e-6
+
+
+def test_a_trace_keeps_its_length_and_drops_whole_groups(served):
+    """A trace of 14 chunks of a helix, length 300 points: the finished chunks kept hold at
+    least 300 points and fewer than 300 + TRACE_GROUP x TRACE_CHUNK (the oldest group goes
+    once the others hold 300), the groups kept are the newest ones, each with its meshes,
+    and a dropped group's meshes are removed from the scene."""
+    from twodisk_ros.explore.scene3d import TRACE_CHUNK, TRACE_GROUP, Traces
+    traces = Traces(served.scene, 1.0, 300)
+    angle = 0.05 * np.arange(14 * TRACE_CHUNK)
+    helix = np.stack([np.cos(angle), np.sin(angle), 0.01 * angle], axis=1)
+    first = None
+    for start in range(0, len(helix), 32):
+        traces.extend(*(helix[start:start + 32],) * 3)
+        traces.publish()
+        if first is None and ('done', 0) in traces.handles:
+            first = traces.handles['done', 0]
+    kept = sum(node[1] for node in traces.nodes)
+    assert 300 <= kept < 300 + TRACE_GROUP * TRACE_CHUNK
+    groups = sorted({node[2] for node in traces.nodes})
+    assert groups == list(range(groups[-1] - len(groups) + 1, groups[-1] + 1))
+    assert sorted(part[1] for part in traces.handles if part != 'now') == groups
+    assert groups[0] > 0 and first[0].name not in served.scene._handle_from_node_name
+    traces.clear()
 
 
 def test_a_replay_in_the_page_has_its_controls_disabled(recording, served):

@@ -299,6 +299,24 @@ def test_a_refused_value_shows_the_nodes_reason_and_the_motion_goes_on(live):
                      f"{settings.delta}")
 
 
+#: The scene canvas's WebGL context: its antialias attribute, and the browser's renderer
+#: name asked here independently of the page's script (WEBGL_debug_renderer_info).
+MULTISAMPLING = ("(() => { const c = document.createElement('canvas').getContext('webgl2');"
+                 " const name = c.getParameter(c.getExtension('WEBGL_debug_renderer_info')"
+                 ".UNMASKED_RENDERER_WEBGL); return [name, document.querySelector('canvas')"
+                 ".getContext('webgl2').getContextAttributes().antialias]; })()")
+
+
+def test_software_gl_draws_the_page_without_multisampling(live):
+    """The browser set-up is software GL (SwiftShader, the renderer the browser names), and
+    there the page's WebGL context has no multisampling (viser asks for it: the page's
+    script, explore/client.py, takes it off); the lesson's check is in the lesson's test."""
+    _, browser, _, _ = live
+    renderer, antialias = browser.evaluate(MULTISAMPLING)
+    assert 'SwiftShader' in renderer
+    assert antialias is False
+
+
 def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     """The lesson, paused, against the projection of the frame of the node's run that its
     player shows (frame k is the scene at k / EXPORT_FPS s, its player's time to 1 ms); no
@@ -348,5 +366,6 @@ def test_the_exported_lesson_renders_the_same_scene_offline(live, tmp_path):
     check_drawn(image, parts, frame, -(g - g[2] * np.array([0.0, 0.0, 1.0])), camera,
                 _canvas(browser), usable,
                 shots / 'explore_lesson_projected.png')
+    assert browser.evaluate(MULTISAMPLING)[1] is False          # software GL, as live
     resources = browser.evaluate("performance.getEntriesByType('resource').map(e => e.name)")
     assert all(name.startswith(('file:', 'data:', 'blob:')) for name in resources), resources

@@ -138,7 +138,7 @@ def _motion(args):
 def _server(host, port):
     """A viser server on (host, port); ServeError (one line) if it cannot bind."""
     import socket
-    import viser
+    from .client import viser_server
     with socket.socket(socket.AF_INET6 if ':' in host else socket.AF_INET) as probe:
         try:
             probe.bind((host, port))
@@ -148,7 +148,7 @@ def _server(host, port):
                               + (' (the port is in use: pick another --port, or 0 for a '
                                  'free one)' if error.errno == 98 else '')) from None
     with quiet():
-        server = viser.ViserServer(host=host, port=port, verbose=False)
+        server = viser_server(host, port)
     if server.get_port() != port:       # viser moves to the next port when one is taken
         stop_server(server)
         raise _ServeError(f'cannot serve on {host}:{port}: the port is in use (pick another '
@@ -178,6 +178,7 @@ def export(motion, path, seconds=EXPORT_SECONDS, fps=EXPORT_FPS):
     and the phase, N_A, N_B, mu_required: :mod:`~twodisk_ros.explore.lesson`); return its
     size (bytes)."""
     from ..outputs import replacing
+    from .client import with_settings
     from .lesson import LessonPlots, with_plots
     from .page import PLOT_RATE
     from .scene3d import Scene3D, camera_for
@@ -199,7 +200,7 @@ def export(motion, path, seconds=EXPORT_SECONDS, fps=EXPORT_FPS):
             scene.show(frame, traces=k % every == 0 or k == frames - 1)
             plots.add(frame)
             serializer.insert_sleep(1.0 / fps)
-        html = with_plots(serializer.as_html(), plots)
+        html = with_plots(with_settings(serializer.as_html()), plots)
     finally:
         stop_server(server)
     with replacing(path) as temporary:

@@ -107,7 +107,7 @@ class Explorer:
             self.status = gui.add_markdown(self._status_text())
             self.plots_control = gui.add_checkbox(
                 'plots', True, hint='show the plots (hidden, software GL draws the page '
-                'about twice as fast: docs/benchmarks.md)')
+                '1.4 to 2.3 times as fast: docs/benchmarks.md)')
         self.plots_control.on_update(lambda _: self._show_plots())
         self.play_button.on_click(lambda _: self.toggle())
         self.reset_button.on_click(lambda _: self.reset())

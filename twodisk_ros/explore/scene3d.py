@@ -17,21 +17,32 @@ import numpy as np
 from ..model import palette
 from ..model.mesh import mesh_parts
 
-__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'simplified', 'wxyz']
+__all__ = ['MESH_RESOLUTION', 'Scene3D', 'Traces', 'camera_for', 'rgb255', 'ribbon',
+           'simplified', 'wxyz']
 
 #: Rim vertices per disk (and hull steps) of the drawn meshes.
 MESH_RESOLUTION = 128
-#: Traces: points per line node before a new node starts (a finished node is never resent).
-TRACE_CHUNK = 64
+#: Traces: points per chunk; a full chunk is simplified and moved to the finished traces, in
+#: groups of TRACE_GROUP chunks (a group's meshes are resent while it fills, never after, and
+#: dropped whole when the trace is longer than its length without it).
+TRACE_CHUNK, TRACE_GROUP = 64, 4
 #: A finished trace node keeps only the points needed to stay within this distance (× body
 #: size) of all its samples: about 0.2 px at the default camera on an 800 px high page, and
 #: software GL's cost of a frame grows with the segments drawn (docs/benchmarks.md).
 TRACE_TOLERANCE = 1e-3
-#: Widths (× body size, world units) of the contact segment and of the traces.
-SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.008
-#: Width of the traces on screen (px): screen-unit lines skip the world-unit lines' second
-#: antialiasing pass, which software GL pays for at every frame (docs/benchmarks.md).
+#: Widths (× body size, world units) of the contact segment and of the traces: a trace is a
+#: strip of two crossed rectangles (:func:`ribbon`), about 2 px wide at the default camera on
+#: an 800 px high page. viser's lines are instanced quads, one instance per segment, and
+#: software GL pays for every instance: the traces as lines cost the page most of its frame
+#: (docs/benchmarks.md).
+SEGMENT_WIDTH, TRACE_WIDTH = 0.015, 0.02
+#: Width on screen (px) of the current chunk of a trace, drawn as lines: it is resent at
+#: every frame sent, and a line costs the server a quarter of a strip's vertices to build and
+#: send (the strips of the finished chunks are sent once a chunk).
 TRACE_PX = 2.0
+#: The traces' strips run this far (× their width) above the points, so that they stay above
+#: the ground (their lower edges 0.35 width below their centre lines).
+TRACE_LIFT = 0.4
 #: Force arrows: |F| / (M g) × body size long; shaft and head radius, head length (× size).
 SHAFT, HEAD, HEAD_LENGTH = 0.008, 0.02, 0.05
 
@@ -81,28 +92,57 @@ def simplified(points, tolerance):
     return np.asarray(keep)
 
 
+def ribbon(points, normal, width):
+    """(vertices (8 (n - 1), 3), faces (4 (n - 1), 3)) of a strip along the polyline
+    ``points`` (n, 3) that shows about 0.7 ``width`` wide from any side: each segment is two
+    rectangles ``width`` wide crossing on it, at ±45° to the plane of unit ``normal``
+    (vertices 8 i + 2 j, 8 i + 2 j + 1 across rectangle j at the segment's start, 8 i + 4 +
+    2 j, 8 i + 5 + 2 j at its end: their midpoints are the polyline). A segment along
+    ``normal`` or of no length has no width."""
+    p = np.asarray(points, dtype=float)
+    d = p[1:] - p[:-1]
+    side = np.cross(normal, d)
+    length = np.linalg.norm(side, axis=1, keepdims=True)
+    side = np.divide(side, length, out=np.zeros_like(side), where=length > 0)
+    up = np.where(length > 0, np.asarray(normal, dtype=float), 0.0)
+    half = 0.5 * width * math.sqrt(0.5)
+    across = (half * (side + up), half * (side - up))
+    vertices = np.stack([p[:-1] - across[0], p[:-1] + across[0], p[:-1] - across[1],
+                         p[:-1] + across[1], p[1:] - across[0], p[1:] + across[0],
+                         p[1:] - across[1], p[1:] + across[1]], axis=1)
+    k = 8 * np.arange(len(d))[:, None]
+    faces = np.concatenate([k + [0, 1, 4], k + [4, 1, 5], k + [2, 3, 6], k + [6, 3, 7]])
+    return vertices.reshape(-1, 3), faces
+
+
 class Traces:
-    """Traces of A, B and G as line nodes of at most :data:`TRACE_CHUNK` points each; at most
-    ``length`` points per trace are kept (older nodes removed)."""
+    """Traces of A, B and G in their colours: the current chunk (part ``'now'``, resent at
+    every frame: lines, cheap to send) and, as strips (:func:`ribbon`, meshes sent once a
+    chunk), the finished chunks of :data:`TRACE_CHUNK` points, simplified,
+    in groups of :data:`TRACE_GROUP` (parts ``('done', group)``); the oldest group is dropped
+    while the others keep ``length`` points per trace (so up to TRACE_GROUP × TRACE_CHUNK
+    more are kept). Software GL pays for every draw call and every line instance
+    (docs/benchmarks.md): some 15 meshes draw what took some 45 nodes of line segments, one
+    instance per segment."""
 
     KEYS = (('a', palette.A), ('b', palette.B), ('g', palette.G))
 
-    def __init__(self, scene, size, length):
+    def __init__(self, scene, size, length, normal=(0.0, 0.0, 1.0)):
         self.scene, self.width = scene, TRACE_WIDTH * size
+        self.normal = np.asarray(normal, dtype=float)
+        self.lift = TRACE_LIFT * self.width * self.normal
         self.tolerance = TRACE_TOLERANCE * size
         self.length = max(2, int(length))
-        self.nodes = []       # [(handles, count)] finished chunks, oldest first
+        self.nodes = []       # [(segments per key, count, group)] finished chunks, oldest first
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
-        self.handles = None
+        self.handles = None   # {part: its meshes, one per trace}
         self.serial = 0
 
     def clear(self):
-        for handles, _ in self.nodes:
-            for h in handles:
-                h.remove()
         if self.handles is not None:
-            for h in self.handles:
-                h.remove()
+            for meshes in self.handles.values():
+                for h in meshes:
+                    h.remove()
         self.nodes, self.handles = [], None
         self.current = [np.zeros((0, 3)) for _ in self.KEYS]
 
@@ -111,32 +151,61 @@ class Traces:
         self.current = [np.concatenate([c, np.asarray(p, dtype=float)])
                         for c, p in zip(self.current, (a, b, g))]
 
+    def _send(self, which, per_key):
+        """(Re)send part ``which``: each trace's polyline (segments (k, 2, 3)), the current
+        chunk as screen-width lines, a group of finished chunks as a strip."""
+        if self.handles is None:
+            self.handles = {}
+        meshes = []
+        for (key, colour), segments in zip(self.KEYS, per_key):
+            if which == 'now':
+                meshes.append(self.scene.add_line_segments(
+                    f'/world/traces/now_{key}', (segments + self.lift).astype(np.float32),
+                    rgb255(colour), thickness=TRACE_PX, thickness_units='screen'))
+                continue
+            points = np.concatenate([segments[:, 0], segments[-1:, 1]]) + self.lift
+            vertices, faces = ribbon(points, self.normal, self.width)
+            # a node of the same name replaces the old one in the same message
+            name = f'done{which[1]}'
+            meshes.append(self.scene.add_mesh_simple(
+                f'/world/traces/{name}_{key}', vertices.astype(np.float32),
+                faces.astype(np.uint32), color=rgb255(colour), side='double',
+                cast_shadow=False, receive_shadow=False))
+        self.handles[which] = meshes
+
     def publish(self):
-        """Send the current chunk; start a new one when it is full; drop the oldest."""
+        """Send the current chunk; when it is full, move it (simplified) to the finished
+        node, start a new one and drop the oldest chunks."""
         if len(self.current[0]) < 2:
             return
-        if self.handles is not None:
-            for h in self.handles:
-                h.remove()
-        self.handles = []
         count = len(self.current[0])
-        for (key, colour), points in zip(self.KEYS, self.current):
-            if count >= TRACE_CHUNK:         # its last sending: only the points needed
+        finished = count >= TRACE_CHUNK
+        per_key = []
+        for points in self.current:
+            if finished:                     # kept for good: only the points needed
                 points = points[simplified(points, self.tolerance)]
-            segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
-            self.handles.append(self.scene.add_line_segments(
-                f'/world/trace_{key}/{self.serial}', segments, rgb255(colour),
-                thickness=TRACE_PX, thickness_units='screen'))
-        if count >= TRACE_CHUNK:
-            self.nodes.append((self.handles, count - 1))
-            self.handles = None
-            self.serial += 1
-            self.current = [c[-1:] for c in self.current]
-        kept = sum(n for _, n in self.nodes)
-        while self.nodes and kept - self.nodes[0][1] >= self.length:
-            handles, n = self.nodes.pop(0)
-            kept -= n
-            for h in handles:
+            per_key.append(np.stack([points[:-1], points[1:]], axis=1))
+        if not finished:
+            self._send('now', per_key)
+            return
+        group = self.serial // TRACE_GROUP
+        self.nodes.append((per_key, count - 1, group))
+        self.serial += 1
+        self.current = [c[-1:] for c in self.current]
+        kept = sum(node[1] for node in self.nodes)
+        while self.nodes[0][2] != group:
+            oldest = [node for node in self.nodes if node[2] == self.nodes[0][2]]
+            if kept - sum(node[1] for node in oldest) < self.length:
+                break
+            kept -= sum(node[1] for node in oldest)
+            del self.nodes[:len(oldest)]
+            for h in self.handles.pop(('done', oldest[0][2])):
+                h.remove()
+        self._send(('done', group), [np.concatenate([node[0][k] for node in self.nodes
+                                                     if node[2] == group])
+                                     for k in range(len(self.KEYS))])
+        if 'now' in self.handles:            # the finished chunk is in the other part now
+            for h in self.handles.pop('now'):
                 h.remove()
 
 
@@ -196,7 +265,7 @@ class Scene3D:
                 plane_color=(235, 235, 228), plane_opacity=0.6, shadow_opacity=0.0)
         if self.traces is not None:
             self.traces.clear()
-        self.traces = Traces(self.scene, self.size, s.path_length)
+        self.traces = Traces(self.scene, self.size, s.path_length, self.normal)
 
     def shift(self, position_g):
         """Minus the foot of G on the ground (m): the translation of ``/world``."""
