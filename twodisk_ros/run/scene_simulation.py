@@ -7,13 +7,9 @@ drive), poses and ground forces in the gravity-aligned ``frame_id``
 (:class:`~twodisk_ros.physics.scenes.terms.SceneTerms`), and the energy balance
 E + W − W_d = E₀ carried across commands, time-outs and runtime scene changes (each continues
 the motion from the state of the last published sample, in a new stretch). The flat free
-scene from the run's start (``theta0``, ``omega0``: no slope, drive or losses) is a scene like
-the others with its own fast solver: the level ground's
-:class:`~twodisk_ros.physics.motion.simulate.MotionStream` (closed forms, the kinematic
-quadrature at the constant |omega0|), the poses of the rolling cycle and the contact forces
-of :class:`~twodisk_ros.physics.forces.contact.ContactForceModel`, exactly as the library's
-``simulate``; there is nothing to balance, so it gives no :class:`SceneValues` (the invariant
-is E itself, or |ω| in kinematic mode).
+scene from the run's start is a scene like the others with its own fast solver
+(:class:`SceneMotion` ``run_start``), and no energy terms: E (|ω| in kinematic mode) is
+conserved.
 
 Commands (docs/physics.md "Scenes", README "Driving the body"): the speed drive's command is
 the signed angular speed Ω (rad/s; the sign of ``omega0``: + for increasing phase), followed
@@ -134,20 +130,11 @@ class SceneMotion:
     terms : SceneTerms, optional
         The tables of an earlier stretch with the same slope, heading and gravity (reused).
     run_start : bool
-        True if ``start`` is the run's own (``theta0``, ``omega0``, no work done before): in
-        the flat free settings (:func:`flat_free`) the stretch then takes the level ground's
-        fast solver (:attr:`level`).
-
-    Attributes
-    ----------
-    level : bool
-        True for the flat free scene from the run's start: the level ground's
-        :class:`~twodisk_ros.physics.motion.simulate.MotionStream` of the settings' mode (its
-        closed forms: the free motion's, or the kinematic quadrature at the constant
-        |omega0|), the rolling cycle's poses and the
-        :class:`~twodisk_ros.physics.forces.contact.ContactForceModel` forces, exactly as the
-        library's ``simulate``; no :class:`SceneValues` (nothing to balance) and no scene
-        tables unless asked for (:attr:`terms`).
+        True if ``start`` is the run's own (``theta0``, ``omega0``): the flat free settings
+        (:func:`flat_free`) then take the level ground's fast solver (``level`` True): its
+        MotionStream (closed forms, or the kinematic quadrature at |omega0|), the cycle's
+        poses and ContactForceModel's forces, exactly as ``simulate``; no SceneValues
+        (nothing to balance), scene tables only if asked for (:attr:`terms`).
     """
 
     def __init__(self, dynamics, settings, model, *, drive=None, command=None, start,

@@ -94,7 +94,7 @@ class Simulation:
         ``omega0``), the work
         done before and the balance's E₀, reused tables. Where the settings are flat, free
         and conservative and ``start`` is None the scene takes the level ground's fast solver
-        (:attr:`SceneMotion.level <twodisk_ros.run.scene_simulation.SceneMotion.level>`).
+        (``run_start`` of :class:`~twodisk_ros.run.scene_simulation.SceneMotion`).
     orientation : array (4,), optional
         The last quaternion published before (the signs stay continuous).
 
