@@ -101,7 +101,7 @@ class _NodeStart:
 
     The flat free scene's path of :class:`~twodisk_ros.run.simulation.Simulation`: the
     MotionStream of the run's description (``RunDescription.stream``, what Simulation's
-    FlatMotion samples) and the energy E = ½ J w² + V of each sample against E₀ (what
+    its level SceneMotion samples) and the energy E = ½ J w² + V of each sample against E₀ (what
     ``Simulation.invariant`` gives there). The node's pose and contact-force tables are not
     built: no claim here reads them (at 2¹⁶ nodes they cost more than the motion itself).
     """
@@ -111,7 +111,7 @@ class _NodeStart:
         from twodisk_ros.run.parameters import DEFAULTS
         from twodisk_ros.run.scene_simulation import flat_free
         settings = DEFAULTS.with_values(**values)
-        assert flat_free(settings)                 # the path of Simulation's FlatMotion
+        assert flat_free(settings)                 # Simulation's level path (SceneMotion.level)
         run = RunDescription(settings)
         self.dynamics, self.stream = run.dynamics, run.stream()
         self.t = np.arange(1, 51) / 100.0

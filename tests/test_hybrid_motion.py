@@ -17,7 +17,7 @@ from twodisk_ros.physics.motion.simulate import MotionStream
 from twodisk_ros.run.description import RunDescription
 from twodisk_ros.run.hybrid import HybridMotion
 from twodisk_ros.run.parameters import DEFAULTS
-from twodisk_ros.run.scene_simulation import FlatMotion
+from twodisk_ros.run.scene_simulation import SceneMotion
 
 pytest.importorskip('mujoco')
 
@@ -53,7 +53,10 @@ def _rolling(runs):
     """The rolling run's motion (the one :class:`~twodisk_ros.run.simulation.Simulation`
     samples for the flat free scene), from t = 0."""
     run = runs['run']
-    return FlatMotion(run.dynamics, runs['settings'], run.stream(), runs['model'])
+    motion = SceneMotion(run.dynamics, runs['settings'], runs['model'], start=run.start(),
+                         run_start=True)
+    assert motion.level          # the level ground's MotionStream, poses and forces
+    return motion
 
 
 def test_the_stretches_alternate_with_reasons(runs):

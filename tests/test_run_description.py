@@ -351,3 +351,29 @@ def test_recordings_without_the_shape_parameters_are_ellipse_runs():
     assert isinstance(run.body, EllipseBody)
     assert run.body.theta_max == EllipseBody(1.0, 0.6, 0.5).theta_max
     assert 'ellipse a = 1 m, b = 0.6 m, delta = 0.5 m' == run.shape_line
+
+
+def test_the_kinematic_flat_run_is_the_librarys_quadrature_bit_for_bit():
+    """Kinematic mode on level ground without drive or losses takes the level ground's own
+    solver inside the one motion class (SceneMotion.level): the library's ``simulate``
+    (kinematic quadrature at the constant |omega0|), the rolling cycle's poses and the
+    motor's contact forces of ContactForceModel, bit for bit, not the speed drive's DOP853
+    (which agrees only to its tolerance, ~1e-12 here)."""
+    from twodisk_ros.physics.forces.contact import ContactForceModel
+    from twodisk_ros.physics.motion.simulate import simulate
+    s = DEFAULTS.with_values(mode='kinematic', omega0=-2.5)
+    sim = Simulation(s)
+    assert sim.scene.level and sim.motion.solver == 'quadrature'
+    t = np.linspace(0.0, 1.5, 61)     # (past one cycle of the oloid at 2.5 rad/s)
+    got = sim.sample(t, forces=True)
+    want = simulate(sim.dynamics, t, mode='kinematic', theta0=s.theta0, branch=s.branch,
+                    omega0=s.omega0, method=s.method, tolerance=s.tolerance)
+    poses = sim.dynamics.cycle.poses(want.phase)
+    forces = ContactForceModel(sim.dynamics).kinematic(want.phase, 2.5)
+    assert np.array_equal(got.phase, want.phase)
+    assert np.array_equal(got.phase_rate, want.phase_rate)
+    assert np.array_equal(got.position_g, poses.position_g)
+    assert np.array_equal(got.quaternion, poses.quaternion)
+    for name in ('normal_a', 'normal_b', 'mu_required', 'force_a', 'force_b'):
+        assert np.array_equal(getattr(got.forces, name), getattr(forces, name)), name
+    assert got.scene is None and sim.invariant(got, 30)[0] == 'angular_speed'

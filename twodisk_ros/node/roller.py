@@ -98,7 +98,7 @@ class Roller(Node):
             self.get_logger().info(note)
         if self.simulation.invalid is not None:    # a slope the body cannot stand on
             self.get_logger().error(self.simulation.invalid.reason)
-        if (self.settings.method == 'table' and self.simulation.scene is None
+        if (self.settings.method == 'table' and self.simulation.scene.level
                 and self.simulation.stream.solver == 'DOP853'):
             self.get_logger().info(
                 'no closed form of this motion is resolved (a start just below the barrier '

@@ -77,9 +77,9 @@ class HybridSimulation(Simulation):
                                      self.scene.scene, start.phase, start.angular_speed, yaw,
                                      s.method, s.tolerance)
             options = dict(shift=shift, engine_start=engine_start, reason=reason)
-        elif self.scene is not None and self.scene.scene.flat_free:   # a torque drive at 0
+        elif self.scene.scene.flat_free:    # (also a torque drive at 0)
             rolling = FreeRolling(self.dynamics, self.forces, self.stream)
-        elif self.scene is not None:        # slope, damping, drive (parameters.py)
+        else:                               # slope, damping, drive (parameters.py)
             rolling = SceneRolling(self.dynamics, self.scene.terms, self.stream, start.phase,
                                    start.angular_speed, self.forces)
         self.hybrid = HybridMotion(self.dynamics, self.forces, self.stream, s.friction,

@@ -1,15 +1,15 @@
 """The node's motion in its scene, one stretch at a time (no rclpy here).
 
-:class:`~twodisk_ros.run.simulation.Simulation` samples one of two motions through the same
-interface (``sample``, ``forces``, ``track_rest``): :class:`FlatMotion` where the settings
-describe the flat, free, conservative scene and the motion starts at ``theta0`` (the
-library's MotionStream, poses and contact forces, bit for bit), and :class:`SceneMotion`
-everywhere else: the scene's stream
+:class:`~twodisk_ros.run.simulation.Simulation` samples one motion class,
+:class:`SceneMotion`, for every scene: the scene's stream
 (:func:`~twodisk_ros.physics.scenes.motion.scene_stream`, or the integrator of the speed
 drive), poses and ground forces in the gravity-aligned ``frame_id``
 (:class:`~twodisk_ros.physics.scenes.terms.SceneTerms`), and the energy balance
 E + W − W_d = E₀ carried across commands, time-outs and runtime scene changes (each continues
-the motion from the state of the last published sample, in a new stretch).
+the motion from the state of the last published sample, in a new stretch). The flat free
+scene from the run's start is a scene like the others with its own fast solver
+(:class:`SceneMotion` ``run_start``), and no energy terms: E (|ω| in kinematic mode) is
+conserved.
 
 Commands (docs/physics.md "Scenes", README "Driving the body"): the speed drive's command is
 the signed angular speed Ω (rad/s; the sign of ``omega0``: + for increasing phase), followed
@@ -25,11 +25,12 @@ import math
 import numpy as np
 
 from ..physics.forces.validity import ValidityReport
+from ..physics.motion.simulate import MotionStream
 from ..physics.scenes.scene import Scene
 from ..physics.scenes.motion import SceneStream, scene_stream
 from ..physics.scenes.terms import SceneTerms
 
-__all__ = ['FlatMotion', 'REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion',
+__all__ = ['REST_ENERGY', 'SPEED_LIMIT', 'TORQUE_LIMIT', 'SceneMotion',
            'SceneValues', 'flat_free', 'frame_metadata', 'ground_normal', 'scene_of']
 
 #: At rest: energy above the stable rest pose at most this × M g L (as physics.scene_events).
@@ -128,33 +129,64 @@ class SceneMotion:
         balance's constant; None for the start of a run.
     terms : SceneTerms, optional
         The tables of an earlier stretch with the same slope, heading and gravity (reused).
+    run_start : bool
+        True if ``start`` is the run's own (``theta0``, ``omega0``): the flat free settings
+        (:func:`flat_free`) then take the level ground's fast solver (``level`` True): its
+        MotionStream (closed forms, or the kinematic quadrature at |omega0|), the cycle's
+        poses and ContactForceModel's forces, exactly as ``simulate``; no SceneValues
+        (nothing to balance), scene tables only if asked for (:attr:`terms`).
     """
 
     def __init__(self, dynamics, settings, model, *, drive=None, command=None, start,
-                 carry=None, terms=None):
+                 carry=None, terms=None, run_start=False):
         u0, u_dot0, speed = (float(x) for x in start)
         self.scene = scene = scene_of(settings, drive, command, speed)
-        if terms is None or (terms.scene.slope, terms.scene.heading0) != (scene.slope,
-                                                                          scene.heading0):
-            terms = SceneTerms(dynamics, scene, model)
-        else:                     # the same ground and gravity: the tables are the same
+        self.dynamics, self.model = dynamics, model
+        self.level = run_start and carry is None and flat_free(settings)
+        #: the constant |omega0| (rad/s) of the kinematic mode's level stream, None if free
+        self._held = abs(settings.omega0) if settings.mode == 'kinematic' else None
+        if terms is not None and (terms.scene.slope, terms.scene.heading0) == (
+                scene.slope, scene.heading0):   # the same ground and gravity: the same tables
             terms = copy(terms)
             terms.scene = scene
-        self.terms = terms
-        if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
-            self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance,
-                                      angular_speed=speed)
-        else:
-            self.stream = scene_stream(dynamics, scene, u0, u_dot0, method=settings.method,
-                                       tolerance=settings.tolerance, terms=terms,
-                                       angular_speed=speed)
-        energy = float(terms.energy_turning(u0, speed))
-        self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x) for x in carry)
-        self.energy0 = self.carry[2]
+        elif terms is not None or not self.level:
+            terms = SceneTerms(dynamics, scene, model)
+        self._terms = terms
         self.standing = (True, '')
         self.rested = math.nan       # the time the body came to rest (s, :meth:`rest`)
-        if carry is None and scene.slope != 0.0:
-            self.standing = terms.standing()
+        if self.level:
+            self.stream = MotionStream(dynamics, u0, u_dot0, mode=settings.mode,
+                                       method=settings.method, tolerance=settings.tolerance,
+                                       angular_speed=speed)
+            self.carry = (0.0, 0.0, self.stream.initial_energy)
+        else:
+            if scene.drive == 'speed':    # (W, W_d tracked, even at a constant command)
+                self.stream = SceneStream(terms, u0, u_dot0, tolerance=settings.tolerance,
+                                          angular_speed=speed)
+            else:
+                self.stream = scene_stream(dynamics, scene, u0, u_dot0,
+                                           method=settings.method,
+                                           tolerance=settings.tolerance, terms=terms,
+                                           angular_speed=speed)
+            energy = float(terms.energy_turning(u0, speed))
+            self.carry = (0.0, 0.0, energy) if carry is None else tuple(float(x)
+                                                                         for x in carry)
+            if carry is None and scene.slope != 0.0:
+                self.standing = terms.standing()
+        self.energy0 = self.carry[2]
+
+    @property
+    def terms(self):
+        """The scene's :class:`~twodisk_ros.physics.scenes.terms.SceneTerms` (built on first
+        use by a :attr:`level` stretch, which samples without them)."""
+        if self._terms is None:
+            self._terms = SceneTerms(self.dynamics, self.scene, self.model)
+        return self._terms
+
+    @property
+    def known_terms(self):
+        """The scene's tables if they were built (for a later stretch to reuse), else None."""
+        return self._terms
 
     @property
     def solver(self):
@@ -163,8 +195,14 @@ class SceneMotion:
 
     def sample(self, t):
         """(u, u̇, ü, w, SceneValues, (G, A, B, q)) at times t (s, increasing); w = |ω_u| u̇
-        the angular speed about AB (rad/s), finite also where the body stops turning in u."""
+        the angular speed about AB (rad/s), finite also where the body stops turning in u.
+        A :attr:`level` stretch gives no ü and no SceneValues (None)."""
         t = np.asarray(t, dtype=float)
+        if self.level:
+            u, u_dot, speed = self.stream.sample_with_speed(t)
+            poses = self.dynamics.cycle.poses(u)
+            return (u, u_dot, None, speed, None,
+                    (poses.position_g, poses.contact_a, poses.contact_b, poses.quaternion))
         w0, wd0, _ = self.carry
         s = self.stream.samples(t)
         u, u_dot, u_ddot, speed = s.phase, s.phase_rate, s.phase_acceleration, s.rolling_speed
@@ -173,9 +211,16 @@ class SceneMotion:
         return u, u_dot, u_ddot, speed, values, self.terms.poses(u)
 
     def forces(self, u, u_dot, u_ddot, speed=None):
-        """The ground's forces (:class:`~twodisk_ros.physics.scenes.terms.SceneForces`) at the
-        states of :meth:`sample` (the scene's terms take u̇ and ü; ``speed`` is not needed)."""
-        return self.terms.forces(u, u_dot, u_ddot)
+        """The ground's forces at the states of :meth:`sample`: the scene's terms' from u̇
+        and ü (:class:`~twodisk_ros.physics.scenes.terms.SceneForces`); on a :attr:`level`
+        stretch the level ground's (:class:`~twodisk_ros.physics.forces.contact.
+        ContactForces`): the motor's at the constant |omega0| in kinematic mode, else the
+        free motion's from (u, w = ``speed``), finite also where u̇ is not."""
+        if not self.level:
+            return self.terms.forces(u, u_dot, u_ddot)
+        if self._held is not None:
+            return self.model.kinematic(u, self._held)
+        return self.model.dynamic(u, angular_speed=speed)
 
     @property
     def comes_to_rest(self):
@@ -230,46 +275,3 @@ class SceneMotion:
                 f'N_B={eq.normal_b:.6g} N, mu_required={eq.mu_required:.4g}{period}')))
         return values
 
-
-class FlatMotion:
-    """The flat free scene's motion: level ground, no drive, no losses, from the run's
-    :class:`~twodisk_ros.physics.motion.simulate.MotionStream`, with the poses of the rolling
-    cycle and the contact forces of the level ground
-    (:class:`~twodisk_ros.physics.forces.contact.ContactForceModel`), exactly as the library's
-    ``simulate``. Sampled as :class:`SceneMotion` is (:meth:`sample`, :meth:`forces`,
-    :meth:`track_rest`), so the simulation has one sample function.
-    """
-
-    #: nothing comes to rest without losses
-    comes_to_rest = False
-    rested = math.nan
-
-    def __init__(self, dynamics, settings, stream, model):
-        self.dynamics, self.stream, self.model = dynamics, stream, model
-        self.kinematic = settings.mode == 'kinematic'
-        self.angular_speed0 = abs(settings.omega0)
-        self.energy0 = stream.initial_energy
-
-    @property
-    def solver(self):
-        """The stream's solver ('quadrature', 'libration', 'DOP853', ...)."""
-        return self.stream.solver
-
-    def sample(self, t):
-        """(u, u̇, None, w, None, (G, A, B, q)) at times t (s, increasing), as
-        :meth:`SceneMotion.sample`: no ü or scene values; w (rad/s) finite where u̇ is not."""
-        u, u_dot, speed = self.stream.sample_with_speed(t)
-        poses = self.dynamics.cycle.poses(u)
-        return (u, u_dot, None, speed, None,
-                (poses.position_g, poses.contact_a, poses.contact_b, poses.quaternion))
-
-    def track_rest(self, t, u, u_dot, u_ddot, values):
-        """Nothing to note: the flat free motion never comes to rest by itself."""
-
-    def forces(self, u, u_dot, u_ddot, speed):
-        """The contact forces (:class:`~twodisk_ros.physics.forces.contact.ContactForces`)
-        at the states of :meth:`sample`: the motor's at the constant |omega0| in kinematic
-        mode, else the free motion's from (u, w), finite also where u̇ is not."""
-        if self.kinematic:
-            return self.model.kinematic(u, self.angular_speed0)
-        return self.model.dynamic(u, angular_speed=speed)

@@ -15,7 +15,7 @@ from ..physics.forces.contact import ContactForceModel
 from ..physics.forces.validity import check_validity
 from ..physics.motion.dynamics import PhaseState
 from .description import RunDescription
-from .scene_simulation import FlatMotion, SceneMotion, flat_free
+from .scene_simulation import SceneMotion
 
 __all__ = ['Sample', 'Simulation', 'continuous_quaternions']
 
@@ -92,8 +92,9 @@ class Simulation:
         in force and its command, the state at t = 0 (a
         :class:`~twodisk_ros.physics.motion.dynamics.PhaseState` (u, u̇, w); None: ``theta0``,
         ``omega0``), the work
-        done before and the balance's E₀, reused tables. The flat free scene's path is taken
-        where the settings are flat, free and conservative and ``start`` is None.
+        done before and the balance's E₀, reused tables. Where the settings are flat, free
+        and conservative and ``start`` is None the scene takes the level ground's fast solver
+        (``run_start`` of :class:`~twodisk_ros.run.scene_simulation.SceneMotion`).
     orientation : array (4,), optional
         The last quaternion published before (the signs stay continuous).
 
@@ -116,17 +117,12 @@ class Simulation:
         self.invalid = None        # ValidityReport of the first sample outside the model
         self._last_quaternion = orientation
         self.angular_speed0 = abs(s.omega0)
-        #: None on the flat free scene's path, else the SceneMotion of this stretch
-        self.scene = None
-        if start is None and flat_free(s):
-            self.start = None
-            self.motion = FlatMotion(self.dynamics, s, run.stream(), self.forces)
-        else:
-            self.start = run.start() if start is None else start
-            self.motion = self.scene = SceneMotion(
-                self.dynamics, s, self.forces, drive=drive, command=command, start=self.start,
-                carry=carry, terms=terms)
-            self.invalid = self.scene.standing_report()
+        #: the :class:`~twodisk_ros.run.scene_simulation.SceneMotion` of this stretch
+        self.start = run.start() if start is None else start
+        self.motion = self.scene = SceneMotion(
+            self.dynamics, s, self.forces, drive=drive, command=command, start=self.start,
+            carry=carry, terms=terms, run_start=start is None)
+        self.invalid = self.scene.standing_report()
         self.stream = self.motion.stream
         self.energy0 = self.motion.energy0
         if start is None:
@@ -136,7 +132,7 @@ class Simulation:
     def equilibria(self):
         """[(Equilibrium, period or None)] of the flat ground (empty in a scene on a slope:
         :meth:`equilibrium_values` gives the rest poses there)."""
-        if self.scene is not None and self.settings.slope != 0.0:
+        if self.settings.slope != 0.0:
             return []
         if '_equilibria' not in self.__dict__:
             self.__dict__['_equilibria'] = self.dynamics.equilibria_with_periods()
@@ -144,7 +140,7 @@ class Simulation:
 
     def equilibrium_values(self):
         """[(key, text)] of the rest poses, for the diagnostics."""
-        if self.scene is not None and self.settings.slope != 0.0:
+        if self.settings.slope != 0.0:
             return self.scene.equilibrium_values()
         return [(f'equilibrium {k}', (
             f'{eq.name}: theta={eq.theta:.9g} rad, psi={eq.psi:.9g} rad, '
@@ -173,7 +169,7 @@ class Simulation:
                          drive=drive, command=command,
                          start=PhaseState(float(sample.phase[i]), float(sample.phase_rate[i]),
                                           self.angular_speed(sample, i)), carry=carry,
-                         terms=self.scene.terms if self.scene is not None else None,
+                         terms=self.scene.known_terms,
                          orientation=sample.quaternion[i])
         if self.invalid is not None and settings.friction == self.settings.friction:
             nxt.invalid = self.invalid
@@ -184,7 +180,7 @@ class Simulation:
     def initial_state(self):
         """The :class:`~twodisk_ros.physics.motion.dynamics.PhaseState` (u0, u̇0, w0) this stretch
         starts from: w0 the angular speed about AB, finite also at a flat vertex."""
-        return self.run.start() if self.start is None else self.start
+        return self.start
 
     def sample(self, t, forces=False, time_offset=0.0):
         """Everything published at simulated times t (s, increasing array, after earlier ones).
