@@ -62,6 +62,20 @@ def _body(name):
     return _BODIES[name]
 
 
+#: the 0.1 m square (n = 4) and egg of the scenes' tests, each built once in this module
+#: (~0.5-1 s of CPU a build) for the tests that only ask them about themselves
+SMALL = {'square': (lambda: Superellipse(0.1, 0.1, 4.0), 0.05),
+         'egg': (lambda: Egg(0.1, 0.08, 0.004), 0.04)}
+
+
+def _small(name):
+    key = ('small', name)
+    if key not in _BODIES:
+        make, delta = SMALL[name]
+        _BODIES[key] = LaminaBody(make(), delta)
+    return _BODIES[key]
+
+
 def _ellipse_pair(shape):
     key = ('ellipse',) + shape
     if key not in _BODIES:
@@ -454,7 +468,7 @@ def test_bodies_describe_themselves_and_what_their_tables_cost():
     oloid = EllipseBody(0.1, 0.1, 0.05)
     assert oloid.describe() == 'a = 0.1 m, b = 0.1 m, Δ = 0.05 m'
     assert oloid.resolution_cause() == 'b/a = 1, delta/a = 0.5'
-    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    square = _small('square')
     assert square.describe() == 'superellipse a = 0.1 m, b = 0.1 m, n = 4, Δ = 0.05 m, parallel'
     assert square.resolution_cause().startswith(repr(square) + ', feature width ')
 
@@ -469,7 +483,7 @@ def test_contact_solver_and_origin_of_every_body():
     assert solver is body.contact_solver and solver.contact_solver is solver
     assert abs(solver.theta_max / body.theta_max - 1) < 1e-14
     assert np.array_equal(body.origin, np.zeros(3)) and body.offset == 0.0
-    egg = LaminaBody(Egg(0.1, 0.08, 0.004), 0.04)
+    egg = _small('egg')
     assert egg.contact_solver is egg.general
     assert np.array_equal(egg.origin, egg.general.centroid) and egg.general.centroid[1] != 0
 
@@ -479,11 +493,11 @@ def test_flat_vertex_phases_from_the_vertices_are_the_bodys_own():
     θ = 0 and ±π/2 on both branches) are among those LaminaBody finds from its phase charts
     (A and B: the turning points u = π/2, 3π/2 too, B on its tip vertex), to 1e-12 rad; none
     for an ellipse or an egg."""
-    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    square = _small('square')
     generic = RollingBody.flat_vertex_phases(square)
     own = square.flat_vertex_phases()
     assert generic.size == 6 and own.size == 8
     gaps = np.abs(np.remainder(generic[:, None] - own[None, :] + math.pi, 2 * math.pi) - math.pi)
     assert np.max(np.min(gaps, axis=1)) < 1e-12
     assert EllipseBody(0.1, 0.07, 0.04).flat_vertex_phases().size == 0
-    assert LaminaBody(Egg(0.1, 0.08, 0.004), 0.04).flat_vertex_phases().size == 0
+    assert _small('egg').flat_vertex_phases().size == 0
