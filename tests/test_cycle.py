@@ -380,15 +380,23 @@ def test_cycle_turn_and_symmetry(drawn):
 
 
 # -- lengths of the traces (no slip, integrated) -----------------------------------------------
-def _trace_length(cycle, field, n):
-    u = np.linspace(0, TWO_PI, n + 1)
-    points = getattr(cycle.state(u), field)
-    return np.linalg.norm(np.diff(points, axis=0), axis=-1).sum()
+def _trace_lengths(cycle, n):
+    """{field: polygon length} of the traces of A and B over one cycle on n + 1 phases."""
+    state = cycle.state(np.linspace(0, TWO_PI, n + 1))
+    return {field: np.linalg.norm(np.diff(getattr(state, field), axis=0), axis=-1).sum()
+            for field in ('contact_a', 'contact_b')}
+
+
+_LENGTHS = {}
 
 
 def _richardson_length(cycle, field):
-    coarse, fine = _trace_length(cycle, field, 2**15), _trace_length(cycle, field, 2**16)
-    return fine + (fine - coarse) / 3
+    """The Richardson-extrapolated length of a trace; both traces of a cycle from the same
+    states (one evaluation of 2^15 + 1 and 2^16 + 1 poses a cycle, not one per trace)."""
+    if id(cycle) not in _LENGTHS:
+        _LENGTHS[id(cycle)] = (cycle, _trace_lengths(cycle, 2**15), _trace_lengths(cycle, 2**16))
+    _, coarse, fine = _LENGTHS[id(cycle)]
+    return fine[field] + (fine[field] - coarse[field]) / 3
 
 
 @pytest.mark.parametrize('name', sorted(NAMED))
