@@ -126,9 +126,8 @@ def test_flat_vertex_equilibria_sit_exactly_on_the_vertex(shape, delta):
     below rounding there), with θ, stability and order of stability.symmetric's closed forms
     (an independent derivation from the vertex's order of contact)."""
     from twodisk_ros.physics.stability.certified import flat_vertex_phases
-    from twodisk_ros.physics.laminae.shapes import Superellipse
-    from twodisk_ros.physics.bodies.lamina_body import LaminaBody
-    body = LaminaBody(Superellipse(*shape), delta)
+    from shared_bodies import superellipse_body       # (0.1, 0.1, 4), 0.05 is other modules' too
+    body = superellipse_body(*shape, delta)
     phases = flat_vertex_phases(body)
     found = equilibria(body)
     closed = {s.name: s for s in symmetric_equilibria(body.lamina, delta)}

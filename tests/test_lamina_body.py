@@ -19,6 +19,7 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
+import shared_bodies
 from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
@@ -62,18 +63,13 @@ def _body(name):
     return _BODIES[name]
 
 
-#: the 0.1 m square (n = 4) and egg of the scenes' tests, each built once in this module
-#: (~0.5-1 s of CPU a build) for the tests that only ask them about themselves
-SMALL = {'square': (lambda: Superellipse(0.1, 0.1, 4.0), 0.05),
-         'egg': (lambda: Egg(0.1, 0.08, 0.004), 0.04)}
-
-
 def _small(name):
-    key = ('small', name)
-    if key not in _BODIES:
-        make, delta = SMALL[name]
-        _BODIES[key] = LaminaBody(make(), delta)
-    return _BODIES[key]
+    """The 0.1 m square (n = 4) or egg of the scenes' tests (tests/shared_bodies.py: built
+    once per process, ~0.5-1 s of CPU a build), for the tests that only ask them about
+    themselves."""
+    if name == 'square':
+        return shared_bodies.superellipse_body(0.1, 0.1, 4.0, 0.05)
+    return shared_bodies.egg_body(0.1, 0.08, 0.004, 0.04)
 
 
 def _ellipse_pair(shape):

@@ -23,13 +23,13 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
+import shared_bodies
 from test_scene import d5, kinematics, stencil
 import test_scene
 from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.laminae.shapes import Superellipse
 from twodisk_ros.physics.laminae.support import Egg
-from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import laminae_of, mass_properties
 from twodisk_ros.physics.scenes.scene import Scene
 from twodisk_ros.physics.scenes.closed import DriftQuadrature, conservative_solution
@@ -50,7 +50,11 @@ def dynamics_of(name):
     if name not in _DYNAMICS:
         if name in BODIES:
             lamina, delta = BODIES[name]
-            body, mass = LaminaBody(lamina, delta), laminae_of(lamina, delta, 'parallel', MASS)
+            # the same bodies as other modules' (tests/shared_bodies.py: built once a process)
+            body = (shared_bodies.superellipse_body(0.1, 0.1, 4, 0.05) if name == 'superellipse'
+                    else shared_bodies.egg_body(0.1, 0.08, 0.004, 0.04))
+            assert repr(body.lamina) == repr(lamina) and body.delta == delta
+            mass = laminae_of(lamina, delta, 'parallel', MASS)
         else:
             shape = (0.1, 0.1, 0.05)
             base = EllipseBody(*shape)
