@@ -177,13 +177,14 @@ def _axial(skew):
                            skew[..., 1, 0] - skew[..., 0, 1]], axis=-1)
 
 
-def _pose_rates(cycle, u, h=FD_STEP):
-    """World ω (rad per unit u) and Ġ (m per unit u) by 5-point differences of the poses."""
+def _pose_rates(cycle, u, h=FD_STEP, rotation=None):
+    """World ω (rad per unit u) and Ġ (m per unit u) by 5-point differences of the poses
+    (``rotation``: the rotations at u if already evaluated)."""
     states = [cycle.state(u + k * h) for k in (-2, -1, 1, 2)]
     weights = np.array([1.0, -8.0, 8.0, -1.0]) / (12 * h)
     r_dot = sum(w * s.rotation for w, s in zip(weights, states))
     g_dot = sum(w * s.position_g for w, s in zip(weights, states))
-    rotation = cycle.state(u).rotation
+    rotation = cycle.state(u).rotation if rotation is None else rotation
     omega_skew = np.einsum('...ij,...kj->...ik', r_dot, rotation)
     return _axial(omega_skew), g_dot, omega_skew
 
@@ -222,7 +223,7 @@ def _check_whole_cycles(shape, no_slip_rtol, cycle=None, material_rtol=MATERIAL_
     assert_allclose((to_body[:, 0] / b) ** 2 + ((to_body[:, 1] + delta) / a) ** 2, 1.0,
                     atol=material_rtol * size / min(a, b))
     # no slip at A and B, ω along AB, and the code's ω
-    omega, g_dot, skew = _pose_rates(cycle, u)
+    omega, g_dot, skew = _pose_rates(cycle, u, rotation=rot)
     omega_body = body.phase_angular_velocity(u)
     scale = np.linalg.norm(omega_body, axis=-1).max()
     assert_allclose(skew + np.swapaxes(skew, -1, -2), 0.0, atol=no_slip_rtol * scale)
@@ -380,15 +381,23 @@ def test_cycle_turn_and_symmetry(drawn):
 
 
 # -- lengths of the traces (no slip, integrated) -----------------------------------------------
-def _trace_length(cycle, field, n):
-    u = np.linspace(0, TWO_PI, n + 1)
-    points = getattr(cycle.state(u), field)
-    return np.linalg.norm(np.diff(points, axis=0), axis=-1).sum()
+def _trace_lengths(cycle, n):
+    """{field: polygon length} of the traces of A and B over one cycle on n + 1 phases."""
+    state = cycle.state(np.linspace(0, TWO_PI, n + 1))
+    return {field: np.linalg.norm(np.diff(getattr(state, field), axis=0), axis=-1).sum()
+            for field in ('contact_a', 'contact_b')}
+
+
+_LENGTHS = {}
 
 
 def _richardson_length(cycle, field):
-    coarse, fine = _trace_length(cycle, field, 2**15), _trace_length(cycle, field, 2**16)
-    return fine + (fine - coarse) / 3
+    """The Richardson-extrapolated length of a trace; both traces of a cycle from the same
+    states (one evaluation of 2^15 + 1 and 2^16 + 1 poses a cycle, not one per trace)."""
+    if id(cycle) not in _LENGTHS:
+        _LENGTHS[id(cycle)] = (cycle, _trace_lengths(cycle, 2**15), _trace_lengths(cycle, 2**16))
+    _, coarse, fine = _LENGTHS[id(cycle)]
+    return fine[field] + (fine[field] - coarse[field]) / 3
 
 
 @pytest.mark.parametrize('name', sorted(NAMED))

@@ -104,10 +104,12 @@ def test_certificate_sees_close_roots():
 
 
 #: superellipses with flat vertices (n > 2): a = b, b < a, a rounded square, non-even
-#: exponents (2.5, 3, 7.5), and n = 3 with a narrow well at the tips (|γ| < 1.7e-4 rad)
+#: exponents (2.5, 3, 7.5), and n = 3 with a narrow well at the tips (|γ| < 1.7e-4 rad).
+#: (0.1, 0.1, 3), Δ = 0.05 is no longer run on its own: its path (n = 3, order 3/2 ≥ 4/3 so
+#: the leading coefficient is checked, a non-even exponent) is that of (0.1, 0.08, 3),
+#: Δ = 0.03, which adds the narrow well; a = b is run at n = 2.5, 4 and 7.5
 FLAT_VERTEX_BODIES = [((0.1, 0.1, 4.0), 0.05), ((0.1, 0.07, 6.0), 0.04), ((1.0, 1.0, 10.0), 0.3),
-                      ((0.1, 0.1, 2.5), 0.05), ((0.1, 0.1, 3.0), 0.05), ((0.1, 0.08, 3.0), 0.03),
-                      ((0.1, 0.1, 7.5), 0.05)]
+                      ((0.1, 0.1, 2.5), 0.05), ((0.1, 0.08, 3.0), 0.03), ((0.1, 0.1, 7.5), 0.05)]
 #: the flat-vertex order q (z_G − z* ≈ A|γ|^q + Bγ²) estimated by the search from three levels
 #: (the γ² term eliminated), against stability.symmetric's n/(n − 1): measured ≤ 9.0e-3
 #: (n = 10, where the o(γ²) rest is largest), ≤ 2.1e-4 for n ≤ 4
@@ -124,9 +126,8 @@ def test_flat_vertex_equilibria_sit_exactly_on_the_vertex(shape, delta):
     below rounding there), with θ, stability and order of stability.symmetric's closed forms
     (an independent derivation from the vertex's order of contact)."""
     from twodisk_ros.physics.stability.certified import flat_vertex_phases
-    from twodisk_ros.physics.laminae.shapes import Superellipse
-    from twodisk_ros.physics.bodies.lamina_body import LaminaBody
-    body = LaminaBody(Superellipse(*shape), delta)
+    from shared_bodies import superellipse_body       # (0.1, 0.1, 4), 0.05 is other modules' too
+    body = superellipse_body(*shape, delta)
     phases = flat_vertex_phases(body)
     found = equilibria(body)
     closed = {s.name: s for s in symmetric_equilibria(body.lamina, delta)}

@@ -19,6 +19,7 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from rounding import ulps
+import shared_bodies
 from twodisk_ros.physics.bodies.ellipse import EllipseBody
 from twodisk_ros.physics.bodies.cycle import RollingCycle
 from twodisk_ros.physics.laminae.shapes import Ellipse, Superellipse
@@ -60,6 +61,15 @@ def _body(name):
         make, delta, arrangement = SHAPES[name]
         _BODIES[name] = LaminaBody(make(), delta, arrangement)
     return _BODIES[name]
+
+
+def _small(name):
+    """The 0.1 m square (n = 4) or egg of the scenes' tests (tests/shared_bodies.py: built
+    once per process, ~0.5-1 s of CPU a build), for the tests that only ask them about
+    themselves."""
+    if name == 'square':
+        return shared_bodies.superellipse_body(0.1, 0.1, 4.0, 0.05)
+    return shared_bodies.egg_body(0.1, 0.08, 0.004, 0.04)
 
 
 def _ellipse_pair(shape):
@@ -454,7 +464,7 @@ def test_bodies_describe_themselves_and_what_their_tables_cost():
     oloid = EllipseBody(0.1, 0.1, 0.05)
     assert oloid.describe() == 'a = 0.1 m, b = 0.1 m, Δ = 0.05 m'
     assert oloid.resolution_cause() == 'b/a = 1, delta/a = 0.5'
-    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    square = _small('square')
     assert square.describe() == 'superellipse a = 0.1 m, b = 0.1 m, n = 4, Δ = 0.05 m, parallel'
     assert square.resolution_cause().startswith(repr(square) + ', feature width ')
 
@@ -469,7 +479,7 @@ def test_contact_solver_and_origin_of_every_body():
     assert solver is body.contact_solver and solver.contact_solver is solver
     assert abs(solver.theta_max / body.theta_max - 1) < 1e-14
     assert np.array_equal(body.origin, np.zeros(3)) and body.offset == 0.0
-    egg = LaminaBody(Egg(0.1, 0.08, 0.004), 0.04)
+    egg = _small('egg')
     assert egg.contact_solver is egg.general
     assert np.array_equal(egg.origin, egg.general.centroid) and egg.general.centroid[1] != 0
 
@@ -479,11 +489,11 @@ def test_flat_vertex_phases_from_the_vertices_are_the_bodys_own():
     θ = 0 and ±π/2 on both branches) are among those LaminaBody finds from its phase charts
     (A and B: the turning points u = π/2, 3π/2 too, B on its tip vertex), to 1e-12 rad; none
     for an ellipse or an egg."""
-    square = LaminaBody(Superellipse(0.1, 0.1, 4.0), 0.05)
+    square = _small('square')
     generic = RollingBody.flat_vertex_phases(square)
     own = square.flat_vertex_phases()
     assert generic.size == 6 and own.size == 8
     gaps = np.abs(np.remainder(generic[:, None] - own[None, :] + math.pi, 2 * math.pi) - math.pi)
     assert np.max(np.min(gaps, axis=1)) < 1e-12
     assert EllipseBody(0.1, 0.07, 0.04).flat_vertex_phases().size == 0
-    assert LaminaBody(Egg(0.1, 0.08, 0.004), 0.04).flat_vertex_phases().size == 0
+    assert _small('egg').flat_vertex_phases().size == 0

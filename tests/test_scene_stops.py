@@ -23,13 +23,13 @@ import numpy as np
 import pytest
 
 from reparametrised_body import ReparametrisedBody
+import shared_bodies
 from test_scene import d5, kinematics, stencil
 import test_scene
 from twodisk_ros.physics import MotionStream, RollingDynamics, EllipseBody
 from twodisk_ros.physics.forces.contact import ContactForceModel
 from twodisk_ros.physics.laminae.shapes import Superellipse
 from twodisk_ros.physics.laminae.support import Egg
-from twodisk_ros.physics.bodies.lamina_body import LaminaBody
 from twodisk_ros.physics.mass.models import laminae_of, mass_properties
 from twodisk_ros.physics.scenes.scene import Scene
 from twodisk_ros.physics.scenes.closed import DriftQuadrature, conservative_solution
@@ -50,7 +50,11 @@ def dynamics_of(name):
     if name not in _DYNAMICS:
         if name in BODIES:
             lamina, delta = BODIES[name]
-            body, mass = LaminaBody(lamina, delta), laminae_of(lamina, delta, 'parallel', MASS)
+            # the same bodies as other modules' (tests/shared_bodies.py: built once a process)
+            body = (shared_bodies.superellipse_body(0.1, 0.1, 4, 0.05) if name == 'superellipse'
+                    else shared_bodies.egg_body(0.1, 0.08, 0.004, 0.04))
+            assert repr(body.lamina) == repr(lamina) and body.delta == delta
+            mass = laminae_of(lamina, delta, 'parallel', MASS)
         else:
             shape = (0.1, 0.1, 0.05)
             base = EllipseBody(*shape)
@@ -66,27 +70,45 @@ def dynamics_of(name):
 STOP_STEP = 1e-3
 
 
+def stop_phases(terms):
+    """The phases (rad, in [0, 2π)) of the table's nodes where |ω_u| = 0 (to 1e-6 of the
+    turn scale): the stops."""
+    n = terms.table_nodes
+    nodes = 2 * math.pi * np.arange(n) / n
+    return nodes[terms.rows(nodes)[:, W] < 1e-6 * terms.turn_scale]
+
+
 def stop_times(terms, stream, t_start, t_end):
     """Instants (s) at which u crosses a phase where |ω_u| = 0: the first time past each
     crossing on a grid of STOP_STEP."""
-    n = terms.table_nodes
-    nodes = 2 * math.pi * np.arange(n) / n
-    stops = nodes[terms.rows(nodes)[:, W] < 1e-6 * terms.turn_scale]
+    stops = stop_phases(terms)
     grid = np.linspace(t_start, t_end, int(math.ceil((t_end - t_start) / STOP_STEP)) + 1)
     u = stream.state(grid)[0]
     found = [grid[1:][np.diff(np.floor((u - s) / (2 * math.pi))) != 0] for s in stops]
     return np.sort(np.concatenate(found)) if found else np.zeros(0)
 
 
-def run(name, scene, duration, w0=3.0, u0=0.3, count=40):
+#: the span (s) of run()'s motions: the superellipse's u passes 3 to 6 of its stops in it in
+#: every scene below (measured: 6 on the slope and with the speed drive, 5 with the torque,
+#: 3 with damping or rolling resistance; checked in run()), the egg rocks or rolls on; 1.5 s
+#: before, the same 40 stencils
+DURATION = 1.0
+
+
+def run(name, scene, duration=DURATION, w0=3.0, u0=0.3, count=40):
     """Samples at stencils about centres ≥ STOP_GAP from the stops, and E etc. from poses."""
     dynamics = dynamics_of(name)
     terms = SceneTerms(dynamics, scene)
     stream = SceneStream(terms, u0, None, angular_speed=w0, tolerance=1e-12)
     centres = np.linspace(0.01, duration, count)
     times = stencil(centres)
-    stream.samples(times)                        # integrate, then read the window
-    stops = stop_times(terms, stream, times[0], times[-1])
+    # integrate, then read the window; STOP_GAP past the last stencil, so that a stop just
+    # after the last centre is found too (over [0.01, 1] s the superellipse on the slope has
+    # one at ~1.0005 s, within the last stencil: its E from poses was 2e-7 M g L off)
+    end = times[-1] + STOP_GAP + STOP_STEP
+    stream.samples(np.append(times, end))
+    stops = stop_times(terms, stream, times[0], end)
+    assert stops.size >= (3 if name == 'superellipse' else 0), stops   # through the stops
     if stops.size:
         gap = centres[:, None] - stops                 # the stop is within STOP_STEP before
         far = np.minimum(np.abs(gap), np.abs(gap + STOP_STEP))
@@ -98,7 +120,7 @@ def run(name, scene, duration, w0=3.0, u0=0.3, count=40):
 
 @pytest.mark.parametrize('name', ['superellipse', 'egg'])
 def test_energy_on_a_slope_is_conserved_from_poses(name):
-    terms, samples, kin = run(name, Scene(gravity=GRAVITY, slope=0.1, heading0=0.3), 1.5)
+    terms, samples, kin = run(name, Scene(gravity=GRAVITY, slope=0.1, heading0=0.3))
     scale = terms.dynamics.energy_scale
     assert kin['energy'].size >= 15
     assert np.max(np.abs(kin['energy'] - kin['energy'][0])) < ENERGY_TOL * scale
@@ -115,7 +137,7 @@ def test_energy_on_a_slope_is_conserved_from_poses(name):
     Scene(gravity=GRAVITY, slope=0.05, heading0=1.0, rolling_resistance=0.02),
     Scene(gravity=GRAVITY, drive='torque', command=0.03)], ids=['damping', 'rolling', 'torque'])
 def test_works_follow_their_laws_and_balance_the_energy_from_poses(name, scene):
-    terms, samples, kin = run(name, scene, 1.5)
+    terms, samples, kin = run(name, scene)
     scale = terms.dynamics.energy_scale
     mid = slice(2, None, 5)
     # E from poses + the works = E₀ (module's works; checks the equation of motion)
@@ -147,7 +169,7 @@ def test_works_follow_their_laws_and_balance_the_energy_from_poses(name, scene):
 def test_speed_drive_follows_the_lag_through_the_stops(name):
     command, lag, w0 = 7.0, 0.4, 3.0
     scene = Scene(gravity=GRAVITY, drive='speed', command=command, lag=lag, slope=0.05)
-    terms, samples, kin = run(name, scene, 1.5, w0=w0)
+    terms, samples, kin = run(name, scene, w0=w0)
     expected = command + (w0 - command) * np.exp(-samples.t[2::5] / lag)
     assert np.max(np.abs(np.linalg.norm(kin['omega'], axis=-1) - expected)) < 1e-8 * command
     balance = kin['energy'] + samples.dissipated[2::5] - samples.drive_work[2::5]
@@ -157,10 +179,15 @@ def test_speed_drive_follows_the_lag_through_the_stops(name):
 @pytest.mark.parametrize('name', ['superellipse', 'egg', 'degenerate'])
 def test_flat_scene_through_the_scene_integrator_is_the_level_grounds_motion(name):
     # DOP853 in τ on the scene's tables against the level ground's MotionStream (closed-form
-    # quadrature or SundmanSolution): G's position over 3 s, both at rtol 1e-12
+    # quadrature or SundmanSolution): G's position over 1.5 s, both at rtol 1e-12. 1.5 s (3 s
+    # before, the same 0.05 s samples) still rolls through the stops: the superellipse's u
+    # from 0.3 to 4.9 (six of its stops kπ/4) and from 0 to 3.4 (four), the double's through
+    # v = π from both starts (to 4.6 and 3.9), the egg over a whole cycle (to 7.0); checked
+    # below for the bodies with stops
     dynamics = dynamics_of(name)
     terms = SceneTerms(dynamics, Scene(gravity=GRAVITY))
-    t = np.linspace(0.0, 3.0, 61)
+    t = np.linspace(0.0, 1.5, 31)
+    stops = stop_phases(terms)
     # u0 = 0: on a stop of the superellipse and the double. Today's MotionStream refuses
     # the egg below its barrier ('does not advance monotonically', physics/motion_general,
     # not a scene: reported), so the egg rolls over (w0 = 6 rad/s)
@@ -170,6 +197,9 @@ def test_flat_scene_through_the_scene_integrator_is_the_level_grounds_motion(nam
         ref_u, _ = MotionStream(dynamics, u0, None, angular_speed=w0, tolerance=1e-12).sample(t)
         gap = dynamics.cycle.positions(got.phase)[0] - dynamics.cycle.positions(ref_u)[0]
         assert np.max(np.abs(gap)) < 1e-9 * dynamics.body.size, (u0, np.max(np.abs(gap)))
+        # u rises through at least one stop past its start (u only rises here)
+        assert np.all(np.diff(got.phase) > 0)
+        assert (name == 'egg') == (not np.any((stops > u0) & (stops < got.phase[-1]))), u0
         assert np.all(np.isfinite(got.energy)) and np.ptp(got.energy) < 1e-9 * \
             dynamics.energy_scale
 
@@ -181,9 +211,13 @@ def test_closed_form_rolls_through_the_stops_on_a_slope():
     stream = scene_stream(dynamics, scene, 0.0, None, angular_speed=3.0, terms=terms)
     assert isinstance(stream, ClosedSceneStream)
     assert isinstance(stream.solution, DriftQuadrature)
-    t = np.linspace(0.0, 2.0, 401)
+    # 1 s (2 s before, the same 5 ms samples): u from 0 (a stop) to 5.07 rad, through six
+    # more stops kπ/4 (asserted); DOP853 at rtol 1e-13 took 2 s of CPU for the 2 s
+    t = np.linspace(0.0, 1.0, 201)
     closed = stream.samples(t)
     ode = SceneStream(terms, 0.0, None, angular_speed=3.0, tolerance=1e-13).samples(t)
+    laps = np.floor((closed.phase[:, None] - stop_phases(terms)) / (2 * math.pi))
+    assert np.all(np.diff(closed.phase) > 0) and np.sum(np.diff(laps, axis=0)) >= 6
     # both from the same tables: the quadrature's and DOP853's errors (measured below 1e-10)
     assert np.max(np.abs(closed.phase - ode.phase)) < 1e-9
     assert np.max(np.abs(closed.rolling_speed - ode.rolling_speed)) < 1e-9 * np.max(
