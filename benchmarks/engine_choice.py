@@ -7,11 +7,13 @@ convex hulls, the mass model's mass and inertia about G, Coulomb μ, the ground 
 z = 0 of the (slope) frame, gravity tilted in it, time step 0.5 ms (MuJoCo's default setting,
 :class:`~twodisk_ros.engine.model.ContactParameters`). MuJoCo runs through
 :class:`~twodisk_ros.engine.run.Engine` (its soft contact, τ = 5 ms, implicitfast, elliptic
-cone). Drake (pydrake, MultibodyPlant, discrete) uses **point contact** (one contact per plate
-and ground, compliant: stiffness 1e6 N/m per geometry, 5e5 N/m per contact, so G sinks about
-as deep as in MuJoCo at rest; Hunt–Crossley dissipation 50 s/m) with Drake's default discrete
-solver, **SAP** with the *lagged* approximation. Hydroelastic contact is not tried: the plates
-are 0.1 mm thick prisms, and hydroelastic needs compliant volumes.
+cone), and at benchmarks/hybrid_cost.py's finer settings (n = 2048, τ = 1 ms, h = 0.1 ms:
+"MuJoCo fine"). Drake (pydrake, MultibodyPlant, discrete) uses **point contact** (one contact
+per plate and ground, compliant: stiffness 1e6 N/m per geometry, 5e5 N/m per contact, so G
+sinks M g / 1e6 N/m ≈ 1e-5 m at rest, MuJoCo's 1.4e-5 m; Hunt–Crossley dissipation 50 s/m), solved by
+**TAMSI** and by **SAP** (its *lagged* approximation, Drake's default: the same contact model
+as TAMSI). Hydroelastic contact is not tried: the plates are 0.1 mm thick prisms, and
+hydroelastic contact needs compliant volumes.
 
 Runs, each engine from the same state, G sampled every 10 ms:
 
@@ -24,7 +26,10 @@ Runs, each engine from the same state, G sampled every 10 ms:
     on level ground: G against the package's exact rolling motion
     (:class:`~twodisk_ros.run.simulation.Simulation`, contact_model rolling);
 (d) rounded square (config/rounded_square.yaml, μ = 0.5) from its start: the energy
-    E = ½ M v² + ½ ωᵀ I ω + M g z against E(0) (the exact body keeps it), and the cost.
+    E = ½ M v² + ½ ωᵀ I ω + M g z over the run (the body slips at its vertices, where
+    friction takes energy: no exact reference), and the cost;
+(e) (c) over 1 s stepped one step at a time from Python, the state read after each step (as
+    the hybrid steps its engine stretches): the cost per simulated second.
 
 For each: CPU seconds (process time of the stepping) per simulated second, the errors and the
 penetration (the deepest mesh vertex below the ground over the run). Engines alternate run by
@@ -33,8 +38,9 @@ recorded with each case. Writes the section between ``<!-- engine-choice:begin -
 ``<!-- engine-choice:end -->`` of docs/benchmarks.md and prints JSON.
 
 Needs pydrake, which is not a dependency of the package: run it with a scratch venv, e.g.
-``python -m venv /tmp/drakevenv && /tmp/drakevenv/bin/python -m pip install drake==1.51.1``
-plus the package's pins of numpy, scipy, PyYAML, mujoco and mujoco-core, then
+``python -m venv /tmp/drakevenv && python -m pip --python /tmp/drakevenv/bin/python install
+drake==1.51.1`` plus the package's pins (requirements.txt) of numpy, scipy, PyYAML, mujoco and
+mujoco-core, then
 ``PYTHONPATH=$PWD /tmp/drakevenv/bin/python benchmarks/engine_choice.py [--quick]``.
 """
 
@@ -56,8 +62,8 @@ DT = 0.01                    #: s between samples
 STIFFNESS = 1e6              #: N/m, Drake point contact, per geometry
 DISSIPATION = 50.0           #: s/m, Drake Hunt–Crossley dissipation
 HOW = ('engine_choice.py needs pydrake (Drake), not a dependency: python -m venv /tmp/drakevenv '
-       '&& /tmp/drakevenv/bin/python -m pip install drake==1.51.1 (and the pins of numpy, scipy, '
-       'PyYAML, mujoco, mujoco-core), then run it with /tmp/drakevenv/bin/python')
+       '&& python -m pip --python /tmp/drakevenv/bin/python install drake==1.51.1 and the pins of '
+       'numpy, scipy, PyYAML, mujoco, mujoco-core; run it with /tmp/drakevenv/bin/python')
 
 
 def _parser():
@@ -118,9 +124,10 @@ class MujocoFine(MujocoBody):
 
 
 class DrakeBody:
-    """The same body in Drake's MultibodyPlant (module docstring)."""
+    """The same body in Drake's MultibodyPlant (module docstring), SAP solver."""
 
-    name = 'Drake'
+    name = 'Drake SAP'
+    approximation = 'lagged'    #: Drake's default: the TAMSI model solved by SAP
 
     def __init__(self, dyn, mu, slope):
         import numpy as np
@@ -139,7 +146,8 @@ class DrakeBody:
         p = ContactParameters(mu=mu)
         builder = DiagramBuilder()
         plant, _ = AddMultibodyPlant(MultibodyPlantConfig(
-            time_step=p.timestep, contact_model='point', discrete_contact_approximation='lagged'),
+            time_step=p.timestep, contact_model='point',
+            discrete_contact_approximation=self.approximation),
             builder)
         i = dyn.mass.inertia
         inertia = RotationalInertia(i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2])
@@ -186,6 +194,13 @@ class DrakeBody:
         velocity = self.plant.EvalBodySpatialVelocityInWorld(self.context, self.body)
         return (pose.translation().copy(), pose.rotation().matrix().copy(),
                 velocity.translational().copy(), velocity.rotational().copy())
+
+
+class DrakeTamsi(DrakeBody):
+    """The same, TAMSI solver (same contact model as SAP's lagged approximation)."""
+
+    name = 'Drake TAMSI'
+    approximation = 'tamsi'
 
 
 def _vertices(dyn):
@@ -340,14 +355,32 @@ def case_square(engine_class, quick):
     return _rolling_case(engine_class, settings, run, 1.0 if quick else 3.0)
 
 
+def case_steps(engine_class, quick):
+    """The oloid rolling for 1 s, stepped one step at a time from Python with the state read
+    after each step (as the hybrid steps its engine stretches, checking its return rule)."""
+    from twodisk_ros.engine.model import ContactParameters
+    from twodisk_ros.engine.state import engine_state
+    settings, run = _oloid()
+    state = engine_state(run.dynamics, run.start().phase, settings.omega0)
+    engine = engine_class(run.dynamics, settings.friction, 0.0)
+    engine.start(state.qpos, state.qvel)
+    step = ContactParameters(**getattr(engine_class, 'changes', {})).timestep
+    count = int(round(1.0 / step))
+    clock = time.process_time()
+    for k in range(1, count + 1):
+        engine.advance(k * step)
+        engine.state()
+    return dict(span=1.0, cpu=time.process_time() - clock, build=0.0)
+
+
 CASES = (('slide', case_slide), ('flight', case_flight), ('rolling', case_rolling),
-         ('square', case_square))
+         ('square', case_square), ('steps', case_steps))
 
 
 def measure(quick=False, repeats=3):
     """{case: {'load': [...], engine: result (least CPU of the repeats, 'cpus': all)}}."""
     sys.path.insert(0, ROOT)
-    engines = (MujocoBody, DrakeBody, MujocoFine)
+    engines = (MujocoBody, DrakeTamsi, DrakeBody, MujocoFine)
     out = {}
     for name, case in CASES:
         results = {e.name: [] for e in engines}
@@ -372,60 +405,65 @@ def _per_second(r):
 
 
 def section(out, machine, date, commit):
-    m, d, fine = 'MuJoCo', 'Drake', 'MuJoCo fine'
+    names = ('MuJoCo', 'Drake TAMSI', 'Drake SAP', 'MuJoCo fine')
+    m = names[0]
     s, f, r, q = (out[k] for k in ('slide', 'flight', 'rolling', 'square'))
     loads = ', '.join(f'{k} {c["load"][0]:.1f}–{c["load"][1]:.1f}' for k, c in out.items())
     lines = [BEGIN, '## Beyond rolling: which free-body engine (MuJoCo or Drake)', '',
              f'`benchmarks/engine_choice.py` (run with pydrake in a scratch venv, drake 1.51.1; '
              f'not a dependency), {date}, commit {commit[:10]}, {machine}; load average during '
              f'each case: {loads} (the machine is shared: the CPU ratios are those of runs '
-             'alternated in one process, least of the repeats). The same body in both '
-             '(config/oloid.yaml\'s plates, n = 512, as convex hulls; the mass model\'s mass '
-             'and inertia; Coulomb μ; step 0.5 ms). MuJoCo: the package\'s engine '
-             '(twodisk_ros/engine, soft contact τ = 5 ms, implicitfast, elliptic cone). Drake: '
-             'MultibodyPlant, point contact (compliant, 1e6 N/m per geometry, Hunt–Crossley '
-             '50 s/m), SAP solver (lagged approximation, Drake\'s default). Penetration: the '
-             'deepest mesh vertex below the ground over the run. CPU: process time of the '
-             'stepping per simulated second.', '',
-             '"MuJoCo fine" is MuJoCo at benchmarks/hybrid_cost.py\'s finer settings '
-             '(n = 2048, τ = 1 ms, h = 0.1 ms).', '',
-             '| run | quantity | MuJoCo | Drake | MuJoCo fine |', '| --- | --- | --- | --- | --- |']
+             'alternated in one process, the least of the repeats). The same body in each '
+             '(the plates of twodisk_ros/engine/model.py, n = 512, as convex hulls; the mass '
+             'model\'s mass and inertia; Coulomb μ; step 0.5 ms). **MuJoCo**: the package\'s '
+             'engine (twodisk_ros/engine: soft contact τ = 5 ms, implicitfast, elliptic cone). '
+             '**Drake**: MultibodyPlant, point contact (compliant, 1e6 N/m per geometry, '
+             'Hunt–Crossley dissipation 50 s/m), with the TAMSI solver or the SAP solver (its '
+             '*lagged* approximation, Drake\'s default: the same contact model as TAMSI, so the '
+             'same motion to the solvers\' tolerance). **MuJoCo fine**: n = 2048, τ = 1 ms, '
+             'h = 0.1 ms (benchmarks/hybrid_cost.py\'s finer settings). Penetration: the deepest '
+             'mesh vertex below the ground over the run. CPU: process time of the stepping per '
+             'simulated second. (d) has no error column: with μ = 0.5 the rounded square slips '
+             'at its vertices (README "Beyond rolling"), where friction takes energy, so its '
+             'exact rolling motion is no reference there; E shows each engine\'s energy '
+             'behaviour over the slips and landings.', '',
+             '| run | quantity | ' + ' | '.join(names) + ' |',
+             '| --- | --- | ' + ' | '.join('---' for _ in names) + ' |']
 
-    def row(run, what, key, fmt, scale=1.0, source=None):
-        c = source if source is not None else run
+    def row(c, what, key, fmt, scale=1.0):
         lines.append(f'| {what[0]} | {what[1]} | '
-                     + ' | '.join(fmt.format(scale * c[e][key]) for e in (m, d, fine)) + ' |')
+                     + ' | '.join(fmt.format(scale * c[e][key]) for e in names) + ' |')
     lines.append(f'| (a) slide, β = 0.3 rad, μ = 0.1, {s[m]["span"]:g} s | exact g (sin β − '
-                 f'μ cos β) (m/s²) | {s[m]["exact"]:.4f} | {s[d]["exact"]:.4f} '
-                 f'| {s[fine]["exact"]:.4f} |')
-    row(s, ('(a)', 'fitted acceleration (m/s²)'), 'accel', '{:.4f}')
-    row(s, ('(a)', 'relative error'), 'rel_error', '{:.1e}')
-    row(s, ('(a)', 'largest rotation (mrad)'), 'turn', '{:.2f}', 1e3)
+                 f'μ cos β) = {s[m]["exact"]:.4f} m/s²: fitted (m/s²) | '
+                 + ' | '.join(f'{s[e]["accel"]:.4f}' for e in names) + ' |')
+    row(s, ('(a)', 'relative error of the acceleration'), 'rel_error', '{:.1e}')
+    row(s, ('(a)', 'largest rotation of the body (mrad)'), 'turn', '{:.2f}', 1e3)
     row(s, ('(a)', 'penetration (mm)'), 'depth', '{:.4f}', 1e3)
     row(s, ('(a)', 'CPU per simulated s'), 'cpu', '{:.3f}', 1 / s[m]['span'])
-    row(f, (f'(b) flight, {f[m]["span"]:g} s', 'max \\|G − parabola\\| (m)'), 'g_error',
-        '{:.1e}')
+    row(f, (f'(b) flight with spin, {f[m]["span"]:g} s', 'max \\|G − parabola\\| (mm)'),
+        'g_error', '{:.3f}', 1e3)
     row(f, ('(b)', 'max \\|L − L0\\| / \\|L0\\| (about G)'), 'momentum_rel', '{:.1e}')
     row(f, ('(b)', 'max \\|ΔE_rot\\| / E_rot'), 'spin_energy_rel', '{:.1e}')
     row(f, ('(b)', 'CPU per simulated s'), 'cpu', '{:.3f}', 1 / f[m]['span'])
-    for c, label in ((r, f'(c) oloid rolling, {r[m]["span"]:g} s'),
-                     (q, f'(d) rounded square, {q[m]["span"]:g} s')):
-        row(c, (label, 'max \\|G − G_rolling\\| (mm)'), 'g_error_max', '{:.2f}', 1e3)
-        row(c, (label.split(' ')[0], '\\|G − G_rolling\\| at 1 s (mm)'), 'g_error_1s', '{:.2f}',
-            1e3)
-        row(c, (label.split(' ')[0], f'E(0) = {c[m]["energy0"]:.4f} J: max \\|E − E(0)\\| (mJ)'),
+    label = f'(c) oloid rolling (config/oloid.yaml), {r[m]["span"]:g} s'
+    row(r, (label, '\\|G − G_rolling\\| at 1 s (mm)'), 'g_error_1s', '{:.2f}', 1e3)
+    row(r, ('(c)', f'max \\|G − G_rolling\\| over {r[m]["span"]:g} s (mm)'), 'g_error_max',
+        '{:.2f}', 1e3)
+    for c, tag in ((r, '(c)'), (q, f'(d) rounded square, {q[m]["span"]:g} s')):
+        row(c, (tag, f'E(0) = {c[m]["energy0"]:.4f} J: max \\|E − E(0)\\| (mJ)'),
             'energy_dev', '{:.1f}', 1e3)
-        row(c, (label.split(' ')[0], 'E at the end (J)'), 'energy_end', '{:.4f}')
-        row(c, (label.split(' ')[0], 'penetration (mm)'), 'depth', '{:.4f}', 1e3)
-        row(c, (label.split(' ')[0], 'CPU per simulated s'), 'cpu', '{:.3f}', 1 / c[m]['span'])
-    ratio = sum(_per_second(c[d]) for c in out.values()) / sum(_per_second(c[m])
-                                                               for c in out.values())
-    fine_ratio = sum(_per_second(c[fine]) for c in out.values()) / sum(
-        _per_second(c[m]) for c in out.values())
-    lines += ['', f'Drake costs {ratio:.1f}× MuJoCo\'s CPU over the four runs, MuJoCo fine '
-              f'{fine_ratio:.1f}× (build apart: MuJoCo {r[m]["build"]:.2f} s, Drake '
-              f'{r[d]["build"]:.2f} s, MuJoCo fine {r[fine]["build"]:.2f} s for the oloid). '
-              'The choice and its reasons: README "Beyond rolling".', END]
+        row(c, (tag[:3], 'E at the end (J)'), 'energy_end', '{:.4f}')
+        row(c, (tag[:3], 'penetration (mm)'), 'depth', '{:.4f}', 1e3)
+        row(c, (tag[:3], 'CPU per simulated s'), 'cpu', '{:.3f}', 1 / c[m]['span'])
+    row(out['steps'], ('(e) = (c) over 1 s, stepped one step at a time from Python, the state '
+                       'read after each step (as the hybrid steps its engine)',
+                       'CPU per simulated s'), 'cpu', '{:.3f}')
+    total = {e: sum(_per_second(out[k][e]) for k in ('slide', 'flight', 'rolling', 'square'))
+             for e in names}
+    lines += ['', 'CPU over the runs (a) to (d) against MuJoCo\'s: '
+              + ', '.join(f'{e} {total[e] / total[m]:.1f}×' for e in names[1:])
+              + ' (the build apart: ' + ', '.join(f'{e} {r[e]["build"]:.2f} s' for e in names)
+              + ' for the oloid). The choice and its reasons: README "Beyond rolling".', END]
     return '\n'.join(lines) + '\n'
 
 
