@@ -60,15 +60,14 @@ chromium:
 	    $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq --no-install-recommends chromium; fi
 
 ## Run the whole test suite (what CI runs), one pytest worker per core. A test module stays
-## on one worker: the modules whose nodes subscribe each use a ROS domain of their own. The
-## modules go out costliest first (tests/conftest.py), so that the workers end together.
+## on one worker: the modules whose nodes subscribe each use a ROS domain of their own.
 ## The package's bytecode is written first: the suite starts a few hundred Python processes,
 ## and where PYTHONDONTWRITEBYTECODE is set each would compile the package again (~0.2 s of
 ## CPU apiece). PYTEST_ARGS adds options (make bench passes --durations).
 PYTEST_ARGS ?=
 test: venv foxglove-readers chromium
 	@$(PY) -m compileall -q twodisk_ros tests benchmarks tools
-	$(PY) -m pytest -n auto --dist loadfile --no-loadscope-reorder $(PYTEST_ARGS)
+	$(PY) -m pytest -n auto --dist loadfile $(PYTEST_ARGS)
 
 ## The main job: record a 20 s oloid run to MCAP, check it offline, write a plot and a GIF.
 demo: venv

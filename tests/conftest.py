@@ -15,22 +15,11 @@ of 700: with every test module imported a worker's heap is large, and the defaul
 of the in-process time of the physics tests in ~2 400 collections (3.5 s of 48 s measured on
 three of their files; 0.5 s in 13 collections after). Reference counting still frees
 everything that is not in a cycle at once; cycles wait a little longer.
-
-The test files run costliest first (:func:`pytest_collection_modifyitems`), each file's tests
-in their own order: ``make test`` hands whole files to its two workers (``--dist loadfile
---no-loadscope-reorder``) in this order, so the last files to start are short ones and the
-workers end together (ordered by their number of tests instead, the last files were the
-browser's and the clock's, and one worker ended 10 s after the other). The costs are the
-seconds per file measured on a fresh clone (tests/file_costs.json; a file not listed counts
-as the median): stale numbers only cost balance, never a result.
 """
 
 import gc
-import json
 import os
-from pathlib import Path
 import shutil
-import statistics
 import tempfile
 
 from hypothesis import settings
@@ -47,11 +36,3 @@ def pytest_unconfigure(config):
 settings.register_profile('ci', derandomize=True, print_blob=True)
 if os.environ.get('CI', '').lower() in ('1', 'true', 'yes'):
     settings.load_profile('ci')
-
-
-def pytest_collection_modifyitems(session, config, items):
-    """Files by their measured cost, costliest first (the module docstring); a stable sort,
-    so each file's tests keep their order and stay together."""
-    costs = json.loads(Path(__file__).with_name('file_costs.json').read_text())
-    median = statistics.median(costs.values())
-    items.sort(key=lambda item: -costs.get(item.nodeid.split('::')[0], median))

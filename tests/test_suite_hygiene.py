@@ -41,13 +41,3 @@ def test_a_child_that_raises_sigint_on_itself_installs_the_handler_first():
             if 'raise_signal(signal.SIGINT)' in script:
                 assert 'signal.signal(signal.SIGINT, signal.default_int_handler)' in script, (
                     f'{path.name}: a child script raises SIGINT without installing its handler')
-
-
-def test_the_file_costs_name_the_test_files_that_exist():
-    """tests/file_costs.json (the order in which make test hands out files, conftest.py)
-    names no file that is gone, and gives every listed file a positive cost."""
-    import json
-    costs = json.loads((TESTS / 'file_costs.json').read_text())
-    files = {f'tests/{p.name}' for p in TESTS.glob('test_*.py')}
-    assert set(costs) <= files, sorted(set(costs) - files)
-    assert all(value > 0 for value in costs.values())
