@@ -48,12 +48,10 @@ import argparse
 import json
 import math
 import os
-import platform
-import subprocess
 import sys
 import time
 
-from sections import replace_section
+from sections import provenance, replace_section
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -75,13 +73,6 @@ def _parser():
                         help='the report whose section is written (default docs/benchmarks.md)')
     parser.add_argument('--no-write', action='store_true', help='print the JSON only')
     return parser
-
-
-def _run(cmd):
-    try:
-        return subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return ''
 
 
 def _matrix(q):
@@ -477,12 +468,7 @@ def main():
     if args.repeats < 1:
         print('engine_choice.py: --repeats must be an integer >= 1', file=sys.stderr)
         return 2
-    cpu = next((line.split(':', 1)[1].strip() for line in _run(['lscpu']).splitlines()
-                if line.startswith('Model name')), platform.processor() or 'unknown CPU')
-    machine = f'{cpu}, {_run(["nproc"]) or os.cpu_count()} CPUs, Python ' \
-        f'{platform.python_version()}'
-    date = _run(['date', '-u']) or time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())
-    commit = _run(['git', '-C', ROOT, 'rev-parse', 'HEAD']) or 'unknown'
+    machine, date, commit = provenance(ROOT)
     out = measure(args.quick, 1 if args.quick else args.repeats)
     print(json.dumps(dict(machine=machine, date=date, commit=commit, cases=out), indent=1))
     if not args.no_write:
