@@ -158,17 +158,19 @@ def recorded_energies(engine, model, slope, to_slope):
     return stamps[ok], energy[ok], dynamics.mass.mass * dynamics.gravity * cos * height[ok]
 
 
-def depth_bounds(stamps, engine, model, parameters, size, slope, to_slope):
+def depth_bounds(stamps, engine, model, parameters, size, slope, to_slope, energies=None):
     """(bound m per contact sample at ``stamps`` ns, one line on it): δ0 + c τ v_max with
     δ0 = DEPTH_TOLERANCE × size, c = f(ζ) dmax / (2 d0) (module docstring) and v_max of
     :func:`approach_speed_bound` with T ≤ max E − min V over the samples from the last one
     before ``LANDING_WINDOW`` τ ahead of the sample to it (a landing's touchdown in that
     window starts from such a state; gravity's work on the way is in min V). Without the
-    rolling_state or poses (or a model) the bound is δ0."""
+    rolling_state or poses (or a model) the bound is δ0. ``energies``: what
+    :func:`recorded_energies` gives for these arguments, if already computed."""
     tau, zeta, d0, dmax, source = contact_parameters(parameters)
     c = 0.5 * landing_depth_factor(min(max(zeta, 1e-3), 10.0)) * dmax / d0
     floor = DEPTH_TOLERANCE * size
-    found = recorded_energies(engine, model, slope, to_slope)
+    found = (recorded_energies(engine, model, slope, to_slope) if energies is None
+             else energies)
     if found is None or not len(found[0]):
         return np.full(len(stamps), floor), (f'{DEPTH_TOLERANCE:g} of the size (no engine '
                                              f'energies recorded for a landing bound)')
@@ -202,6 +204,7 @@ def engine_check(engine, intervals, parameters, weight, size, model=None):
 
     worst, where, count = 0.0, '', 0
     said, closest = f'{DEPTH_TOLERANCE:g} of the size', None
+    energies = recorded_energies(engine, model, slope, to_slope)     # both disks' bounds
     for disk in 'ab':
         wrench, point = engine.get('wrench_' + disk), engine.get('contact_' + disk)
         if wrench is not None and len(wrench):
@@ -218,7 +221,7 @@ def engine_check(engine, intervals, parameters, weight, size, model=None):
                     worst, where = float(excess[i]), f'{name} at stamp {wrench.stamp_ns[i]}'
         if point is not None and len(point):
             bound, said = depth_bounds(point.stamp_ns, engine, model, parameters, size, slope,
-                                       to_slope)
+                                       to_slope, energies)
             deep = -ground(point.values['point'])[:, 2]
             depth = (deep - bound) / size
             j = int(np.argmax(deep / bound))
